@@ -1,0 +1,314 @@
+//! Building soft bodies from vertices and tetrahedra.
+
+use hecs::{Entity, World};
+use nalgebra::Vector3;
+
+use crate::constraint::{signed_height, signed_volume, VERTEX_FACE_ORDER};
+use crate::error::BuildError;
+use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::mesh::{Surface, Tetrahedra};
+use crate::particles::Particles;
+
+/// A tetrahedral mesh: vertex positions (m) and tetrahedra as vertex indices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TetMesh {
+    /// Vertex positions, m.
+    pub vertices: Vec<Vector3<f32>>,
+    /// Tetrahedra, four vertex indices each, either orientation.
+    pub tets: Vec<[u32; 4]>,
+}
+
+/// A built soft body: its components, ready to be spawned as one entity.
+///
+/// Fields are the components; `None` families are simply not added.
+#[derive(Clone, Debug)]
+pub struct SoftBody {
+    /// Particle state.
+    pub particles: Particles,
+    /// Tetrahedra with rest volumes.
+    pub tetrahedra: Tetrahedra,
+    /// Boundary triangles.
+    pub surface: Surface,
+    /// Edge family, if chosen.
+    pub edges: Option<EdgeConstraints>,
+    /// Vertex–face family, if chosen.
+    pub vertex_face: Option<VertexFaceConstraints>,
+    /// Volume family, if chosen.
+    pub volume: Option<VolumeConstraints>,
+}
+
+impl SoftBody {
+    /// Spawns the body as one entity holding its components.
+    pub fn spawn(self, world: &mut World) -> Entity {
+        let mut b = hecs::EntityBuilder::new();
+        b.add(self.particles).add(self.tetrahedra).add(self.surface);
+        if let Some(e) = self.edges {
+            b.add(e);
+        }
+        if let Some(v) = self.vertex_face {
+            b.add(v);
+        }
+        if let Some(v) = self.volume {
+            b.add(v);
+        }
+        world.spawn(b.build())
+    }
+}
+
+/// Builds a [`SoftBody`] from raw vertices and tetrahedra, choosing its constraint families.
+///
+/// ```
+/// use tetpbd::{generators, SoftBodyBuilder};
+/// let mesh = generators::box_grid(nalgebra::Vector3::new(1.0, 1.0, 1.0), [2, 2, 2], generators::CellSplit::Six)?;
+/// let body = SoftBodyBuilder::new(mesh).density(1000.0).edges(0.0).volume(0.0).build()?;
+/// assert!(body.vertex_face.is_none());
+/// # Ok::<(), tetpbd::BuildError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct SoftBodyBuilder {
+    mesh: TetMesh,
+    density: f32,
+    edge: Option<f32>,
+    vertex_face: Option<f32>,
+    volume: Option<f32>,
+    pinned: Vec<u32>,
+    velocity: Vector3<f32>,
+    translation: Vector3<f32>,
+    epsilon: f32,
+}
+
+impl SoftBodyBuilder {
+    /// Default relative volume epsilon: a tetrahedron with `|V| < 1e-6 · (longest edge)³`
+    /// is rejected as degenerate.
+    pub const DEFAULT_EPSILON: f32 = 1e-6;
+
+    /// Starts from a mesh. Defaults: density 1000 kg/m³, no constraint family, nothing pinned.
+    pub fn new(mesh: TetMesh) -> Self {
+        SoftBodyBuilder {
+            mesh,
+            density: 1000.0,
+            edge: None,
+            vertex_face: None,
+            volume: None,
+            pinned: Vec::new(),
+            velocity: Vector3::zeros(),
+            translation: Vector3::zeros(),
+            epsilon: Self::DEFAULT_EPSILON,
+        }
+    }
+
+    /// Starts from raw arrays.
+    pub fn from_arrays(vertices: Vec<Vector3<f32>>, tets: Vec<[u32; 4]>) -> Self {
+        Self::new(TetMesh { vertices, tets })
+    }
+
+    /// Density, kg/m³; masses are lumped as `density · |V| / 4` per tetrahedron corner.
+    pub fn density(mut self, density: f32) -> Self {
+        self.density = density;
+        self
+    }
+
+    /// Adds the edge family with compliance `alpha` (m/N; 0 = rigid).
+    pub fn edges(mut self, alpha: f32) -> Self {
+        self.edge = Some(alpha);
+        self
+    }
+
+    /// Adds the vertex–face family with compliance `alpha` (m/N).
+    pub fn vertex_face(mut self, alpha: f32) -> Self {
+        self.vertex_face = Some(alpha);
+        self
+    }
+
+    /// Adds the volume family with compliance `alpha` (m⁵/N).
+    pub fn volume(mut self, alpha: f32) -> Self {
+        self.volume = Some(alpha);
+        self
+    }
+
+    /// Pins these vertices (inverse mass 0).
+    pub fn pinned(mut self, vertices: impl IntoIterator<Item = u32>) -> Self {
+        self.pinned.extend(vertices);
+        self
+    }
+
+    /// Initial velocity of every free particle, m/s.
+    pub fn velocity(mut self, v: Vector3<f32>) -> Self {
+        self.velocity = v;
+        self
+    }
+
+    /// Moves the mesh by `t` (m) before building; rest data is translation-free.
+    pub fn translation(mut self, t: Vector3<f32>) -> Self {
+        self.translation = t;
+        self
+    }
+
+    /// Relative volume epsilon (see [`Self::DEFAULT_EPSILON`]).
+    pub fn volume_epsilon(mut self, eps: f32) -> Self {
+        self.epsilon = eps;
+        self
+    }
+
+    /// Validates the input and builds the components.
+    pub fn build(self) -> Result<SoftBody, BuildError> {
+        let SoftBodyBuilder {
+            mesh,
+            density,
+            edge,
+            vertex_face,
+            volume,
+            pinned,
+            velocity,
+            translation,
+            epsilon,
+        } = self;
+        let n = mesh.vertices.len();
+        if n == 0 {
+            return Err(BuildError::NoVertices);
+        }
+        if !(density.is_finite() && density > 0.0) {
+            return Err(BuildError::BadDensity { value: density });
+        }
+        if !(epsilon.is_finite() && epsilon >= 0.0) {
+            return Err(BuildError::BadEpsilon { value: epsilon });
+        }
+        for (family, a) in [("edge", edge), ("vertex-face", vertex_face), ("volume", volume)] {
+            if let Some(a) = a {
+                if !(a.is_finite() && a >= 0.0) {
+                    return Err(BuildError::BadCompliance { family, value: a });
+                }
+            }
+        }
+        if !velocity.iter().all(|c| c.is_finite()) {
+            return Err(BuildError::NonFiniteVelocity);
+        }
+        let positions: Vec<Vector3<f32>> = mesh.vertices.iter().map(|v| v + translation).collect();
+        for (i, (v, p)) in mesh.vertices.iter().zip(&positions).enumerate() {
+            if !v.iter().chain(p.iter()).all(|c| c.is_finite()) {
+                return Err(BuildError::NonFiniteVertex { vertex: i });
+            }
+        }
+        let mut rest_volumes = Vec::with_capacity(mesh.tets.len());
+        let mut masses = vec![0.0f32; n];
+        for (t, tet) in mesh.tets.iter().enumerate() {
+            for (k, &i) in tet.iter().enumerate() {
+                if i as usize >= n {
+                    return Err(BuildError::IndexOutOfRange {
+                        tet: t,
+                        index: i,
+                        vertex_count: n,
+                    });
+                }
+                if tet[..k].contains(&i) {
+                    return Err(BuildError::RepeatedVertex { tet: t, index: i });
+                }
+            }
+            let p = tet.map(|i| mesh.vertices[i as usize]);
+            let vol = signed_volume(&p[0], &p[1], &p[2], &p[3]);
+            let mut longest = 0.0f32;
+            for a in 0..4 {
+                for b in a + 1..4 {
+                    longest = longest.max((p[a] - p[b]).norm());
+                }
+            }
+            let threshold = epsilon * longest * longest * longest;
+            if !(vol.abs() > threshold) || vol == 0.0 {
+                return Err(BuildError::DegenerateTetrahedron {
+                    tet: t,
+                    volume: vol,
+                    threshold,
+                });
+            }
+            rest_volumes.push(vol);
+            for &i in tet {
+                masses[i as usize] += density * vol.abs() / 4.0;
+            }
+        }
+        if let Some(vertex) = masses.iter().position(|m| *m <= 0.0) {
+            return Err(BuildError::UnreferencedVertex { vertex });
+        }
+        let mut inv_masses: Vec<f32> = masses.iter().map(|m| 1.0 / m).collect();
+        for &i in &pinned {
+            match inv_masses.get_mut(i as usize) {
+                Some(w) => *w = 0.0,
+                None => {
+                    return Err(BuildError::PinnedOutOfRange {
+                        index: i,
+                        vertex_count: n,
+                    })
+                }
+            }
+        }
+        let velocities = inv_masses
+            .iter()
+            .map(|w| if *w > 0.0 { velocity } else { Vector3::zeros() })
+            .collect();
+        let surface = Surface::from_tetrahedra(&mesh.tets, &mesh.vertices);
+        let edges = edge.map(|alpha| {
+            let list = unique_edges(&mesh.tets);
+            let rest_lengths = list
+                .iter()
+                .map(|[a, b]| (mesh.vertices[*a as usize] - mesh.vertices[*b as usize]).norm())
+                .collect();
+            EdgeConstraints {
+                lambdas: vec![0.0; list.len()],
+                edges: list,
+                rest_lengths,
+                compliance: alpha,
+            }
+        });
+        let vertex_face = vertex_face.map(|alpha| VertexFaceConstraints {
+            rest_heights: mesh
+                .tets
+                .iter()
+                .map(|tet| {
+                    VERTEX_FACE_ORDER.map(|o| {
+                        let [a, b, c, d] = o.map(|k| mesh.vertices[tet[k] as usize]);
+                        // The volume check above guarantees a non-degenerate face.
+                        signed_height(&a, &b, &c, &d).unwrap_or(0.0)
+                    })
+                })
+                .collect(),
+            lambdas: vec![[0.0; 4]; mesh.tets.len()],
+            compliance: alpha,
+        });
+        let volume = volume.map(|alpha| VolumeConstraints {
+            lambdas: vec![0.0; mesh.tets.len()],
+            compliance: alpha,
+        });
+        Ok(SoftBody {
+            particles: Particles {
+                prev_positions: positions.clone(),
+                positions,
+                velocities,
+                inv_masses,
+                masses,
+                rest_positions: mesh.vertices,
+            },
+            tetrahedra: Tetrahedra {
+                indices: mesh.tets,
+                rest_volumes,
+            },
+            surface,
+            edges,
+            vertex_face,
+            volume,
+        })
+    }
+}
+
+/// The unique edges of `tets`, each `[low, high]`, sorted.
+pub fn unique_edges(tets: &[[u32; 4]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(tets.len() * 6);
+    for t in tets {
+        for a in 0..4 {
+            for b in a + 1..4 {
+                edges.push([t[a].min(t[b]), t[a].max(t[b])]);
+            }
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}

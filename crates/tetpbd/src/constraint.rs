@@ -1,0 +1,249 @@
+//! Constraint math: pure functions, no ECS, no rapier.
+//!
+//! Every function here is generic over the scalar (`f32` in the solver, `f64` in the
+//! finite-difference tests) and returns `None` instead of a non-finite value when the
+//! configuration is degenerate. The systems count those `None`s in [`crate::StepStats`].
+//!
+//! # XPBD
+//!
+//! For a constraint `C(x₀ … xₙ)` with compliance `α` (inverse stiffness), one Gauss–Seidel
+//! projection inside a substep of length `h` is (Macklin et al. 2016, "XPBD"):
+//!
+//! ```text
+//! α̃  = α / h²
+//! Δλ = (−C − α̃ λ) / (Σᵢ wᵢ |∇ᵢC|² + α̃)
+//! Δxᵢ = wᵢ ∇ᵢC Δλ,        λ ← λ + Δλ
+//! ```
+//!
+//! where `wᵢ` is the inverse mass of particle `i` and `λ` the constraint's accumulated
+//! Lagrange multiplier, reset to zero at the start of every substep. With `α = 0` this is
+//! the hard PBD projection of Müller et al. 2006, which removes `C` to first order in one
+//! step. The potential energy behind a compliant constraint is `U = C² / (2α)`, so `α` has the
+//! units of `C² / J`: m/N for the two length constraints, m⁵/N for the volume constraint.
+
+use nalgebra::{RealField, Vector3};
+
+/// One XPBD multiplier update.
+///
+/// `c` is the constraint value, `lambda` its accumulated multiplier, `alpha_tilde = α/h²`,
+/// `w_grad_sq` the sum `Σ wᵢ |∇ᵢC|²`. Returns `Δλ`, or `None` when the denominator is not
+/// positive (all particles pinned and `α = 0`, or a vanishing gradient).
+#[inline]
+pub fn xpbd_delta_lambda<T: RealField + Copy>(
+    c: T,
+    lambda: T,
+    alpha_tilde: T,
+    w_grad_sq: T,
+) -> Option<T> {
+    let denom = w_grad_sq + alpha_tilde;
+    if denom > T::default_epsilon() * T::default_epsilon() {
+        Some((-c - alpha_tilde * lambda) / denom)
+    } else {
+        None
+    }
+}
+
+/// A constraint value with its gradients with respect to each of its `N` particles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Evaluated<T: RealField + Copy, const N: usize> {
+    /// The constraint value `C`.
+    pub c: T,
+    /// `∇ᵢC` for each particle, in the order the particles were passed.
+    pub grad: [Vector3<T>; N],
+}
+
+// ---------------------------------------------------------------------------------------
+// Edge distance.
+//
+// C = |p0 − p1| − d. With n = (p0 − p1)/|p0 − p1|: ∇p0 C = n, ∇p1 C = −n, |∇|² = 1 each.
+// A zero-length edge has no direction; the caller may pass the rest direction as fallback.
+// ---------------------------------------------------------------------------------------
+
+/// Edge distance constraint `C = |p0 − p1| − d`.
+///
+/// * `C` in metres, compliance in m/N.
+/// * `∇p0 C = (p0 − p1) / |p0 − p1|`, `∇p1 C = −∇p0 C`.
+///
+/// When `|p0 − p1|` is below `1e-6 · d` (coincident points) the direction is undefined. The
+/// `fallback` unit vector is then used as `∇p0 C` (the solver passes the rest-pose direction,
+/// so a collapsed edge re-expands the way it was built); with `fallback = None` the function
+/// returns `None`.
+#[inline]
+pub fn edge<T: RealField + Copy>(
+    p0: &Vector3<T>,
+    p1: &Vector3<T>,
+    rest_length: T,
+    fallback: Option<&Vector3<T>>,
+) -> Option<Evaluated<T, 2>> {
+    let d = p0 - p1;
+    let len = d.norm();
+    let tiny = rest_length * nalgebra::convert::<f64, T>(1e-6);
+    let n = if len > tiny && len > T::zero() {
+        d / len
+    } else {
+        *fallback?
+    };
+    Some(Evaluated {
+        c: len - rest_length,
+        grad: [n, -n],
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// Vertex–face ("plane") constraint, as derived in the seed.
+//
+// Translate so that p0 = 0: a = p1 − p0, b = p2 − p0, c = p3 − p0, m = b × c, n = m/|m|.
+//   C      = a·n − d
+//   ∇p1 C  = n
+//   ∇p2 C  = ( c × a + (n × c)(n·a) ) / |m|
+//   ∇p3 C  = −( b × a + (n × b)(n·a) ) / |m|
+//   ∇p0 C  = −(∇p1 + ∇p2 + ∇p3)           (translation invariance)
+// |m| → 0 (the face collapses to a segment or a point) leaves n undefined: return None.
+// ---------------------------------------------------------------------------------------
+
+/// Vertex–face constraint: `p1` held at signed height `d` above the plane through
+/// `p0, p2, p3`.
+///
+/// ```text
+/// C = (p1 − p0) · n − d,     n = ((p2 − p0) × (p3 − p0)) / |(p2 − p0) × (p3 − p0)|
+/// ```
+///
+/// * `C` in metres, compliance in m/N; `d` is signed (from the rest pose), so an inverted
+///   tetrahedron has `C ≈ −2d` and is pushed back through the plane.
+/// * With `a = p1 − p0`, `b = p2 − p0`, `c = p3 − p0`, `m = b × c`:
+///   `∇p1 C = n`, `∇p2 C = (c × a + (n × c)(n·a)) / |m|`,
+///   `∇p3 C = −(b × a + (n × b)(n·a)) / |m|`, `∇p0 C = −(∇p1 C + ∇p2 C + ∇p3 C)`.
+///
+/// Returns `None` when the face is degenerate: `|m| ≤ 1e-7 · (|b|² + |c|²)` (collinear or
+/// coincident face points; the plane's normal is undefined).
+#[inline]
+pub fn vertex_face<T: RealField + Copy>(
+    p0: &Vector3<T>,
+    p1: &Vector3<T>,
+    p2: &Vector3<T>,
+    p3: &Vector3<T>,
+    rest_height: T,
+) -> Option<Evaluated<T, 4>> {
+    let a = p1 - p0;
+    let b = p2 - p0;
+    let c = p3 - p0;
+    let m = b.cross(&c);
+    let m_len = m.norm();
+    let scale = b.norm_squared() + c.norm_squared();
+    if !(m_len > scale * nalgebra::convert::<f64, T>(1e-7)) || m_len <= T::zero() {
+        return None;
+    }
+    let inv = T::one() / m_len;
+    let n = m * inv;
+    let na = n.dot(&a);
+    let g1 = n;
+    let g2 = (c.cross(&a) + n.cross(&c) * na) * inv;
+    let g3 = -(b.cross(&a) + n.cross(&b) * na) * inv;
+    let g0 = -(g1 + g2 + g3);
+    Some(Evaluated {
+        c: na - rest_height,
+        grad: [g0, g1, g2, g3],
+    })
+}
+
+/// The four vertex–face constraints of tetrahedron `(v0, v1, v2, v3)`.
+///
+/// Entry `k` lists the corners passed to [`vertex_face`] as `(p0, p1, p2, p3)` so that
+/// corner `k` plays `p1`, the vertex held above the plane of the other three. Each is an
+/// even permutation of `(0, 1, 2, 3)`, so all four rest heights carry the sign of the
+/// tetrahedron's signed volume.
+pub const VERTEX_FACE_ORDER: [[usize; 4]; 4] = [[1, 0, 3, 2], [0, 1, 2, 3], [0, 2, 3, 1], [0, 3, 1, 2]];
+
+/// Signed height of `p1` above the plane through `p0, p2, p3` (the `C + d` of
+/// [`vertex_face`]), or `None` for a degenerate face.
+#[inline]
+pub fn signed_height<T: RealField + Copy>(
+    p0: &Vector3<T>,
+    p1: &Vector3<T>,
+    p2: &Vector3<T>,
+    p3: &Vector3<T>,
+) -> Option<T> {
+    vertex_face(p0, p1, p2, p3, T::zero()).map(|e| e.c)
+}
+
+// ---------------------------------------------------------------------------------------
+// Signed volume.
+//
+// C = (1/6) a·(b × c) − V with a, b, c as above.
+//   ∇p1 C = (1/6) b × c,  ∇p2 C = (1/6) c × a,  ∇p3 C = (1/6) a × b,  ∇p0 C = −Σ.
+// (The seed writes ∇p2 = −(1/6) a × c, the same vector.) The gradients vanish only when all
+// four points are collinear/coincident; the XPBD denominator then vanishes and the caller
+// skips the projection.
+// ---------------------------------------------------------------------------------------
+
+/// Signed volume of the tetrahedron `(p0, p1, p2, p3)`: `(1/6)(p1 − p0)·((p2 − p0) × (p3 − p0))`,
+/// in m³. Positive when `p1` lies on the side of the face `(p0, p2, p3)` its normal points to.
+#[inline]
+pub fn signed_volume<T: RealField + Copy>(
+    p0: &Vector3<T>,
+    p1: &Vector3<T>,
+    p2: &Vector3<T>,
+    p3: &Vector3<T>,
+) -> T {
+    (p1 - p0).dot(&(p2 - p0).cross(&(p3 - p0))) * nalgebra::convert::<f64, T>(1.0 / 6.0)
+}
+
+/// Signed volume constraint `C = (1/6)(p1 − p0)·((p2 − p0) × (p3 − p0)) − V`.
+///
+/// * `C` in m³, compliance in m⁵/N (`U = C²/2α`; a bulk modulus `K` in Pa corresponds to
+///   `α = V/K`).
+/// * With `a = p1 − p0`, `b = p2 − p0`, `c = p3 − p0`: `∇p1 C = (1/6) b × c`,
+///   `∇p2 C = (1/6) c × a`, `∇p3 C = (1/6) a × b`, `∇p0 C = −(∇p1 C + ∇p2 C + ∇p3 C)`.
+///
+/// Always finite for finite input; the gradients are all zero when the four points are
+/// collinear, which [`xpbd_delta_lambda`] reports as `None`.
+#[inline]
+pub fn volume<T: RealField + Copy>(
+    p0: &Vector3<T>,
+    p1: &Vector3<T>,
+    p2: &Vector3<T>,
+    p3: &Vector3<T>,
+    rest_volume: T,
+) -> Evaluated<T, 4> {
+    let sixth = nalgebra::convert::<f64, T>(1.0 / 6.0);
+    let a = p1 - p0;
+    let b = p2 - p0;
+    let c = p3 - p0;
+    let g1 = b.cross(&c) * sixth;
+    let g2 = c.cross(&a) * sixth;
+    let g3 = a.cross(&b) * sixth;
+    let g0 = -(g1 + g2 + g3);
+    Evaluated {
+        c: a.dot(&b.cross(&c)) * sixth - rest_volume,
+        grad: [g0, g1, g2, g3],
+    }
+}
+
+/// Applies one XPBD projection of an evaluated constraint to the particles `idx`.
+///
+/// `w` are the particles' inverse masses, `lambda` the constraint's multiplier (updated in
+/// place). Returns `false` (and moves nothing) when [`xpbd_delta_lambda`] returns `None`.
+#[inline]
+pub fn apply<const N: usize>(
+    positions: &mut [Vector3<f32>],
+    idx: [usize; N],
+    w: [f32; N],
+    e: &Evaluated<f32, N>,
+    lambda: &mut f32,
+    alpha_tilde: f32,
+) -> bool {
+    let mut w_grad_sq = 0.0;
+    for k in 0..N {
+        w_grad_sq += w[k] * e.grad[k].norm_squared();
+    }
+    match xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
+        Some(dl) => {
+            *lambda += dl;
+            for k in 0..N {
+                positions[idx[k]] += e.grad[k] * (w[k] * dl);
+            }
+            true
+        }
+        None => false,
+    }
+}

@@ -1,0 +1,218 @@
+//! Error types: one per kind of call, each naming what is wrong.
+
+use std::fmt;
+
+/// Why a soft body could not be built.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BuildError {
+    /// The mesh has no vertices.
+    NoVertices,
+    /// A vertex coordinate is NaN or infinite.
+    NonFiniteVertex {
+        /// Vertex index.
+        vertex: usize,
+    },
+    /// A tetrahedron refers to a vertex that does not exist.
+    IndexOutOfRange {
+        /// Tetrahedron index.
+        tet: usize,
+        /// The offending vertex index.
+        index: u32,
+        /// Number of vertices.
+        vertex_count: usize,
+    },
+    /// A tetrahedron uses the same vertex twice.
+    RepeatedVertex {
+        /// Tetrahedron index.
+        tet: usize,
+        /// The repeated vertex index.
+        index: u32,
+    },
+    /// A tetrahedron's |volume| is below `epsilon · (longest edge)³`.
+    DegenerateTetrahedron {
+        /// Tetrahedron index.
+        tet: usize,
+        /// Its signed volume, m³.
+        volume: f32,
+        /// The threshold it fell below, m³.
+        threshold: f32,
+    },
+    /// A vertex belongs to no tetrahedron, so it would have no mass.
+    UnreferencedVertex {
+        /// Vertex index.
+        vertex: usize,
+    },
+    /// A pinned index does not exist.
+    PinnedOutOfRange {
+        /// The offending index.
+        index: u32,
+        /// Number of vertices.
+        vertex_count: usize,
+    },
+    /// Density must be finite and > 0, kg/m³.
+    BadDensity {
+        /// The value given.
+        value: f32,
+    },
+    /// A compliance must be finite and ≥ 0.
+    BadCompliance {
+        /// Which family ("edge", "vertex-face", "volume").
+        family: &'static str,
+        /// The value given.
+        value: f32,
+    },
+    /// The volume epsilon must be finite and ≥ 0.
+    BadEpsilon {
+        /// The value given.
+        value: f32,
+    },
+    /// The initial velocity is NaN or infinite.
+    NonFiniteVelocity,
+    /// A generator parameter is out of range.
+    BadGeneratorParameter {
+        /// Parameter name.
+        name: &'static str,
+        /// The value given.
+        value: f32,
+    },
+}
+
+impl fmt::Display for BuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BuildError::NoVertices => write!(f, "the mesh has no vertices"),
+            BuildError::NonFiniteVertex { vertex } => {
+                write!(f, "vertex {vertex} has a non-finite coordinate")
+            }
+            BuildError::IndexOutOfRange {
+                tet,
+                index,
+                vertex_count,
+            } => write!(
+                f,
+                "tetrahedron {tet} refers to vertex {index}, but there are only {vertex_count} vertices"
+            ),
+            BuildError::RepeatedVertex { tet, index } => {
+                write!(f, "tetrahedron {tet} uses vertex {index} more than once")
+            }
+            BuildError::DegenerateTetrahedron {
+                tet,
+                volume,
+                threshold,
+            } => write!(
+                f,
+                "tetrahedron {tet} has volume {volume:e} m³, below the threshold {threshold:e} m³"
+            ),
+            BuildError::UnreferencedVertex { vertex } => {
+                write!(f, "vertex {vertex} belongs to no tetrahedron")
+            }
+            BuildError::PinnedOutOfRange {
+                index,
+                vertex_count,
+            } => write!(
+                f,
+                "pinned vertex {index} does not exist ({vertex_count} vertices)"
+            ),
+            BuildError::BadDensity { value } => {
+                write!(f, "density must be finite and > 0 kg/m³, got {value}")
+            }
+            BuildError::BadCompliance { family, value } => write!(
+                f,
+                "{family} compliance must be finite and >= 0, got {value}"
+            ),
+            BuildError::BadEpsilon { value } => {
+                write!(f, "volume epsilon must be finite and >= 0, got {value}")
+            }
+            BuildError::NonFiniteVelocity => write!(f, "initial velocity is not finite"),
+            BuildError::BadGeneratorParameter { name, value } => {
+                write!(f, "generator parameter `{name}` is out of range: {value}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for BuildError {}
+
+/// Why solver settings were rejected.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SettingsError {
+    /// Frame time step must be finite and > 0, s.
+    BadDt {
+        /// The value given.
+        value: f32,
+    },
+    /// Substeps and iterations must be ≥ 1.
+    ZeroCount {
+        /// Which count ("substeps" or "iterations").
+        what: &'static str,
+    },
+    /// Gravity must be finite, m/s².
+    NonFiniteGravity,
+    /// Damping must be finite and ≥ 0, 1/s.
+    BadDamping {
+        /// The value given.
+        value: f32,
+    },
+    /// The family order must list each family exactly once.
+    BadOrder,
+}
+
+impl fmt::Display for SettingsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SettingsError::BadDt { value } => {
+                write!(f, "frame dt must be finite and > 0 s, got {value}")
+            }
+            SettingsError::ZeroCount { what } => write!(f, "{what} must be at least 1"),
+            SettingsError::NonFiniteGravity => write!(f, "gravity is not finite"),
+            SettingsError::BadDamping { value } => {
+                write!(f, "damping must be finite and >= 0 1/s, got {value}")
+            }
+            SettingsError::BadOrder => write!(f, "family order must list each family once"),
+        }
+    }
+}
+
+impl std::error::Error for SettingsError {}
+
+/// Why a write to a body's state was rejected.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StateError {
+    /// Particle index out of range.
+    ParticleOutOfRange {
+        /// The offending index.
+        index: usize,
+        /// Number of particles.
+        len: usize,
+    },
+    /// A value is NaN or infinite.
+    NonFinite {
+        /// What was written ("position", "velocity", "acceleration").
+        what: &'static str,
+        /// Particle index (0 for per-body values).
+        index: usize,
+    },
+    /// Compliance must be finite and ≥ 0.
+    BadCompliance {
+        /// The value given.
+        value: f32,
+    },
+}
+
+impl fmt::Display for StateError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StateError::ParticleOutOfRange { index, len } => {
+                write!(f, "particle {index} out of range ({len} particles)")
+            }
+            StateError::NonFinite { what, index } => {
+                write!(f, "{what} of particle {index} is not finite")
+            }
+            StateError::BadCompliance { value } => {
+                write!(f, "compliance must be finite and >= 0, got {value}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for StateError {}

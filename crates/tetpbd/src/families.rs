@@ -1,0 +1,117 @@
+//! The three constraint families, each an optional hecs component with its own compliance.
+//!
+//! A body without a family's component pays nothing for it: the family's system queries
+//! for the component and never sees the body. Multipliers (`λ`) live next to the data they
+//! belong to and are reset by the solver at the start of every substep.
+
+#[cfg(feature = "serde")]
+use serde::{Deserialize, Serialize};
+
+/// Edge distance constraints `C = |p0 − p1| − d`, one per unique edge of the tetrahedra.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct EdgeConstraints {
+    pub(crate) edges: Vec<[u32; 2]>,
+    pub(crate) rest_lengths: Vec<f32>,
+    pub(crate) lambdas: Vec<f32>,
+    /// Compliance α, m/N (inverse stiffness; 0 = rigid). Must be finite and ≥ 0.
+    pub(crate) compliance: f32,
+}
+
+/// Vertex–face constraints: four per tetrahedron, each vertex held at its signed rest height
+/// above the plane of the other three (see [`crate::constraint::vertex_face`]). Uses the
+/// body's [`crate::Tetrahedra`].
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct VertexFaceConstraints {
+    pub(crate) rest_heights: Vec<[f32; 4]>,
+    pub(crate) lambdas: Vec<[f32; 4]>,
+    /// Compliance α, m/N.
+    pub(crate) compliance: f32,
+}
+
+/// Signed volume constraints, one per tetrahedron (rest volumes in the body's
+/// [`crate::Tetrahedra`]). Combine with [`EdgeConstraints`]: volume alone does not keep shape.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct VolumeConstraints {
+    pub(crate) lambdas: Vec<f32>,
+    /// Compliance α, m⁵/N.
+    pub(crate) compliance: f32,
+}
+
+macro_rules! compliance_accessors {
+    ($t:ty, $unit:literal) => {
+        impl $t {
+            #[doc = concat!("Compliance α, ", $unit, ".")]
+            pub fn compliance(&self) -> f32 {
+                self.compliance
+            }
+
+            #[doc = concat!("Sets the compliance α (", $unit, "); rejects negative or non-finite values.")]
+            pub fn set_compliance(&mut self, alpha: f32) -> Result<(), crate::StateError> {
+                if alpha.is_finite() && alpha >= 0.0 {
+                    self.compliance = alpha;
+                    Ok(())
+                } else {
+                    Err(crate::StateError::BadCompliance { value: alpha })
+                }
+            }
+        }
+    };
+}
+
+compliance_accessors!(EdgeConstraints, "m/N");
+compliance_accessors!(VertexFaceConstraints, "m/N");
+compliance_accessors!(VolumeConstraints, "m⁵/N");
+
+impl EdgeConstraints {
+    /// Number of edge constraints.
+    pub fn len(&self) -> usize {
+        self.edges.len()
+    }
+
+    /// `true` when there is no edge.
+    pub fn is_empty(&self) -> bool {
+        self.edges.is_empty()
+    }
+
+    /// The edges as particle index pairs.
+    pub fn edges(&self) -> &[[u32; 2]] {
+        &self.edges
+    }
+
+    /// Rest length of each edge, m.
+    pub fn rest_lengths(&self) -> &[f32] {
+        &self.rest_lengths
+    }
+}
+
+impl VertexFaceConstraints {
+    /// Number of scalar constraints (four per tetrahedron).
+    pub fn len(&self) -> usize {
+        4 * self.rest_heights.len()
+    }
+
+    /// `true` when there is no constraint.
+    pub fn is_empty(&self) -> bool {
+        self.rest_heights.is_empty()
+    }
+
+    /// Signed rest heights, per tetrahedron, of corners 0..4 above their opposite faces, m.
+    pub fn rest_heights(&self) -> &[[f32; 4]] {
+        &self.rest_heights
+    }
+}
+
+impl VolumeConstraints {
+    /// Number of volume constraints (one per tetrahedron).
+    pub fn len(&self) -> usize {
+        self.lambdas.len()
+    }
+
+    /// `true` when there is no constraint.
+    pub fn is_empty(&self) -> bool {
+        self.lambdas.is_empty()
+    }
+}

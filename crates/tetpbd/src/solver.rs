@@ -1,0 +1,227 @@
+//! The solver: a frame as `substeps × iterations` of the systems.
+
+use std::time::Instant;
+
+use hecs::World;
+use nalgebra::Vector3;
+
+use crate::error::SettingsError;
+use crate::stats::{Family, StepStats};
+use crate::systems;
+
+/// Settings of a [`Solver`]. Fields are public; [`SolverSettings::validate`] (called by every
+/// step) rejects bad values with a typed error before they reach the state.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct SolverSettings {
+    /// Frame time step, s (> 0).
+    pub dt: f32,
+    /// Substeps per frame (≥ 1); each has length `h = dt / substeps`.
+    pub substeps: u32,
+    /// Constraint iterations per substep (≥ 1). Macklin et al. 2019 ("Small Steps in
+    /// Physics Simulation") show that spending a budget on substeps beats iterations, so the
+    /// default is many substeps of one iteration.
+    pub iterations: u32,
+    /// Gravity, m/s².
+    pub gravity: Vector3<f32>,
+    /// Linear velocity damping, 1/s (0 = none).
+    pub damping: f32,
+    /// The order in which the families are projected in an iteration. Default: volume,
+    /// vertex–face, edge — edges last, so lengths are closest to rest at the end.
+    pub order: [Family; 3],
+    /// Evaluate every constraint after the step to fill [`crate::FamilyStats::after`] and
+    /// [`StepStats::inverted`]. Costs about one extra sweep; off by default.
+    pub measure_error: bool,
+    /// Also evaluate every constraint before the step ([`crate::FamilyStats::before`]).
+    pub measure_before: bool,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings {
+            dt: 1.0 / 60.0,
+            substeps: 10,
+            iterations: 1,
+            gravity: Vector3::new(0.0, -9.81, 0.0),
+            damping: 0.0,
+            order: Family::ALL,
+            measure_error: false,
+            measure_before: false,
+        }
+    }
+}
+
+impl SolverSettings {
+    /// Checks every field; the first bad one is returned.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(SettingsError::BadDt { value: self.dt });
+        }
+        if self.substeps == 0 {
+            return Err(SettingsError::ZeroCount { what: "substeps" });
+        }
+        if self.iterations == 0 {
+            return Err(SettingsError::ZeroCount { what: "iterations" });
+        }
+        if !self.gravity.iter().all(|g| g.is_finite()) {
+            return Err(SettingsError::NonFiniteGravity);
+        }
+        if !(self.damping.is_finite() && self.damping >= 0.0) {
+            return Err(SettingsError::BadDamping {
+                value: self.damping,
+            });
+        }
+        let mut seen = [false; 3];
+        for f in self.order {
+            let i = f as usize;
+            if seen[i] {
+                return Err(SettingsError::BadOrder);
+            }
+            seen[i] = true;
+        }
+        Ok(())
+    }
+
+    /// Substep length `dt / substeps`, s.
+    pub fn substep_dt(&self) -> f32 {
+        self.dt / self.substeps as f32
+    }
+}
+
+/// Extra work run inside the solver's substep loop, e.g. collision constraints of a
+/// coupling crate. Every method has an empty default.
+pub trait SubstepHook {
+    /// Once per frame, before the first substep (gather collision candidates here).
+    fn begin_frame(&mut self, _world: &mut World, _dt: f32) {}
+    /// After prediction, before the first iteration of a substep.
+    fn begin_substep(&mut self, _world: &mut World, _h: f32) {}
+    /// Each iteration, after the internal constraint families.
+    fn project(&mut self, _world: &mut World, _h: f32) {}
+    /// After the velocity update of a substep (velocity-level friction and restitution).
+    fn end_substep(&mut self, _world: &mut World, _h: f32) {}
+    /// Once per frame, after the last substep.
+    fn end_frame(&mut self, _world: &mut World, _dt: f32) {}
+}
+
+/// The empty hook.
+impl SubstepHook for () {}
+
+/// Runs frames of the soft-body systems on a [`hecs::World`].
+///
+/// ```text
+/// for each of `substeps` substeps (h = dt / substeps):
+///     predict            x_prev ← x; v ← (v + h(g + a))·damping; x ← x + h v
+///     reset λ
+///     repeat `iterations` times: project families in `order`, then hook.project
+///     update velocities  v ← (x − x_prev) / h
+///     hook.end_substep
+/// ```
+#[derive(Clone, Debug, Default)]
+pub struct Solver {
+    /// The settings used by the next step.
+    pub settings: SolverSettings,
+}
+
+impl Solver {
+    /// A solver with validated settings.
+    pub fn new(settings: SolverSettings) -> Result<Solver, SettingsError> {
+        settings.validate()?;
+        Ok(Solver { settings })
+    }
+
+    /// Advances every soft body in `world` by one frame.
+    pub fn step(&mut self, world: &mut World) -> Result<StepStats, SettingsError> {
+        self.step_with(world, &mut ())
+    }
+
+    /// Advances every soft body by one frame, running `hook` inside the substep loop.
+    pub fn step_with(
+        &mut self,
+        world: &mut World,
+        hook: &mut dyn SubstepHook,
+    ) -> Result<StepStats, SettingsError> {
+        let s = &self.settings;
+        s.validate()?;
+        let start = Instant::now();
+        let mut stats = StepStats {
+            substeps: s.substeps,
+            iterations: s.iterations,
+            ..StepStats::default()
+        };
+        count_constraints(world, &mut stats);
+        if s.measure_before {
+            let m = systems::measure(world);
+            stats.edge.before = Some(m.edge);
+            stats.vertex_face.before = Some(m.vertex_face);
+            stats.volume.before = Some(m.volume);
+        }
+        let h = s.substep_dt();
+        let t = Instant::now();
+        hook.begin_frame(world, s.dt);
+        let mut hook_time = t.elapsed();
+        for _ in 0..s.substeps {
+            let t = Instant::now();
+            systems::predict(world, h, s.gravity, s.damping);
+            systems::reset_lambdas(world);
+            stats.predict_time += t.elapsed();
+            let t = Instant::now();
+            hook.begin_substep(world, h);
+            hook_time += t.elapsed();
+            for _ in 0..s.iterations {
+                for family in s.order {
+                    let t = Instant::now();
+                    let c = match family {
+                        Family::Edge => systems::project_edges(world, h),
+                        Family::VertexFace => systems::project_vertex_face(world, h),
+                        Family::Volume => systems::project_volume(world, h),
+                    };
+                    let f = stats.family_mut(family);
+                    f.time += t.elapsed();
+                    f.projections += c.applied;
+                    f.degenerate += c.degenerate;
+                }
+                let t = Instant::now();
+                hook.project(world, h);
+                hook_time += t.elapsed();
+            }
+            let t = Instant::now();
+            stats.non_finite_resets += systems::update_velocities(world, h);
+            stats.velocity_time += t.elapsed();
+            let t = Instant::now();
+            hook.end_substep(world, h);
+            hook_time += t.elapsed();
+        }
+        let t = Instant::now();
+        hook.end_frame(world, s.dt);
+        hook_time += t.elapsed();
+        stats.hook_time = hook_time;
+        if s.measure_error {
+            let t = Instant::now();
+            let m = systems::measure(world);
+            stats.edge.after = Some(m.edge);
+            stats.vertex_face.after = Some(m.vertex_face);
+            stats.volume.after = Some(m.volume);
+            stats.inverted = Some(m.inverted);
+            stats.measure_time = t.elapsed();
+        }
+        stats.total_time = start.elapsed();
+        Ok(stats)
+    }
+}
+
+fn count_constraints(world: &mut World, stats: &mut StepStats) {
+    use crate::{EdgeConstraints, Particles, VertexFaceConstraints, VolumeConstraints};
+    for p in world.query_mut::<&Particles>() {
+        stats.bodies += 1;
+        stats.particles += p.len();
+    }
+    for e in world.query_mut::<&EdgeConstraints>() {
+        stats.edge.count += e.len();
+    }
+    for v in world.query_mut::<&VertexFaceConstraints>() {
+        stats.vertex_face.count += v.len();
+    }
+    for v in world.query_mut::<&VolumeConstraints>() {
+        stats.volume.count += v.len();
+    }
+}

@@ -1,0 +1,249 @@
+//! Systems: plain functions over `&mut hecs::World`, each a loop over one query.
+//!
+//! [`crate::Solver`] calls them in this order every substep of length `h`:
+//! [`predict`], the family projections (`iterations` times, in
+//! [`crate::SolverSettings::order`]), [`update_velocities`]. They are public so that an
+//! integrator can build a different schedule.
+
+use hecs::World;
+use nalgebra::Vector3;
+
+use crate::constraint::{self, VERTEX_FACE_ORDER};
+use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::mesh::Tetrahedra;
+use crate::particles::{ExternalAcceleration, Particles};
+use crate::stats::{ErrorAccumulator, ErrorStats};
+
+/// Projections done and skipped by one call of a family system.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ProjectionCount {
+    /// Projections applied.
+    pub applied: u64,
+    /// Degenerate configurations skipped or handled by a fallback direction.
+    pub degenerate: u64,
+}
+
+/// Saves `x` as the substep start, applies gravity plus each body's
+/// [`ExternalAcceleration`] and the linear damping `v ← v · max(0, 1 − damping·h)` to free
+/// particles, then moves every particle to its prediction `x + h v`.
+///
+/// Pinned particles (inverse mass 0) keep their velocity: one set by the user moves them
+/// kinematically.
+pub fn predict(world: &mut World, h: f32, gravity: Vector3<f32>, damping: f32) {
+    let keep = (1.0 - damping * h).max(0.0);
+    for (p, extra) in world.query_mut::<(&mut Particles, Option<&ExternalAcceleration>)>() {
+        let a = gravity + extra.map_or(Vector3::zeros(), |e| e.0);
+        let Particles {
+            positions,
+            prev_positions,
+            velocities,
+            inv_masses,
+            ..
+        } = p;
+        for i in 0..positions.len() {
+            prev_positions[i] = positions[i];
+            if inv_masses[i] > 0.0 {
+                velocities[i] = (velocities[i] + a * h) * keep;
+            }
+            positions[i] += velocities[i] * h;
+        }
+    }
+}
+
+/// Sets every multiplier λ to zero (start of a substep).
+pub fn reset_lambdas(world: &mut World) {
+    for e in world.query_mut::<&mut EdgeConstraints>() {
+        e.lambdas.fill(0.0);
+    }
+    for v in world.query_mut::<&mut VertexFaceConstraints>() {
+        v.lambdas.fill([0.0; 4]);
+    }
+    for v in world.query_mut::<&mut VolumeConstraints>() {
+        v.lambdas.fill(0.0);
+    }
+}
+
+/// One Gauss–Seidel sweep over every body's [`EdgeConstraints`].
+///
+/// A zero-length edge (`|p0 − p1| < 1e-6 d`) is pushed apart along its rest-pose direction
+/// and counted as degenerate.
+pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
+    let mut count = ProjectionCount::default();
+    for (p, e) in world.query_mut::<(&mut Particles, &mut EdgeConstraints)>() {
+        let alpha_tilde = e.compliance / (h * h);
+        let x = &mut p.positions;
+        let w = &p.inv_masses;
+        for (k, &[a, b]) in e.edges.iter().enumerate() {
+            let (a, b) = (a as usize, b as usize);
+            let d = e.rest_lengths[k];
+            let delta = x[a] - x[b];
+            let len = delta.norm();
+            let n = if len > 1e-6 * d {
+                delta / len
+            } else {
+                count.degenerate += 1;
+                (p.rest_positions[a] - p.rest_positions[b]) / d
+            };
+            let wsum = w[a] + w[b];
+            let Some(dl) =
+                constraint::xpbd_delta_lambda(len - d, e.lambdas[k], alpha_tilde, wsum)
+            else {
+                continue;
+            };
+            e.lambdas[k] += dl;
+            x[a] += n * (w[a] * dl);
+            x[b] -= n * (w[b] * dl);
+            count.applied += 1;
+        }
+    }
+    count
+}
+
+/// One Gauss–Seidel sweep over every body's [`VertexFaceConstraints`], the four
+/// constraints of a tetrahedron one after another. A degenerate face is skipped and counted.
+pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
+    let mut count = ProjectionCount::default();
+    for (p, tets, vf) in
+        world.query_mut::<(&mut Particles, &Tetrahedra, &mut VertexFaceConstraints)>()
+    {
+        let alpha_tilde = vf.compliance / (h * h);
+        let x = &mut p.positions;
+        let w = &p.inv_masses;
+        for (t, tet) in tets.indices.iter().enumerate() {
+            for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
+                let idx = order.map(|o| tet[o] as usize);
+                let wi = idx.map(|i| w[i]);
+                let e = constraint::vertex_face(
+                    &x[idx[0]],
+                    &x[idx[1]],
+                    &x[idx[2]],
+                    &x[idx[3]],
+                    vf.rest_heights[t][k],
+                );
+                let applied = match e {
+                    Some(e) => constraint::apply(
+                        x,
+                        idx,
+                        wi,
+                        &e,
+                        &mut vf.lambdas[t][k],
+                        alpha_tilde,
+                    ),
+                    None => false,
+                };
+                if applied {
+                    count.applied += 1;
+                } else if wi.iter().any(|w| *w > 0.0) {
+                    count.degenerate += 1;
+                }
+            }
+        }
+    }
+    count
+}
+
+/// One Gauss–Seidel sweep over every body's [`VolumeConstraints`]. A tetrahedron whose
+/// gradients vanish (all four points collinear) is skipped and counted.
+pub fn project_volume(world: &mut World, h: f32) -> ProjectionCount {
+    let mut count = ProjectionCount::default();
+    for (p, tets, vol) in world.query_mut::<(&mut Particles, &Tetrahedra, &mut VolumeConstraints)>()
+    {
+        let alpha_tilde = vol.compliance / (h * h);
+        let x = &mut p.positions;
+        let w = &p.inv_masses;
+        for (t, tet) in tets.indices.iter().enumerate() {
+            let idx = tet.map(|i| i as usize);
+            let wi = idx.map(|i| w[i]);
+            let e = constraint::volume(
+                &x[idx[0]],
+                &x[idx[1]],
+                &x[idx[2]],
+                &x[idx[3]],
+                tets.rest_volumes[t],
+            );
+            if constraint::apply(x, idx, wi, &e, &mut vol.lambdas[t], alpha_tilde) {
+                count.applied += 1;
+            } else if wi.iter().any(|w| *w > 0.0) {
+                count.degenerate += 1;
+            }
+        }
+    }
+    count
+}
+
+/// Sets `v = (x − x_prev) / h`. A particle whose position became non-finite is put back
+/// to its substep start with zero velocity and counted (a safety net that never acts in a
+/// healthy run; see [`crate::StepStats::non_finite_resets`]).
+pub fn update_velocities(world: &mut World, h: f32) -> u64 {
+    let inv_h = 1.0 / h;
+    let mut resets = 0;
+    for p in world.query_mut::<&mut Particles>() {
+        let Particles {
+            positions,
+            prev_positions,
+            velocities,
+            ..
+        } = p;
+        for i in 0..positions.len() {
+            let v = (positions[i] - prev_positions[i]) * inv_h;
+            if v.iter().all(|c| c.is_finite()) {
+                velocities[i] = v;
+            } else {
+                positions[i] = prev_positions[i];
+                velocities[i] = Vector3::zeros();
+                resets += 1;
+            }
+        }
+    }
+    resets
+}
+
+/// `|C|` of every constraint at the current positions, per family, over all bodies.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Measured {
+    /// Edge family.
+    pub edge: ErrorStats,
+    /// Vertex–face family.
+    pub vertex_face: ErrorStats,
+    /// Volume family.
+    pub volume: ErrorStats,
+    /// Tetrahedra whose signed volume has the wrong sign (over all bodies with tetrahedra).
+    pub inverted: usize,
+}
+
+/// Evaluates every constraint at the current positions without moving anything.
+pub fn measure(world: &mut World) -> Measured {
+    let mut edge = ErrorAccumulator::default();
+    let mut vface = ErrorAccumulator::default();
+    let mut vol = ErrorAccumulator::default();
+    let mut inverted = 0;
+    for (p, e) in world.query_mut::<(&Particles, &EdgeConstraints)>() {
+        for (k, &[a, b]) in e.edges.iter().enumerate() {
+            edge.add((p.positions[a as usize] - p.positions[b as usize]).norm() - e.rest_lengths[k]);
+        }
+    }
+    for (p, tets, vf) in world.query_mut::<(&Particles, &Tetrahedra, &VertexFaceConstraints)>() {
+        for (t, tet) in tets.indices.iter().enumerate() {
+            for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
+                let [a, b, c, d] = order.map(|o| p.positions[tet[o] as usize]);
+                // A degenerate face has no height; its violation is the full rest height.
+                let hgt = constraint::signed_height(&a, &b, &c, &d).unwrap_or(0.0);
+                vface.add(hgt - vf.rest_heights[t][k]);
+            }
+        }
+    }
+    for (p, tets, _) in world.query_mut::<(&Particles, &Tetrahedra, &VolumeConstraints)>() {
+        for t in 0..tets.len() {
+            vol.add(tets.volume_at(t, &p.positions) - tets.rest_volumes[t]);
+        }
+    }
+    for (p, tets) in world.query_mut::<(&Particles, &Tetrahedra)>() {
+        inverted += tets.count_inverted(&p.positions);
+    }
+    Measured {
+        edge: edge.finish(),
+        vertex_face: vface.finish(),
+        volume: vol.finish(),
+        inverted,
+    }
+}
