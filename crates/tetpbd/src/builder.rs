@@ -173,7 +173,11 @@ impl SoftBodyBuilder {
         if !(epsilon.is_finite() && epsilon >= 0.0) {
             return Err(BuildError::BadEpsilon { value: epsilon });
         }
-        for (family, a) in [("edge", edge), ("vertex-face", vertex_face), ("volume", volume)] {
+        for (family, a) in [
+            ("edge", edge),
+            ("vertex-face", vertex_face),
+            ("volume", volume),
+        ] {
             if let Some(a) = a {
                 if !(a.is_finite() && a >= 0.0) {
                     return Err(BuildError::BadCompliance { family, value: a });

@@ -152,7 +152,8 @@ pub fn vertex_face<T: RealField + Copy>(
 /// corner `k` plays `p1`, the vertex held above the plane of the other three. Each is an
 /// even permutation of `(0, 1, 2, 3)`, so all four rest heights carry the sign of the
 /// tetrahedron's signed volume.
-pub const VERTEX_FACE_ORDER: [[usize; 4]; 4] = [[1, 0, 3, 2], [0, 1, 2, 3], [0, 2, 3, 1], [0, 3, 1, 2]];
+pub const VERTEX_FACE_ORDER: [[usize; 4]; 4] =
+    [[1, 0, 3, 2], [0, 1, 2, 3], [0, 2, 3, 1], [0, 3, 1, 2]];
 
 /// Signed height of `p1` above the plane through `p0, p2, p3` (the `C + d` of
 /// [`vertex_face`]), or `None` for a degenerate face.

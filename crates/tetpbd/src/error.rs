@@ -155,6 +155,11 @@ pub enum SettingsError {
     },
     /// The family order must list each family exactly once.
     BadOrder,
+    /// The correction speed limit must be finite and > 0, m/s.
+    BadCorrectionSpeed {
+        /// The value given.
+        value: f32,
+    },
 }
 
 impl fmt::Display for SettingsError {
@@ -169,6 +174,10 @@ impl fmt::Display for SettingsError {
                 write!(f, "damping must be finite and >= 0 1/s, got {value}")
             }
             SettingsError::BadOrder => write!(f, "family order must list each family once"),
+            SettingsError::BadCorrectionSpeed { value } => write!(
+                f,
+                "max correction speed must be finite and > 0 m/s, got {value}"
+            ),
         }
     }
 }

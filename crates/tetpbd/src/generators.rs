@@ -20,13 +20,21 @@ pub enum CellSplit {
 /// A box of `size` (m), centred at the origin, split into `cells` cells per axis and each
 /// cell into tetrahedra. All tetrahedra are positively oriented. Vertex `(i, j, k)` has index
 /// `i + (cells[0] + 1) * (j + (cells[1] + 1) * k)`.
-pub fn box_grid(size: Vector3<f32>, cells: [u32; 3], split: CellSplit) -> Result<TetMesh, BuildError> {
+pub fn box_grid(
+    size: Vector3<f32>,
+    cells: [u32; 3],
+    split: CellSplit,
+) -> Result<TetMesh, BuildError> {
     for (name, v) in [("size.x", size.x), ("size.y", size.y), ("size.z", size.z)] {
         if !(v.is_finite() && v > 0.0) {
             return Err(BuildError::BadGeneratorParameter { name, value: v });
         }
     }
-    for (name, c) in [("cells[0]", cells[0]), ("cells[1]", cells[1]), ("cells[2]", cells[2])] {
+    for (name, c) in [
+        ("cells[0]", cells[0]),
+        ("cells[1]", cells[1]),
+        ("cells[2]", cells[2]),
+    ] {
         if c == 0 || c > 1024 {
             return Err(BuildError::BadGeneratorParameter {
                 name,
@@ -43,7 +51,8 @@ pub fn box_grid(size: Vector3<f32>, cells: [u32; 3], split: CellSplit) -> Result
         for j in 0..=ny {
             for i in 0..=nx {
                 vertices.push(
-                    Vector3::new(i as f32 * cell.x, j as f32 * cell.y, k as f32 * cell.z) - size / 2.0,
+                    Vector3::new(i as f32 * cell.x, j as f32 * cell.y, k as f32 * cell.z)
+                        - size / 2.0,
                 );
             }
         }
@@ -54,8 +63,20 @@ pub fn box_grid(size: Vector3<f32>, cells: [u32; 3], split: CellSplit) -> Result
     };
     let mut tets = Vec::with_capacity((nx * ny * nz * per_cell) as usize);
     // Corner c of a cell is at offset (c & 1, (c >> 1) & 1, (c >> 2) & 1).
-    const FIVE_EVEN: [[usize; 4]; 5] = [[0, 1, 2, 4], [3, 2, 1, 7], [5, 4, 7, 1], [6, 7, 4, 2], [1, 2, 4, 7]];
-    const FIVE_ODD: [[usize; 4]; 5] = [[1, 0, 3, 5], [2, 3, 0, 6], [4, 5, 6, 0], [7, 6, 5, 3], [0, 3, 5, 6]];
+    const FIVE_EVEN: [[usize; 4]; 5] = [
+        [0, 1, 2, 4],
+        [3, 2, 1, 7],
+        [5, 4, 7, 1],
+        [6, 7, 4, 2],
+        [1, 2, 4, 7],
+    ];
+    const FIVE_ODD: [[usize; 4]; 5] = [
+        [1, 0, 3, 5],
+        [2, 3, 0, 6],
+        [4, 5, 6, 0],
+        [7, 6, 5, 3],
+        [0, 3, 5, 6],
+    ];
     const SIX: [[usize; 4]; 6] = [
         [0, 1, 3, 7],
         [0, 1, 5, 7],
@@ -116,8 +137,18 @@ pub fn ball(radius: f32, cells: u32, split: CellSplit) -> Result<TetMesh, BuildE
 /// A beam of `length` along x with a square cross-section of side `width` (m), `cells`
 /// cells long and `cross` cells across, starting at `x = 0`. Convenient for hanging-beam
 /// scenes: the vertices with `x = 0` are [`beam_root`].
-pub fn beam(length: f32, width: f32, cells: u32, cross: u32, split: CellSplit) -> Result<TetMesh, BuildError> {
-    let mut mesh = box_grid(Vector3::new(length, width, width), [cells, cross, cross], split)?;
+pub fn beam(
+    length: f32,
+    width: f32,
+    cells: u32,
+    cross: u32,
+    split: CellSplit,
+) -> Result<TetMesh, BuildError> {
+    let mut mesh = box_grid(
+        Vector3::new(length, width, width),
+        [cells, cross, cross],
+        split,
+    )?;
     for v in &mut mesh.vertices {
         v.x += length / 2.0;
     }
@@ -126,7 +157,11 @@ pub fn beam(length: f32, width: f32, cells: u32, cross: u32, split: CellSplit) -
 
 /// Indices of the vertices of `mesh` with the smallest x (the root of a [`beam`]).
 pub fn beam_root(mesh: &TetMesh) -> Vec<u32> {
-    let min = mesh.vertices.iter().map(|v| v.x).fold(f32::INFINITY, f32::min);
+    let min = mesh
+        .vertices
+        .iter()
+        .map(|v| v.x)
+        .fold(f32::INFINITY, f32::min);
     let tol = 1e-6 * (1.0 + min.abs());
     (0..mesh.vertices.len() as u32)
         .filter(|&i| (mesh.vertices[i as usize].x - min).abs() <= tol)

@@ -100,7 +100,10 @@ impl Particles {
             return Err(StateError::ParticleOutOfRange { index: i, len: n });
         }
         if !p.iter().all(|x| x.is_finite()) {
-            return Err(StateError::NonFinite { what: "position", index: i });
+            return Err(StateError::NonFinite {
+                what: "position",
+                index: i,
+            });
         }
         self.positions[i] = p;
         self.prev_positions[i] = p;
@@ -114,7 +117,10 @@ impl Particles {
             return Err(StateError::ParticleOutOfRange { index: i, len: n });
         }
         if !v.iter().all(|x| x.is_finite()) {
-            return Err(StateError::NonFinite { what: "velocity", index: i });
+            return Err(StateError::NonFinite {
+                what: "velocity",
+                index: i,
+            });
         }
         self.velocities[i] = v;
         Ok(())
@@ -152,7 +158,9 @@ impl Particles {
             .iter()
             .zip(&self.velocities)
             .zip(&self.masses)
-            .fold(Vector3::zeros(), |acc, ((x, v), m)| acc + x.cross(&(v * *m)))
+            .fold(Vector3::zeros(), |acc, ((x, v), m)| {
+                acc + x.cross(&(v * *m))
+            })
     }
 
     /// Kinetic energy ½ Σ mᵢ|vᵢ|², J.

@@ -29,6 +29,11 @@ pub struct SolverSettings {
     /// The order in which the families are projected in an iteration. Default: volume,
     /// vertex–face, edge — edges last, so lengths are closest to rest at the end.
     pub order: [Family; 3],
+    /// Safety net: the velocity a substep's projections add to a particle is clamped to this
+    /// length, m/s (positions keep their full correction). `None` = no clamp. See
+    /// [`systems::update_velocities`]; clamps are counted in
+    /// [`StepStats::velocity_clamps`].
+    pub max_correction_speed: Option<f32>,
     /// Evaluate every constraint after the step to fill [`crate::FamilyStats::after`] and
     /// [`StepStats::inverted`]. Costs about one extra sweep; off by default.
     pub measure_error: bool,
@@ -45,6 +50,7 @@ impl Default for SolverSettings {
             gravity: Vector3::new(0.0, -9.81, 0.0),
             damping: 0.0,
             order: Family::ALL,
+            max_correction_speed: None,
             measure_error: false,
             measure_before: false,
         }
@@ -70,6 +76,11 @@ impl SolverSettings {
             return Err(SettingsError::BadDamping {
                 value: self.damping,
             });
+        }
+        if let Some(v) = self.max_correction_speed {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(SettingsError::BadCorrectionSpeed { value: v });
+            }
         }
         let mut seen = [false; 3];
         for f in self.order {
@@ -185,7 +196,9 @@ impl Solver {
                 hook_time += t.elapsed();
             }
             let t = Instant::now();
-            stats.non_finite_resets += systems::update_velocities(world, h);
+            let u = systems::update_velocities(world, h, s.max_correction_speed);
+            stats.non_finite_resets += u.non_finite_resets;
+            stats.velocity_clamps += u.clamped;
             stats.velocity_time += t.elapsed();
             let t = Instant::now();
             hook.end_substep(world, h);

@@ -108,6 +108,9 @@ pub struct StepStats {
     /// Particles whose state became non-finite during the step and were reset to their
     /// substep start with zero velocity (a safety net; 0 in every healthy run).
     pub non_finite_resets: u64,
+    /// Particle velocity updates clamped by
+    /// [`crate::SolverSettings::max_correction_speed`] (summed over substeps).
+    pub velocity_clamps: u64,
     /// Time in prediction (gravity, damping, integration).
     pub predict_time: Duration,
     /// Time in the velocity update.

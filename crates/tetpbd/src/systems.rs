@@ -85,8 +85,7 @@ pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
                 (p.rest_positions[a] - p.rest_positions[b]) / d
             };
             let wsum = w[a] + w[b];
-            let Some(dl) =
-                constraint::xpbd_delta_lambda(len - d, e.lambdas[k], alpha_tilde, wsum)
+            let Some(dl) = constraint::xpbd_delta_lambda(len - d, e.lambdas[k], alpha_tilde, wsum)
             else {
                 continue;
             };
@@ -121,14 +120,9 @@ pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
                     vf.rest_heights[t][k],
                 );
                 let applied = match e {
-                    Some(e) => constraint::apply(
-                        x,
-                        idx,
-                        wi,
-                        &e,
-                        &mut vf.lambdas[t][k],
-                        alpha_tilde,
-                    ),
+                    Some(e) => {
+                        constraint::apply(x, idx, wi, &e, &mut vf.lambdas[t][k], alpha_tilde)
+                    }
                     None => false,
                 };
                 if applied {
@@ -171,12 +165,33 @@ pub fn project_volume(world: &mut World, h: f32) -> ProjectionCount {
     count
 }
 
-/// Sets `v = (x − x_prev) / h`. A particle whose position became non-finite is put back
-/// to its substep start with zero velocity and counted (a safety net that never acts in a
-/// healthy run; see [`crate::StepStats::non_finite_resets`]).
-pub fn update_velocities(world: &mut World, h: f32) -> u64 {
+/// What [`update_velocities`] did besides the plain update.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct VelocityUpdate {
+    /// Particles whose position became non-finite, reset to their substep start.
+    pub non_finite_resets: u64,
+    /// Particles whose correction speed was clamped.
+    pub clamped: u64,
+}
+
+/// Sets `v = (x − x_prev) / h`.
+///
+/// With `max_correction_speed = Some(s)`, the part of the new velocity that the constraint
+/// projections added, `(x − x_prev)/h − v_pred` (with `v_pred` the predicted velocity, still
+/// in the velocity array during the projections), is clamped to length `s` (m/s). The
+/// positions keep their full correction; only the velocity it would have created is limited.
+/// This is a safety net for large errors corrected in one substep (an inverted body snapping
+/// back), which otherwise turn into a velocity of `Δx/h`; each clamp is counted.
+///
+/// A particle whose position became non-finite is put back to its substep start with zero
+/// velocity and counted (a safety net that never acts in a healthy run).
+pub fn update_velocities(
+    world: &mut World,
+    h: f32,
+    max_correction_speed: Option<f32>,
+) -> VelocityUpdate {
     let inv_h = 1.0 / h;
-    let mut resets = 0;
+    let mut out = VelocityUpdate::default();
     for p in world.query_mut::<&mut Particles>() {
         let Particles {
             positions,
@@ -185,17 +200,25 @@ pub fn update_velocities(world: &mut World, h: f32) -> u64 {
             ..
         } = p;
         for i in 0..positions.len() {
-            let v = (positions[i] - prev_positions[i]) * inv_h;
+            let mut v = (positions[i] - prev_positions[i]) * inv_h;
+            if let Some(limit) = max_correction_speed {
+                let dv = v - velocities[i];
+                let n2 = dv.norm_squared();
+                if n2 > limit * limit {
+                    v = velocities[i] + dv * (limit / n2.sqrt());
+                    out.clamped += 1;
+                }
+            }
             if v.iter().all(|c| c.is_finite()) {
                 velocities[i] = v;
             } else {
                 positions[i] = prev_positions[i];
                 velocities[i] = Vector3::zeros();
-                resets += 1;
+                out.non_finite_resets += 1;
             }
         }
     }
-    resets
+    out
 }
 
 /// `|C|` of every constraint at the current positions, per family, over all bodies.
@@ -219,7 +242,9 @@ pub fn measure(world: &mut World) -> Measured {
     let mut inverted = 0;
     for (p, e) in world.query_mut::<(&Particles, &EdgeConstraints)>() {
         for (k, &[a, b]) in e.edges.iter().enumerate() {
-            edge.add((p.positions[a as usize] - p.positions[b as usize]).norm() - e.rest_lengths[k]);
+            edge.add(
+                (p.positions[a as usize] - p.positions[b as usize]).norm() - e.rest_lengths[k],
+            );
         }
     }
     for (p, tets, vf) in world.query_mut::<(&Particles, &Tetrahedra, &VertexFaceConstraints)>() {

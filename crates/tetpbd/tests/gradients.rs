@@ -1,0 +1,195 @@
+//! Every constraint's analytic gradient against central finite differences in f64.
+
+mod common_rng;
+
+use common_rng::Rng;
+use nalgebra::Vector3;
+use tetpbd::constraint::{edge, signed_volume, vertex_face, volume, Evaluated};
+
+/// Central finite difference of `f` with respect to particle `i`, coordinate by coordinate.
+fn fd<const N: usize>(
+    p: &[Vector3<f64>; N],
+    i: usize,
+    eps: f64,
+    f: &dyn Fn(&[Vector3<f64>; N]) -> f64,
+) -> Vector3<f64> {
+    let mut g = Vector3::zeros();
+    for k in 0..3 {
+        let mut a = *p;
+        let mut b = *p;
+        a[i][k] += eps;
+        b[i][k] -= eps;
+        g[k] = (f(&a) - f(&b)) / (2.0 * eps);
+    }
+    g
+}
+
+fn check<const N: usize>(
+    p: &[Vector3<f64>; N],
+    e: &Evaluated<f64, N>,
+    f: &dyn Fn(&[Vector3<f64>; N]) -> f64,
+    what: &str,
+) {
+    check_with_step(p, e, f, 1e-6, what)
+}
+
+/// `eps` is the finite-difference step, m; it must be small against the smallest feature
+/// of the configuration (the squeeze of a near-degenerate face).
+fn check_with_step<const N: usize>(
+    p: &[Vector3<f64>; N],
+    e: &Evaluated<f64, N>,
+    f: &dyn Fn(&[Vector3<f64>; N]) -> f64,
+    eps: f64,
+    what: &str,
+) {
+    let gmax = e.grad.iter().map(|g| g.norm()).fold(1e-12, f64::max);
+    for i in 0..N {
+        let num = fd(p, i, eps, f);
+        let err = (num - e.grad[i]).norm() / gmax;
+        assert!(
+            err < 1e-5,
+            "{what}: ∇p{i} analytic {:?} vs finite difference {:?} (relative error {err:e}) at {p:?}",
+            e.grad[i],
+            num
+        );
+    }
+    let sum: Vector3<f64> = e.grad.iter().sum();
+    assert!(
+        sum.norm() < 1e-9 * gmax.max(1.0),
+        "{what}: gradients do not sum to zero: {sum:?}"
+    );
+}
+
+#[test]
+fn edge_gradient_matches_finite_differences() {
+    let mut rng = Rng::new(1);
+    for _ in 0..500 {
+        let p = [rng.vec(2.0), rng.vec(2.0)];
+        let d = rng.range(0.1, 2.0);
+        let e = edge(&p[0], &p[1], d, None).expect("random points are distinct");
+        assert!((e.c - ((p[0] - p[1]).norm() - d)).abs() < 1e-12);
+        check(&p, &e, &|q| (q[0] - q[1]).norm() - d, "edge");
+    }
+}
+
+#[test]
+fn edge_zero_length_uses_fallback_or_reports_none() {
+    let p = Vector3::new(1.0f64, 2.0, 3.0);
+    assert!(edge(&p, &p, 1.0, None).is_none());
+    let dir = Vector3::new(0.0, 1.0, 0.0);
+    let e = edge(&p, &p, 1.0, Some(&dir)).expect("fallback given");
+    assert_eq!(e.grad, [dir, -dir]);
+    assert_eq!(e.c, -1.0);
+}
+
+fn random_tet(rng: &mut Rng) -> [Vector3<f64>; 4] {
+    loop {
+        let p = [rng.vec(1.0), rng.vec(1.0), rng.vec(1.0), rng.vec(1.0)];
+        if signed_volume(&p[0], &p[1], &p[2], &p[3]).abs() > 1e-3 {
+            return p;
+        }
+    }
+}
+
+fn height(q: &[Vector3<f64>; 4]) -> f64 {
+    let n = (q[2] - q[0]).cross(&(q[3] - q[0]));
+    (q[1] - q[0]).dot(&n) / n.norm()
+}
+
+#[test]
+fn vertex_face_gradient_matches_finite_differences() {
+    let mut rng = Rng::new(2);
+    for _ in 0..500 {
+        let p = random_tet(&mut rng);
+        let d = rng.range(-0.5, 0.5);
+        let e = vertex_face(&p[0], &p[1], &p[2], &p[3], d).expect("non-degenerate face");
+        assert!((e.c - (height(&p) - d)).abs() < 1e-12);
+        check(&p, &e, &|q| height(q) - d, "vertex-face");
+    }
+}
+
+#[test]
+fn vertex_face_gradient_near_degenerate_face() {
+    // Face (p0, p2, p3) nearly collinear but still above the degeneracy threshold.
+    let mut rng = Rng::new(3);
+    for k in 0..200 {
+        let squeeze = 10f64.powf(-(1.0 + (k % 5) as f64));
+        let p0 = rng.vec(1.0);
+        let dir = rng.vec(1.0).normalize();
+        let p2 = p0 + dir;
+        let p3 = p0 + dir * rng.range(0.3, 2.0) + rng.vec(1.0).cross(&dir).normalize() * squeeze;
+        let p1 = rng.vec(1.0);
+        let p = [p0, p1, p2, p3];
+        let e = vertex_face(&p0, &p1, &p2, &p3, 0.1).expect("above the threshold");
+        check_with_step(
+            &p,
+            &e,
+            &|q| height(q) - 0.1,
+            1e-4 * squeeze,
+            "vertex-face near-degenerate",
+        );
+    }
+}
+
+#[test]
+fn vertex_face_degenerate_face_is_none_not_nan() {
+    let o = Vector3::new(0.0f64, 0.0, 0.0);
+    let x = Vector3::new(1.0, 0.0, 0.0);
+    let y = Vector3::new(0.0, 1.0, 0.0);
+    // Collinear face points, coincident face points, everything at one point.
+    assert!(vertex_face(&o, &y, &x, &(x * 2.0), 0.5).is_none());
+    assert!(vertex_face(&o, &y, &o, &x, 0.5).is_none());
+    assert!(vertex_face(&o, &o, &o, &o, 0.5).is_none());
+    let o32 = Vector3::new(0.0f32, 0.0, 0.0);
+    assert!(vertex_face(&o32, &o32, &o32, &o32, 0.5).is_none());
+}
+
+#[test]
+fn volume_gradient_matches_finite_differences() {
+    let mut rng = Rng::new(4);
+    for _ in 0..500 {
+        let p = random_tet(&mut rng);
+        let v0 = rng.range(-0.2, 0.2);
+        let e = volume(&p[0], &p[1], &p[2], &p[3], v0);
+        let f = |q: &[Vector3<f64>; 4]| {
+            (q[1] - q[0]).dot(&(q[2] - q[0]).cross(&(q[3] - q[0]))) / 6.0 - v0
+        };
+        assert!((e.c - f(&p)).abs() < 1e-12);
+        check(&p, &e, &f, "volume");
+    }
+}
+
+#[test]
+fn volume_gradient_has_the_one_sixth() {
+    // Unit right tetrahedron: ∇p1 C = (1/6) e2 × e3 = (1/6, 0, 0), not (1, 0, 0).
+    let z = Vector3::zeros();
+    let e = volume(&z, &Vector3::x(), &Vector3::y(), &Vector3::z(), 0.0f64);
+    assert!((e.grad[1] - Vector3::new(1.0 / 6.0, 0.0, 0.0)).norm() < 1e-15);
+    assert!((e.c - 1.0 / 6.0).abs() < 1e-15);
+}
+
+#[test]
+fn collapsed_tetrahedron_volume_is_finite() {
+    let p = Vector3::new(0.3f32, -0.2, 0.1);
+    let e = volume(&p, &p, &p, &p, 0.1);
+    assert!(e.c.is_finite() && e.grad.iter().all(|g| g.norm() == 0.0));
+    assert!(tetpbd::constraint::xpbd_delta_lambda(e.c, 0.0, 0.0, 0.0f32).is_none());
+}
+
+#[test]
+fn f32_matches_f64() {
+    let mut rng = Rng::new(5);
+    for _ in 0..200 {
+        let p = random_tet(&mut rng);
+        let q = p.map(|v| v.cast::<f32>());
+        let a = vertex_face(&p[0], &p[1], &p[2], &p[3], 0.1).unwrap();
+        let b = vertex_face(&q[0], &q[1], &q[2], &q[3], 0.1).unwrap();
+        let gmax = a.grad.iter().map(|g| g.norm()).fold(1.0, f64::max);
+        for i in 0..4 {
+            assert!((a.grad[i] - b.grad[i].cast::<f64>()).norm() < 1e-3 * gmax);
+        }
+        let a = volume(&p[0], &p[1], &p[2], &p[3], 0.0);
+        let b = volume(&q[0], &q[1], &q[2], &q[3], 0.0);
+        assert!((a.c - f64::from(b.c)).abs() < 1e-5);
+    }
+}
