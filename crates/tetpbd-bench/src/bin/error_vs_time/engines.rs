@@ -1,0 +1,322 @@
+//! The two engines behind one small trait: tetpbd's [`Solver`] on a hecs world, and rapier's
+//! built-in soft bodies in a [`PhysicsWorld`].
+
+use std::time::Instant;
+
+use nalgebra::Vector3;
+use rapier3d::math::Vector;
+use rapier3d::prelude::{
+    PhysicsWorld, SoftBodyBuilder as RapierBuilder, SoftBodyCellModel, SoftBodyHandle,
+    SoftBodyMaterial, SoftBodySolver, SpringCoefficients,
+};
+use tetpbd::{hecs, Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats};
+
+use crate::scenes::{Scene, DT};
+
+/// Soft compliance of the length constraints (edges, vertex–face), m/N.
+pub const SOFT_LENGTH_COMPLIANCE: f32 = 1e-7;
+/// Soft compliance of the volume constraints, m⁵/N.
+pub const SOFT_VOLUME_COMPLIANCE: f32 = 1e-11;
+/// Young's modulus of rapier's elastic cell models, Pa.
+pub const RAPIER_YOUNG: f32 = 1e8;
+/// Poisson's ratio of rapier's elastic cell models.
+pub const RAPIER_POISSON: f32 = 0.3;
+/// Natural frequency standing for "hard" in rapier's frequency-based softness, Hz (rapier's own
+/// default for joints; a frequency above the substep rate saturates instead of exploding).
+pub const RAPIER_HARD_HZ: f32 = 1.0e6;
+
+/// The constraint sets of tetpbd that are swept.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConstraintSet {
+    /// Edges and signed volumes.
+    EdgesVolume,
+    /// Vertex–face constraints alone.
+    VertexFace,
+    /// Vertex–face constraints and edges.
+    VertexFaceEdges,
+}
+
+/// One model of either engine: what is simulated, independent of substeps and iterations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Model {
+    /// tetpbd with a constraint set, compliance 0 (`soft == false`) or the soft compliances.
+    Ours {
+        /// Constraint families.
+        set: ConstraintSet,
+        /// Soft compliances instead of 0.
+        soft: bool,
+    },
+    /// rapier's soft body with a cell model and solver.
+    Rapier {
+        /// Cell model.
+        cell: SoftBodyCellModel,
+        /// Solver.
+        solver: SoftBodySolver,
+        /// For the volume model: edges and cell volumes at [`RAPIER_HARD_HZ`] instead of the
+        /// default 30 Hz softness.
+        hard: bool,
+    },
+}
+
+impl Model {
+    /// The engine's name.
+    pub fn engine(&self) -> &'static str {
+        match self {
+            Model::Ours { .. } => "tetpbd",
+            Model::Rapier { .. } => "rapier",
+        }
+    }
+
+    /// A short label, unique among the swept models.
+    pub fn label(&self) -> String {
+        match *self {
+            Model::Ours { set, soft } => {
+                let s = match set {
+                    ConstraintSet::EdgesVolume => "edges+volume",
+                    ConstraintSet::VertexFace => "vertex-face",
+                    ConstraintSet::VertexFaceEdges => "vertex-face+edges",
+                };
+                format!("tetpbd {s} {}", if soft { "soft" } else { "α=0" })
+            }
+            Model::Rapier { cell, solver, hard } => {
+                let c = match cell {
+                    SoftBodyCellModel::Volume => "Volume",
+                    SoftBodyCellModel::Corotational => "Corotational",
+                    SoftBodyCellModel::NeoHookean => "NeoHookean",
+                };
+                let s = match solver {
+                    SoftBodySolver::Constraints => "Constraints",
+                    SoftBodySolver::Fem => "Fem",
+                };
+                let k = match (cell, hard) {
+                    (SoftBodyCellModel::Volume, true) => " hard",
+                    (SoftBodyCellModel::Volume, false) => " 30Hz",
+                    _ => "",
+                };
+                format!("rapier {s} {c}{k}")
+            }
+        }
+    }
+
+    /// `true` for the models whose converged answer keeps every edge and volume at rest
+    /// (tetpbd with α = 0 and a set holding edges or volumes; rapier's hard volume model).
+    pub fn is_hard(&self) -> bool {
+        match *self {
+            Model::Ours { soft, .. } => !soft,
+            Model::Rapier { cell, hard, .. } => hard && cell == SoftBodyCellModel::Volume,
+        }
+    }
+
+    /// How the model is set up, for the summary.
+    pub fn setup(&self) -> String {
+        match *self {
+            Model::Ours { set, soft } => {
+                let (l, v) = if soft {
+                    (SOFT_LENGTH_COMPLIANCE, SOFT_VOLUME_COMPLIANCE)
+                } else {
+                    (0.0, 0.0)
+                };
+                match set {
+                    ConstraintSet::EdgesVolume => format!("edges α={l:e} m/N, volume α={v:e} m⁵/N"),
+                    ConstraintSet::VertexFace => format!("vertex-face α={l:e} m/N"),
+                    ConstraintSet::VertexFaceEdges => {
+                        format!("vertex-face α={l:e} m/N, edges α={l:e} m/N")
+                    }
+                }
+            }
+            Model::Rapier { cell, hard, .. } => match cell {
+                SoftBodyCellModel::Volume if hard => format!(
+                    "tet edges + per-cell volume, edge and volume softness {RAPIER_HARD_HZ:e} Hz, ζ=1"
+                ),
+                SoftBodyCellModel::Volume => {
+                    "tet edges + per-cell volume, default softness 30 Hz, ζ=1".to_string()
+                }
+                _ => format!(
+                    "no edges, E={RAPIER_YOUNG:e} Pa, ν={RAPIER_POISSON}, elastic damping ratio 1"
+                ),
+            },
+        }
+    }
+}
+
+/// One frame's cost.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameCost {
+    /// Wall time of the step, ms (tetpbd: without the error measurement).
+    pub ms: f64,
+    /// Constraint projections done (0 when the engine does not say).
+    pub projections: u64,
+}
+
+/// A running simulation of one scene.
+pub trait Sim {
+    /// Advances one frame of [`DT`].
+    fn step(&mut self) -> FrameCost;
+    /// Current particle positions, in mesh vertex order.
+    fn positions(&self) -> Vec<Vector3<f32>>;
+    /// tetpbd's own statistics of the last step (None for rapier).
+    fn stats(&self) -> Option<&StepStats>;
+}
+
+/// Builds the simulation of `model` on `scene` with `substeps × iterations` (rapier: its
+/// `num_solver_iterations` is the substep count; it has no separate iteration count).
+pub fn build(model: Model, scene: &Scene, substeps: u32, iterations: u32) -> Box<dyn Sim> {
+    match model {
+        Model::Ours { set, soft } => Box::new(Ours::new(set, soft, scene, substeps, iterations)),
+        Model::Rapier { cell, solver, hard } => {
+            Box::new(Rapier::new(cell, solver, hard, scene, substeps))
+        }
+    }
+}
+
+struct Ours {
+    world: hecs::World,
+    solver: Solver,
+    last: StepStats,
+}
+
+impl Ours {
+    fn new(set: ConstraintSet, soft: bool, scene: &Scene, substeps: u32, iterations: u32) -> Ours {
+        let (l, v) = if soft {
+            (SOFT_LENGTH_COMPLIANCE, SOFT_VOLUME_COMPLIANCE)
+        } else {
+            (0.0, 0.0)
+        };
+        let b = SoftBodyBuilder::new(scene.mesh.clone())
+            .density(scene.density)
+            .pinned(scene.pinned.iter().copied());
+        let b = match set {
+            ConstraintSet::EdgesVolume => b.edges(l).volume(v),
+            ConstraintSet::VertexFace => b.vertex_face(l),
+            ConstraintSet::VertexFaceEdges => b.vertex_face(l).edges(l),
+        };
+        let mut world = hecs::World::new();
+        let e = b.build().expect("scene meshes are valid").spawn(&mut world);
+        {
+            let mut p = world.get::<&mut Particles>(e).expect("just spawned");
+            for (i, x) in scene.start.iter().enumerate() {
+                p.set_position(i, *x).expect("finite start positions");
+            }
+        }
+        let solver = Solver::new(SolverSettings {
+            dt: DT,
+            substeps,
+            iterations,
+            gravity: Vector3::new(0.0, scene.gravity, 0.0),
+            damping: scene.damping,
+            measure_error: true,
+            ..Default::default()
+        })
+        .expect("valid settings");
+        Ours {
+            world,
+            solver,
+            last: StepStats::default(),
+        }
+    }
+}
+
+impl Sim for Ours {
+    fn step(&mut self) -> FrameCost {
+        self.last = self
+            .solver
+            .step(&mut self.world)
+            .expect("settings validated");
+        let s = &self.last;
+        FrameCost {
+            ms: (s.total_time - s.measure_time).as_secs_f64() * 1e3,
+            projections: s.edge.projections + s.vertex_face.projections + s.volume.projections,
+        }
+    }
+
+    fn positions(&self) -> Vec<Vector3<f32>> {
+        let mut q = self.world.query::<&Particles>();
+        q.iter()
+            .next()
+            .map(|p| p.positions().to_vec())
+            .unwrap_or_default()
+    }
+
+    fn stats(&self) -> Option<&StepStats> {
+        Some(&self.last)
+    }
+}
+
+struct Rapier {
+    world: PhysicsWorld,
+    handle: SoftBodyHandle,
+}
+
+impl Rapier {
+    fn new(
+        cell: SoftBodyCellModel,
+        solver: SoftBodySolver,
+        hard: bool,
+        scene: &Scene,
+        substeps: u32,
+    ) -> Rapier {
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::new(0.0, scene.gravity, 0.0);
+        world.integration_parameters.dt = DT;
+        world.integration_parameters.num_solver_iterations = substeps as usize;
+        let to_rapier = |v: &Vector3<f32>| Vector::new(v.x, v.y, v.z);
+        let material = match (cell, hard) {
+            (SoftBodyCellModel::Volume, true) => {
+                let k = SpringCoefficients::new(RAPIER_HARD_HZ, 1.0);
+                SoftBodyMaterial {
+                    edge_softness: k,
+                    volume_softness: k,
+                    ..Default::default()
+                }
+            }
+            (SoftBodyCellModel::Volume, false) => SoftBodyMaterial::default(),
+            _ => SoftBodyMaterial {
+                young_modulus: RAPIER_YOUNG,
+                poisson_ratio: RAPIER_POISSON,
+                elastic_damping_ratio: 1.0,
+                ..Default::default()
+            },
+        };
+        let mut b = RapierBuilder::new(scene.mesh.vertices.iter().map(to_rapier).collect())
+            .cells(scene.mesh.tets.clone())
+            .masses(scene.masses())
+            .pinned_particles(scene.pinned.iter().copied())
+            .cell_model(cell)
+            .solver(solver)
+            .material(material)
+            .linear_damping(scene.damping)
+            .no_surface_collider()
+            .can_sleep(false);
+        if cell == SoftBodyCellModel::Volume {
+            b = b.edges(scene.edges.clone());
+        }
+        let handle = world.insert_soft_body(b);
+        let body = &mut world.soft_bodies[handle];
+        for (i, x) in scene.start.iter().enumerate() {
+            body.set_particle_position(i, to_rapier(x));
+        }
+        Rapier { world, handle }
+    }
+}
+
+impl Sim for Rapier {
+    fn step(&mut self) -> FrameCost {
+        let t = Instant::now();
+        self.world.step();
+        FrameCost {
+            ms: t.elapsed().as_secs_f64() * 1e3,
+            projections: 0,
+        }
+    }
+
+    fn positions(&self) -> Vec<Vector3<f32>> {
+        self.world.soft_bodies[self.handle]
+            .particle_positions()
+            .map(|p| Vector3::new(p.x, p.y, p.z))
+            .collect()
+    }
+
+    fn stats(&self) -> Option<&StepStats> {
+        None
+    }
+}

@@ -1,0 +1,175 @@
+//! `cargo run --release -p tetpbd-bench --bin error_vs_time [-- --quick] [-- --out DIR]`
+//!
+//! Error against run time, tetpbd next to rapier 0.36's built-in soft bodies, on the scenes of
+//! issue 5 that need no contacts: a) a hanging beam settling to static equilibrium, b) a block
+//! squashed to 50 % height and released. Writes `docs/error-vs-time/` (results.csv,
+//! squash_volume.csv, plot.png, plot.svg, summary.md).
+
+mod engines;
+mod metrics;
+mod pareto;
+mod plot;
+mod report;
+mod scenes;
+mod summary;
+mod summary_setup;
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use rapier3d::prelude::{SoftBodyCellModel, SoftBodySolver};
+
+use engines::{build, ConstraintSet, Model};
+use metrics::{converged, deviation, exact_rest, run};
+use report::Row;
+use scenes::Scene;
+
+/// What the command was asked to do.
+struct Args {
+    quick: bool,
+    out: PathBuf,
+}
+
+fn parse_args() -> Result<Args, String> {
+    let mut args = Args {
+        quick: false,
+        out: PathBuf::from("docs/error-vs-time"),
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--quick" => args.quick = true,
+            "--out" => args.out = it.next().ok_or("--out needs a directory")?.into(),
+            "-h" | "--help" => {
+                return Err("usage: error_vs_time [--quick] [--out DIR]".to_string());
+            }
+            other => return Err(format!("unknown argument `{other}` (try --help)")),
+        }
+    }
+    Ok(args)
+}
+
+/// The swept models: every tetpbd constraint set at α = 0 and soft, and rapier's cell models
+/// and solvers.
+fn models(quick: bool) -> Vec<Model> {
+    let mut m = Vec::new();
+    for soft in [false, true] {
+        for set in [
+            ConstraintSet::EdgesVolume,
+            ConstraintSet::VertexFace,
+            ConstraintSet::VertexFaceEdges,
+        ] {
+            if quick && set != ConstraintSet::EdgesVolume {
+                continue;
+            }
+            m.push(Model::Ours { set, soft });
+        }
+    }
+    let rapier = [
+        (SoftBodyCellModel::Volume, SoftBodySolver::Constraints, true),
+        (
+            SoftBodyCellModel::Volume,
+            SoftBodySolver::Constraints,
+            false,
+        ),
+        (
+            SoftBodyCellModel::Corotational,
+            SoftBodySolver::Constraints,
+            false,
+        ),
+        (
+            SoftBodyCellModel::NeoHookean,
+            SoftBodySolver::Constraints,
+            false,
+        ),
+        (SoftBodyCellModel::Corotational, SoftBodySolver::Fem, false),
+    ];
+    for (k, (cell, solver, hard)) in rapier.into_iter().enumerate() {
+        if quick && k > 2 {
+            continue;
+        }
+        m.push(Model::Rapier { cell, solver, hard });
+    }
+    m
+}
+
+/// `(substeps, iterations)` swept for a model at the 1/60 s frame.
+fn budgets(model: &Model, quick: bool) -> Vec<(u32, u32)> {
+    match (model, quick) {
+        (Model::Ours { .. }, false) => vec![
+            (1, 1),
+            (2, 1),
+            (4, 1),
+            (8, 1),
+            (16, 1),
+            (32, 1),
+            (64, 1),
+            (1, 4),
+            (1, 16),
+            (1, 32),
+            (4, 4),
+        ],
+        (Model::Ours { .. }, true) => vec![(1, 1), (4, 1), (16, 1), (1, 4)],
+        (Model::Rapier { .. }, false) => vec![(1, 1), (2, 1), (4, 1), (8, 1), (16, 1), (32, 1)],
+        (Model::Rapier { .. }, true) => vec![(1, 1), (4, 1), (16, 1)],
+    }
+}
+
+/// Substeps at which the reference search starts and stops.
+fn reference_range(model: &Model, quick: bool) -> (u32, u32) {
+    match (model, quick) {
+        (Model::Ours { .. }, false) => (128, 512),
+        (Model::Ours { .. }, true) => (64, 128),
+        (Model::Rapier { .. }, false) => (32, 128),
+        (Model::Rapier { .. }, true) => (32, 64),
+    }
+}
+
+fn main() {
+    let args = match parse_args() {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(2);
+        }
+    };
+    let started = Instant::now();
+    let scenes = [Scene::hanging_beam(args.quick), Scene::squash(args.quick)];
+    let mut rows = Vec::new();
+    let mut references = Vec::new();
+    for scene in &scenes {
+        for model in models(args.quick) {
+            let (lo, hi) = reference_range(&model, args.quick);
+            let t = Instant::now();
+            let r = if model.is_hard() {
+                exact_rest(scene)
+            } else {
+                converged(model, scene, lo, hi)
+            };
+            eprintln!(
+                "{:<18} {:<36} reference {:>5} substeps, change {:.2e} ({:.1} s)",
+                scene.name,
+                model.label(),
+                r.substeps,
+                r.change,
+                t.elapsed().as_secs_f64()
+            );
+            for (substeps, iterations) in budgets(&model, args.quick) {
+                let res = run(build(model, scene, substeps, iterations).as_mut(), scene);
+                let dev = deviation(scene, &res.trajectory, &r.trajectory);
+                eprintln!(
+                    "    {substeps:>3}x{iterations:<3} {:>9.3} ms  dev max {:.2e} rms {:.2e}  vol {:+.3}%  strain {:.2e}",
+                    res.ms_median, dev.max, dev.rms, res.last.volume_err_pct, res.last.edge_strain_rms
+                );
+                rows.push(Row::new(scene, model, substeps, iterations, &res, dev, &r));
+            }
+            references.push((scene.name, model, r.substeps, r.change));
+        }
+    }
+    let elapsed = started.elapsed().as_secs_f64();
+    if let Err(e) = report::write_all(&args.out, &scenes, &rows, &references, args.quick, elapsed) {
+        eprintln!("writing {}: {e}", args.out.display());
+        std::process::exit(1);
+    }
+    eprintln!("wrote {} in {elapsed:.0} s", args.out.display());
+}

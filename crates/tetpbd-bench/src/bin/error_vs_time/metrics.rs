@@ -1,0 +1,273 @@
+//! Running one configuration and measuring it: observables both engines share (volume kept,
+//! edge stretch, inverted tetrahedra, shape), tetpbd's own per-family |C|, and the deviation
+//! from a converged reference run.
+
+use nalgebra::{Matrix3, Vector3};
+use tetpbd::Family;
+
+use crate::engines::{build, Model, Sim};
+use crate::scenes::{height, tet_volume, Scene, SceneKind, DT};
+
+/// Observables computed the same way from either engine's positions.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Observables {
+    /// Total signed volume over rest volume, minus one, in %.
+    pub volume_err_pct: f32,
+    /// RMS over the mesh edges of the strain `|l / l₀ − 1|`.
+    pub edge_strain_rms: f32,
+    /// Largest edge strain.
+    pub edge_strain_max: f32,
+    /// Tetrahedra whose signed volume changed sign.
+    pub inverted: usize,
+    /// y extent over the rest y extent.
+    pub height_ratio: f32,
+}
+
+/// Evaluates the shared observables at positions `x`.
+pub fn observe(scene: &Scene, x: &[Vector3<f32>]) -> Observables {
+    let (mut now, mut rest, mut inverted) = (0.0f64, 0.0f64, 0);
+    for (t, v0) in scene.mesh.tets.iter().zip(&scene.rest_volumes) {
+        let v = tet_volume(t, x);
+        now += f64::from(v * v0.signum());
+        rest += f64::from(v0.abs());
+        if v * v0 <= 0.0 {
+            inverted += 1;
+        }
+    }
+    let (mut sum_sq, mut max) = (0.0f64, 0.0f32);
+    for ([a, b], l0) in scene.edges.iter().zip(&scene.rest_lengths) {
+        let s = ((x[*a as usize] - x[*b as usize]).norm() / l0 - 1.0).abs();
+        sum_sq += f64::from(s * s);
+        max = max.max(s);
+    }
+    Observables {
+        volume_err_pct: ((now / rest - 1.0) * 100.0) as f32,
+        edge_strain_rms: (sum_sq / scene.edges.len().max(1) as f64).sqrt() as f32,
+        edge_strain_max: max,
+        inverted,
+        height_ratio: height(x) / scene.rest_height(),
+    }
+}
+
+/// Max and RMS of tetpbd's `|C|` of one family after the last frame (m or m³).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FamilyError {
+    /// RMS of C.
+    pub rms: f32,
+    /// Max |C|.
+    pub max: f32,
+}
+
+/// What one run of one configuration gave.
+#[derive(Clone, Debug)]
+pub struct RunResult {
+    /// Median wall ms per frame over the frames after the warm-up.
+    pub ms_median: f64,
+    /// Wall ns per constraint projection over the measured frames (tetpbd only).
+    pub ns_per_projection: Option<f64>,
+    /// Observables after the last frame.
+    pub last: Observables,
+    /// Largest number of inverted tetrahedra over all frames.
+    pub max_inverted: usize,
+    /// tetpbd's per-family |C| after the last frame, in [`Family::ALL`] order (None: rapier,
+    /// or the family is not in the set).
+    pub families: [Option<FamilyError>; 3],
+    /// Squash: first time after which volume and height stay within 1 % of rest, s.
+    pub recover_s: Option<f32>,
+    /// Largest particle speed over the last frame, m/s (from the last two frames' positions).
+    pub final_speed: f32,
+    /// `false` when a position became non-finite.
+    pub finite: bool,
+    /// Positions after every frame.
+    pub trajectory: Vec<Vec<Vector3<f32>>>,
+    /// Volume error after every frame, %.
+    pub volume_series: Vec<f32>,
+}
+
+/// Runs `sim` through `scene.frames` frames.
+pub fn run(sim: &mut dyn Sim, scene: &Scene) -> RunResult {
+    let mut times = Vec::with_capacity(scene.frames);
+    let (mut proj, mut proj_ms) = (0u64, 0.0f64);
+    let mut trajectory = Vec::with_capacity(scene.frames);
+    let mut obs = Vec::with_capacity(scene.frames);
+    let mut families = [None; 3];
+    let mut finite = true;
+    for f in 0..scene.frames {
+        let cost = sim.step();
+        if f >= scene.warmup {
+            times.push(cost.ms);
+            proj += cost.projections;
+            proj_ms += cost.ms;
+        }
+        let x = sim.positions();
+        if !x.iter().all(|p| p.iter().all(|c| c.is_finite())) {
+            finite = false;
+        }
+        obs.push(observe(scene, &x));
+        trajectory.push(x);
+        if let Some(s) = sim.stats() {
+            for (k, fam) in Family::ALL.iter().enumerate() {
+                let st = s.family(*fam);
+                families[k] = match st.after {
+                    Some(e) if st.count > 0 => Some(FamilyError {
+                        rms: e.rms,
+                        max: e.max,
+                    }),
+                    _ => None,
+                };
+            }
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    let final_speed = match trajectory.len() {
+        n if n >= 2 => trajectory[n - 1]
+            .iter()
+            .zip(&trajectory[n - 2])
+            .map(|(a, b)| (a - b).norm() / DT)
+            .fold(0.0, f32::max),
+        _ => 0.0,
+    };
+    let recover_s = match scene.kind {
+        SceneKind::Squash => recovery_time(&obs),
+        SceneKind::HangingBeam => None,
+    };
+    RunResult {
+        ms_median: times.get(times.len() / 2).copied().unwrap_or(f64::NAN),
+        ns_per_projection: (proj > 0).then(|| proj_ms * 1e6 / proj as f64),
+        last: obs.last().copied().unwrap_or_default(),
+        max_inverted: obs.iter().map(|o| o.inverted).max().unwrap_or(0),
+        families,
+        recover_s,
+        final_speed,
+        finite,
+        volume_series: obs.iter().map(|o| o.volume_err_pct).collect(),
+        trajectory,
+    }
+}
+
+/// First time after which the volume and the height both stay within 1 % of rest.
+fn recovery_time(obs: &[Observables]) -> Option<f32> {
+    let ok =
+        |o: &Observables| o.volume_err_pct.abs() <= 1.0 && (o.height_ratio - 1.0).abs() <= 0.01;
+    let mut first = None;
+    for (f, o) in obs.iter().enumerate() {
+        match (ok(o), first) {
+            (true, None) => first = Some(f),
+            (false, _) => first = None,
+            _ => {}
+        }
+    }
+    first.map(|f| (f + 1) as f32 * DT)
+}
+
+/// Deviation of a run from a reference, relative to the body size.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Deviation {
+    /// Largest particle displacement over the compared frames.
+    pub max: f32,
+    /// RMS particle displacement over the compared frames.
+    pub rms: f32,
+}
+
+/// Compares `run` with `reference`: the last frame for the hanging beam (static
+/// equilibrium; pinned, so no rigid motion to remove), every frame for the squash, each frame
+/// after the best rigid alignment of the run onto the reference (the shape is compared, not
+/// where the free block drifted or turned).
+pub fn deviation(
+    scene: &Scene,
+    run: &[Vec<Vector3<f32>>],
+    reference: &[Vec<Vector3<f32>>],
+) -> Deviation {
+    let frames: Vec<usize> = match scene.kind {
+        SceneKind::HangingBeam => vec![run.len().min(reference.len()).saturating_sub(1)],
+        SceneKind::Squash => (0..run.len().min(reference.len())).collect(),
+    };
+    let (mut max, mut sum_sq, mut n) = (0.0f32, 0.0f64, 0usize);
+    for f in frames {
+        let aligned = match scene.kind {
+            SceneKind::HangingBeam => run[f].clone(),
+            SceneKind::Squash => align(&run[f], &reference[f]),
+        };
+        for (a, b) in aligned.iter().zip(&reference[f]) {
+            let d = (a - b).norm();
+            let d = if d.is_finite() { d } else { f32::INFINITY };
+            max = max.max(d);
+            sum_sq += f64::from(d) * f64::from(d);
+            n += 1;
+        }
+    }
+    Deviation {
+        max: max / scene.size,
+        rms: (sum_sq / n.max(1) as f64).sqrt() as f32 / scene.size,
+    }
+}
+
+/// `x` moved by the rotation and translation that best map it onto `target` (least squares,
+/// equal weights; Kabsch). Non-finite input is returned unchanged.
+pub fn align(x: &[Vector3<f32>], target: &[Vector3<f32>]) -> Vec<Vector3<f32>> {
+    if x.is_empty() || !x.iter().all(|p| p.iter().all(|c| c.is_finite())) {
+        return x.to_vec();
+    }
+    let n = x.len() as f64;
+    let cx = x.iter().map(|p| p.cast::<f64>()).sum::<Vector3<f64>>() / n;
+    let ct = target.iter().map(|p| p.cast::<f64>()).sum::<Vector3<f64>>() / n;
+    let mut h = Matrix3::<f64>::zeros();
+    for (a, b) in x.iter().zip(target) {
+        h += (a.cast::<f64>() - cx) * (b.cast::<f64>() - ct).transpose();
+    }
+    let svd = h.svd(true, true);
+    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return x.to_vec();
+    };
+    let mut r = v_t.transpose() * u.transpose();
+    if r.determinant() < 0.0 {
+        let mut v = v_t.transpose();
+        v.column_mut(2).neg_mut();
+        r = v * u.transpose();
+    }
+    x.iter()
+        .map(|p| (r * (p.cast::<f64>() - cx) + ct).cast::<f32>())
+        .collect()
+}
+
+/// The reference a model's runs are compared with.
+#[derive(Clone, Debug)]
+pub struct Reference {
+    /// Substeps of the run kept as reference (one iteration each); 0 for the exact answer.
+    pub substeps: u32,
+    /// Max deviation between it and the run with half as many substeps (relative to size);
+    /// 0 for the exact answer.
+    pub change: f32,
+    /// Its positions after every frame.
+    pub trajectory: Vec<Vec<Vector3<f32>>>,
+}
+
+/// The exact answer of a hard model (every edge and volume at rest): the rest shape in every
+/// frame (pinned beam: exactly there; free block: compared after rigid alignment).
+pub fn exact_rest(scene: &Scene) -> Reference {
+    Reference {
+        substeps: 0,
+        change: 0.0,
+        trajectory: vec![scene.mesh.vertices.clone(); scene.frames],
+    }
+}
+
+/// Doubles the substeps from `start` until the answer changes by less than 1e-6 of the body
+/// size, or `max` is reached.
+pub fn converged(model: Model, scene: &Scene, start: u32, max: u32) -> Reference {
+    let mut s = start;
+    let mut prev = run(build(model, scene, s, 1).as_mut(), scene).trajectory;
+    loop {
+        s *= 2;
+        let next = run(build(model, scene, s, 1).as_mut(), scene).trajectory;
+        let change = deviation(scene, &next, &prev).max;
+        if change < 1e-6 || s >= max {
+            return Reference {
+                substeps: s,
+                change,
+                trajectory: next,
+            };
+        }
+        prev = next;
+    }
+}

@@ -1,0 +1,165 @@
+//! The scenes of the report: one fixed tetrahedral mesh each, handed to both engines.
+
+use nalgebra::Vector3;
+use tetpbd::constraint::signed_volume;
+use tetpbd::generators::{self, CellSplit};
+use tetpbd::{unique_edges, TetMesh};
+
+/// Which scene of issue 5.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneKind {
+    /// a) A beam pinned at one end, sagging under gravity to static equilibrium.
+    HangingBeam,
+    /// b) A block squashed to 50 % height, released without gravity.
+    Squash,
+}
+
+/// One scene: the mesh both engines get, and how it is run.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Which scene.
+    pub kind: SceneKind,
+    /// Short name used in the CSV and the plot.
+    pub name: &'static str,
+    /// The rest mesh (both engines build their rest state from it).
+    pub mesh: TetMesh,
+    /// Pinned vertices.
+    pub pinned: Vec<u32>,
+    /// Start positions (the rest mesh, or the squashed one).
+    pub start: Vec<Vector3<f32>>,
+    /// Gravity along y, m/s².
+    pub gravity: f32,
+    /// Linear velocity damping of every particle, 1/s (same in both engines).
+    pub damping: f32,
+    /// Frames run at 1/60 s.
+    pub frames: usize,
+    /// Frames excluded from the timing median.
+    pub warmup: usize,
+    /// Body size used to make displacements relative, m.
+    pub size: f32,
+    /// Density, kg/m³ (masses are lumped per tetrahedron corner, the same in both engines).
+    pub density: f32,
+    /// Unique edges of the mesh with their rest lengths.
+    pub edges: Vec<[u32; 2]>,
+    /// Rest length of each edge, m.
+    pub rest_lengths: Vec<f32>,
+    /// Signed rest volume of each tetrahedron, m³.
+    pub rest_volumes: Vec<f32>,
+}
+
+/// Frame time step of every run, s.
+pub const DT: f32 = 1.0 / 60.0;
+
+impl Scene {
+    /// a) A 2 m × 0.2 m × 0.2 m beam, 20 × 2 × 2 cells of six tetrahedra, pinned at x = 0,
+    /// damped so that it settles within the run.
+    pub fn hanging_beam(quick: bool) -> Scene {
+        let mesh =
+            generators::beam(2.0, 0.2, 20, 2, CellSplit::Six).expect("valid beam parameters");
+        let pinned = generators::beam_root(&mesh);
+        let start = mesh.vertices.clone();
+        Scene::new(
+            SceneKind::HangingBeam,
+            "a_hanging_beam",
+            mesh,
+            pinned,
+            start,
+            -9.81,
+            10.0,
+            if quick { 60 } else { 180 },
+            2.0,
+        )
+    }
+
+    /// b) A 1 m cube, 4 × 4 × 4 cells of six tetrahedra, squashed to 50 % height about its
+    /// centre (x and z unchanged, so half its volume) and released at rest, without gravity.
+    pub fn squash(quick: bool) -> Scene {
+        let mesh = generators::box_grid(Vector3::repeat(1.0), [4, 4, 4], CellSplit::Six)
+            .expect("valid box parameters");
+        let start = mesh
+            .vertices
+            .iter()
+            .map(|v| Vector3::new(v.x, 0.5 * v.y, v.z))
+            .collect();
+        Scene::new(
+            SceneKind::Squash,
+            "b_squash_release",
+            mesh,
+            Vec::new(),
+            start,
+            0.0,
+            2.0,
+            if quick { 60 } else { 120 },
+            1.0,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        kind: SceneKind,
+        name: &'static str,
+        mesh: TetMesh,
+        pinned: Vec<u32>,
+        start: Vec<Vector3<f32>>,
+        gravity: f32,
+        damping: f32,
+        frames: usize,
+        size: f32,
+    ) -> Scene {
+        let edges = unique_edges(&mesh.tets);
+        let rest_lengths = edges
+            .iter()
+            .map(|[a, b]| (mesh.vertices[*a as usize] - mesh.vertices[*b as usize]).norm())
+            .collect();
+        let rest_volumes = mesh
+            .tets
+            .iter()
+            .map(|t| tet_volume(t, &mesh.vertices))
+            .collect();
+        Scene {
+            kind,
+            name,
+            mesh,
+            pinned,
+            start,
+            gravity,
+            damping,
+            frames,
+            warmup: 10.min(frames / 4),
+            size,
+            density: 1000.0,
+            edges,
+            rest_lengths,
+            rest_volumes,
+        }
+    }
+
+    /// Lumped particle masses, kg: `density · |V| / 4` per tetrahedron corner.
+    pub fn masses(&self) -> Vec<f32> {
+        let mut m = vec![0.0; self.mesh.vertices.len()];
+        for (t, v) in self.mesh.tets.iter().zip(&self.rest_volumes) {
+            for &i in t {
+                m[i as usize] += self.density * v.abs() / 4.0;
+            }
+        }
+        m
+    }
+
+    /// Height (y extent) of the rest mesh, m.
+    pub fn rest_height(&self) -> f32 {
+        height(&self.mesh.vertices)
+    }
+}
+
+/// Signed volume of tetrahedron `t` at `x`, m³.
+pub fn tet_volume(t: &[u32; 4], x: &[Vector3<f32>]) -> f32 {
+    let [a, b, c, d] = t.map(|i| x[i as usize]);
+    signed_volume(&a, &b, &c, &d)
+}
+
+/// y extent of a point set, m.
+pub fn height(x: &[Vector3<f32>]) -> f32 {
+    let lo = x.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
+    let hi = x.iter().map(|p| p.y).fold(f32::NEG_INFINITY, f32::max);
+    hi - lo
+}

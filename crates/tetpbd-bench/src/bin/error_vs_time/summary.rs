@@ -1,0 +1,243 @@
+//! summary.md: machine, date, commit, set-up of every configuration, and the Pareto headline
+//! in numbers, all from the rows of this run.
+
+use std::fmt::Write as _;
+use std::process::Command;
+
+use crate::engines::Model;
+use crate::pareto::{compare, median, Point};
+use crate::report::Row;
+use crate::scenes::{Scene, SceneKind};
+
+fn command_line(cmd: &str, args: &[&str]) -> Option<String> {
+    let out = Command::new(cmd).args(args).output().ok()?;
+    let s = String::from_utf8_lossy(&out.stdout).trim().to_string();
+    (out.status.success() && !s.is_empty()).then_some(s)
+}
+
+fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|c| {
+            c.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".to_string());
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    let os = std::fs::read_to_string("/etc/os-release")
+        .ok()
+        .and_then(|c| {
+            c.lines().find(|l| l.starts_with("PRETTY_NAME=")).map(|l| {
+                l.trim_start_matches("PRETTY_NAME=")
+                    .trim_matches('"')
+                    .to_string()
+            })
+        })
+        .unwrap_or_else(|| std::env::consts::OS.to_string());
+    let rustc = command_line("rustc", &["--version"]).unwrap_or_else(|| "rustc ?".to_string());
+    format!("{cpu}, {cores} logical cores available, {os}, {rustc}")
+}
+
+fn commit() -> String {
+    let head = command_line("git", &["rev-parse", "--short=12", "HEAD"])
+        .unwrap_or_else(|| "unknown".to_string());
+    let dirty = command_line(
+        "git",
+        &[
+            "status",
+            "--porcelain",
+            "--",
+            "crates/tetpbd",
+            "crates/tetpbd-bench",
+        ],
+    )
+    .is_some();
+    if dirty {
+        format!("{head} (with uncommitted changes in crates/tetpbd or crates/tetpbd-bench)")
+    } else {
+        head
+    }
+}
+
+/// A named error metric.
+struct Metric {
+    name: &'static str,
+    f: fn(&Row) -> f64,
+}
+
+const DEV: Metric = Metric {
+    name: "max deviation from converged reference (relative to body size)",
+    f: |r| f64::from(r.dev.max),
+};
+const STRAIN: Metric = Metric {
+    name: "RMS edge strain",
+    f: |r| f64::from(r.edge_strain_rms),
+};
+const LATE_VOLUME: Metric = Metric {
+    name: "max |volume error| % over the second half",
+    f: |r| f64::from(r.late_volume_err_pct),
+};
+
+fn points(rows: &[Row], idx: &[usize], m: &Metric) -> Vec<Point> {
+    idx.iter()
+        .map(|&i| Point {
+            ms: rows[i].ms,
+            err: (m.f)(&rows[i]),
+            row: i,
+        })
+        .collect()
+}
+
+/// Three significant digits, without an exponent for ordinary ratios.
+fn sig(x: f64) -> String {
+    match x.abs() {
+        a if a >= 1e5 || (a < 1e-2 && a > 0.0) => format!("{x:.2e}"),
+        a if a >= 100.0 => format!("{x:.0}"),
+        a if a >= 10.0 => format!("{x:.1}"),
+        _ => format!("{x:.2}"),
+    }
+}
+
+fn describe(r: &Row) -> String {
+    format!("{} {}", r.model.label(), r.budget())
+}
+
+/// The headline paragraph and table for one scene, one metric and one selection of rows.
+fn headline(s: &mut String, rows: &[Row], scene: &str, m: &Metric, hard_only: bool) {
+    let sel = |engine: &str| -> Vec<usize> {
+        (0..rows.len())
+            .filter(|&i| {
+                let r = &rows[i];
+                r.scene == scene
+                    && r.model.engine() == engine
+                    && r.finite
+                    && (!hard_only || r.model.is_hard())
+            })
+            .collect()
+    };
+    let matches = compare(
+        &points(rows, &sel("tetpbd"), m),
+        &points(rows, &sel("rapier"), m),
+    );
+    let speed: Vec<f64> = matches.iter().filter_map(|x| x.speedup()).collect();
+    let gain: Vec<f64> = matches.iter().filter_map(|x| x.accuracy_gain()).collect();
+    let range = |v: &[f64]| {
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        format!("{lo:.2}–{hi:.2}")
+    };
+    let which = if hard_only {
+        "hard models only"
+    } else {
+        "all models"
+    };
+    let _ = writeln!(s, "**{scene}, {which}, error = {}.** ", m.name);
+    match median(speed.clone()) {
+        Some(x) => {
+            let _ = writeln!(
+                s,
+                "At equal error, tetpbd's front is **{x:.2}× faster** than rapier's (median over the {} of {} rapier Pareto points tetpbd reaches; range {}). ",
+                speed.len(),
+                matches.len(),
+                range(&speed)
+            );
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "At equal error: tetpbd reaches none of rapier's {} Pareto points. ",
+                matches.len()
+            );
+        }
+    }
+    match median(gain.clone()) {
+        Some(x) => {
+            let _ = writeln!(
+                s,
+                "At equal time, tetpbd's error is **{}× smaller** (median over the {} of {} rapier Pareto points with a tetpbd run at most as costly; range {}).\n",
+                sig(x),
+                gain.len(),
+                matches.len(),
+                range(&gain)
+            );
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "At equal time: no tetpbd run is as cheap as any rapier Pareto point.\n"
+            );
+        }
+    }
+    let _ = writeln!(s, "| rapier Pareto point | ms | error | tetpbd at equal error | ms | speed-up | tetpbd at equal time | error | gain |");
+    let _ = writeln!(s, "|---|---:|---:|---|---:|---:|---|---:|---:|");
+    for x in &matches {
+        let t = &rows[x.theirs.row];
+        let (ee, ee_ms, sp) = match x.at_equal_error {
+            Some(p) => (
+                describe(&rows[p.row]),
+                format!("{:.3}", p.ms),
+                format!("{:.2}×", x.theirs.ms / p.ms),
+            ),
+            None => ("—".into(), String::new(), String::new()),
+        };
+        let (et, et_err, g) = match x.at_equal_time {
+            Some(p) => (
+                describe(&rows[p.row]),
+                format!("{:.2e}", p.err),
+                format!("{}×", sig(x.theirs.err / p.err.max(f64::MIN_POSITIVE))),
+            ),
+            None => ("—".into(), String::new(), String::new()),
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {:.3} | {:.2e} | {ee} | {ee_ms} | {sp} | {et} | {et_err} | {g} |",
+            describe(t),
+            x.theirs.ms,
+            x.theirs.err
+        );
+    }
+    let _ = writeln!(s);
+}
+
+/// The whole summary.
+pub fn markdown(
+    scenes: &[Scene],
+    rows: &[Row],
+    references: &[(&'static str, Model, u32, f32)],
+    quick: bool,
+    elapsed_s: f64,
+) -> String {
+    let mut s = String::new();
+    let date = command_line("date", &["-u", "+%Y-%m-%d %H:%M UTC"])
+        .unwrap_or_else(|| "unknown".to_string());
+    let _ = writeln!(
+        s,
+        "# Error against run time: tetpbd vs rapier 0.36 soft bodies\n"
+    );
+    let _ = writeln!(s, "Regenerate: `cargo run --release -p tetpbd-bench --bin error_vs_time{}` (this run took {elapsed_s:.0} s).\n", if quick { " -- --quick" } else { "" });
+    if quick {
+        let _ = writeln!(s, "**This is a `--quick` smoke run: fewer models, budgets, frames and a cheaper reference. Do not quote it.**\n");
+    }
+    let _ = writeln!(s, "- Machine: {}\n- Date: {date}\n- Commit: {}\n- Every run single-threaded, one after the other (tetpbd has no parallel solver yet; rapier built without its `parallel` feature).\n", machine(), commit());
+    let _ = writeln!(s, "![error vs time](plot.png)\n\nData: [results.csv](results.csv) (one row per run), [squash_volume.csv](squash_volume.csv) (volume error per frame of every squash run).\n");
+    let _ = writeln!(s, "## Headline (Pareto fronts)\n");
+    let _ = writeln!(s, "Each engine's Pareto front is the set of its runs that no other run of the same engine beats in both median ms per frame and error. At each rapier front point we take tetpbd's cheapest run with an error at most rapier's (equal error) and tetpbd's most accurate run costing at most rapier's (equal time).\n");
+    for scene in scenes {
+        match scene.kind {
+            SceneKind::HangingBeam => {
+                headline(&mut s, rows, scene.name, &DEV, false);
+                headline(&mut s, rows, scene.name, &DEV, true);
+                headline(&mut s, rows, scene.name, &STRAIN, true);
+            }
+            SceneKind::Squash => {
+                headline(&mut s, rows, scene.name, &DEV, false);
+                headline(&mut s, rows, scene.name, &LATE_VOLUME, false);
+                headline(&mut s, rows, scene.name, &LATE_VOLUME, true);
+            }
+        }
+    }
+    crate::summary_setup::setup(&mut s, scenes, rows, references);
+    s
+}
