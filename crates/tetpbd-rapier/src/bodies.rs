@@ -1,0 +1,234 @@
+//! Rigid bodies inside the soft substeps: one proxy per body a soft body touches.
+//!
+//! rapier has already advanced every body from its start pose `P₀` to its end pose `P₁`
+//! when the soft substeps run. Inside substep `k` a body stands at the interpolation of
+//! `P₀ → P₁` at `t = (k+1)·h`, composed with an *offset* that the soft contacts and
+//! attachments build up: a centre-of-mass translation `dx` and a rotation `dq`, each moving on
+//! with its own velocity (`dv`, `dω`), exactly as XPBD integrates a rigid body (Müller et al.
+//! 2020). With no soft interaction the offset stays zero and the body ends at `P₁` bit for
+//! bit. Fixed and kinematic bodies never get an offset (infinite mass).
+
+use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
+
+use crate::convert::{inertia_to_na, pose_to_glam, to_glam, to_na};
+
+/// How a body takes part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum BodyKind {
+    Fixed,
+    Kinematic,
+    Dynamic,
+}
+
+/// One rigid body during the soft substeps of a frame.
+#[derive(Clone, Debug)]
+pub(crate) struct BodyProxy {
+    pub handle: RigidBodyHandle,
+    pub kind: BodyKind,
+    com_local: Vector3<f32>,
+    com_start: Vector3<f32>,
+    com_end: Vector3<f32>,
+    rot_start: UnitQuaternion<f32>,
+    rot_end: UnitQuaternion<f32>,
+    v_base: Vector3<f32>,
+    w_base: Vector3<f32>,
+    v_end: Vector3<f32>,
+    w_end: Vector3<f32>,
+    inv_mass: Vector3<f32>,
+    inv_inertia: Matrix3<f32>,
+    dx: Vector3<f32>,
+    dq: UnitQuaternion<f32>,
+    dv: Vector3<f32>,
+    dw: Vector3<f32>,
+    dx_sub: Vector3<f32>,
+    dq_sub: UnitQuaternion<f32>,
+    frac: f32,
+    /// Pose at the end of the current substep (after corrections so far).
+    pub pose: Isometry3<f32>,
+    /// Pose at the end of the previous substep.
+    pub prev: Isometry3<f32>,
+    /// Whether a soft correction moved the body this frame.
+    pub touched: bool,
+}
+
+impl BodyProxy {
+    /// A proxy of `body`, whose pose before rapier's step was `start` (m, rad).
+    pub fn new(handle: RigidBodyHandle, body: &RigidBody, start: Isometry3<f32>, dt: f32) -> Self {
+        let kind = if body.is_dynamic() {
+            BodyKind::Dynamic
+        } else if body.is_kinematic() {
+            BodyKind::Kinematic
+        } else {
+            BodyKind::Fixed
+        };
+        let end = crate::convert::pose_to_na(body.position());
+        let start = if kind == BodyKind::Fixed { end } else { start };
+        let com_local = to_na(body.local_center_of_mass());
+        let com_start = start * nalgebra::Point3::from(com_local);
+        let com_end = end * nalgebra::Point3::from(com_local);
+        let (v_base, w_base) = if kind == BodyKind::Fixed {
+            (Vector3::zeros(), Vector3::zeros())
+        } else {
+            (
+                (com_end.coords - com_start.coords) / dt,
+                (end.rotation * start.rotation.inverse()).scaled_axis() / dt,
+            )
+        };
+        let (inv_mass, inv_inertia) = if kind == BodyKind::Dynamic {
+            let mp = body.mass_properties();
+            (
+                to_na(mp.effective_inv_mass),
+                inertia_to_na(&mp.effective_world_inv_inertia),
+            )
+        } else {
+            (Vector3::zeros(), Matrix3::zeros())
+        };
+        BodyProxy {
+            handle,
+            kind,
+            com_local,
+            com_start: com_start.coords,
+            com_end: com_end.coords,
+            rot_start: start.rotation,
+            rot_end: end.rotation,
+            v_base,
+            w_base,
+            v_end: to_na(body.linvel()),
+            w_end: to_na(body.angvel()),
+            inv_mass,
+            inv_inertia,
+            dx: Vector3::zeros(),
+            dq: UnitQuaternion::identity(),
+            dv: Vector3::zeros(),
+            dw: Vector3::zeros(),
+            dx_sub: Vector3::zeros(),
+            dq_sub: UnitQuaternion::identity(),
+            frac: 0.0,
+            pose: start,
+            prev: start,
+            touched: false,
+        }
+    }
+
+    /// `true` for a dynamic body (finite mass).
+    pub fn is_dynamic(&self) -> bool {
+        self.kind == BodyKind::Dynamic
+    }
+
+    /// Moves to the end of the next substep; `frac` is its end time as a fraction of the frame.
+    pub fn begin_substep(&mut self, frac: f32, h: f32) {
+        self.prev = self.pose;
+        if self.kind == BodyKind::Dynamic {
+            self.dx_sub = self.dx;
+            self.dq_sub = self.dq;
+            self.dx += self.dv * h;
+            self.dq = UnitQuaternion::from_scaled_axis(self.dw * h) * self.dq;
+        }
+        self.set_pose(frac);
+    }
+
+    fn set_pose(&mut self, frac: f32) {
+        if self.kind == BodyKind::Fixed {
+            self.pose = Isometry3::from_parts(
+                Translation3::from(self.com_end - self.rot_end * self.com_local),
+                self.rot_end,
+            );
+            return;
+        }
+        self.frac = frac;
+        let com = self.com_start.lerp(&self.com_end, frac) + self.dx;
+        let rot = self.dq * self.rot_start.nlerp(&self.rot_end, frac);
+        self.pose = Isometry3::from_parts(Translation3::from(com - rot * self.com_local), rot);
+    }
+
+    /// Poses before and after rapier's step (no soft offsets).
+    pub fn frame_poses(&self) -> (Isometry3<f32>, Isometry3<f32>) {
+        let at = |com: Vector3<f32>, rot: UnitQuaternion<f32>| {
+            Isometry3::from_parts(Translation3::from(com - rot * self.com_local), rot)
+        };
+        (
+            at(self.com_start, self.rot_start),
+            at(self.com_end, self.rot_end),
+        )
+    }
+
+    /// Current world centre of mass, m.
+    pub fn com(&self) -> Vector3<f32> {
+        self.pose.translation.vector + self.pose.rotation * self.com_local
+    }
+
+    /// Generalized inverse mass `nᵀM⁻¹n + (r×n)ᵀ I⁻¹ (r×n)` for a unit direction `n` at the
+    /// world point `q`, 1/kg; 0 for fixed and kinematic bodies.
+    pub fn inv_mass_at(&self, q: &Vector3<f32>, n: &Vector3<f32>) -> f32 {
+        if self.kind != BodyKind::Dynamic {
+            return 0.0;
+        }
+        let rn = (q - self.com()).cross(n);
+        n.dot(&self.inv_mass.component_mul(n)) + rn.dot(&(self.inv_inertia * rn))
+    }
+
+    /// Applies a positional impulse `p` (kg·m: direction × Δλ) at the world point `q`.
+    pub fn apply_position_impulse(&mut self, p: &Vector3<f32>, q: &Vector3<f32>) {
+        if self.kind != BodyKind::Dynamic {
+            return;
+        }
+        let dtheta = self.inv_inertia * (q - self.com()).cross(p);
+        self.dx += self.inv_mass.component_mul(p);
+        let dq = Quaternion::from_parts(0.0, dtheta) * self.dq.into_inner() * 0.5;
+        self.dq = UnitQuaternion::new_normalize(self.dq.into_inner() + dq);
+        self.touched = true;
+        let frac = self.frac;
+        self.set_pose(frac);
+    }
+
+    /// Ends a substep: the offset velocities follow from the offset motion.
+    pub fn end_substep(&mut self, h: f32) {
+        if self.kind != BodyKind::Dynamic {
+            return;
+        }
+        self.dv = (self.dx - self.dx_sub) / h;
+        self.dw = (self.dq * self.dq_sub.inverse()).scaled_axis() / h;
+    }
+
+    /// Velocity of the body's material point at the world point `q`, m/s.
+    pub fn velocity_at(&self, q: &Vector3<f32>) -> Vector3<f32> {
+        match self.kind {
+            BodyKind::Fixed => Vector3::zeros(),
+            _ => {
+                let w = self.w_base + self.dw;
+                self.v_base + self.dv + w.cross(&(q - self.com()))
+            }
+        }
+    }
+
+    /// Applies a velocity impulse `j` (N·s) at the world point `q`.
+    pub fn apply_velocity_impulse(&mut self, j: &Vector3<f32>, q: &Vector3<f32>) {
+        if self.kind != BodyKind::Dynamic {
+            return;
+        }
+        self.dv += self.inv_mass.component_mul(j);
+        self.dw += self.inv_inertia * (q - self.com()).cross(j);
+        self.touched = true;
+    }
+
+    /// Writes the final pose and velocity back to rapier. Returns `false` (and writes
+    /// nothing) when the result is not finite.
+    pub fn write_back(&self, body: &mut RigidBody) -> bool {
+        if self.kind != BodyKind::Dynamic || !self.touched {
+            return true;
+        }
+        let v = self.v_end + self.dv;
+        let w = self.w_end + self.dw;
+        let t = self.pose.translation.vector;
+        let finite = [v, w, t].iter().all(|x| x.iter().all(|c| c.is_finite()))
+            && self.pose.rotation.coords.iter().all(|c| c.is_finite());
+        if !finite {
+            return false;
+        }
+        body.set_position(pose_to_glam(&self.pose), true);
+        body.set_linvel(to_glam(&v), true);
+        body.set_angvel(to_glam(&w), true);
+        true
+    }
+}

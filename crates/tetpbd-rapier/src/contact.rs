@@ -1,0 +1,182 @@
+//! Particle–collider contacts: XPBD inequality constraints with Coulomb friction, and the
+//! velocity pass for restitution.
+//!
+//! Per iteration, for surface particle `p` and the closest point `q` on the collider (normal
+//! `n` from the collider to the particle, thickness `δ`):
+//!
+//! ```text
+//! C   = (p − q)·n − δ ≥ 0                      (only violated contacts are projected)
+//! w   = w_p + w_rigid,   w_rigid = nᵀM⁻¹n + (r×n)ᵀ I⁻¹ (r×n)   (0 for fixed/kinematic)
+//! Δλ  = −C / w,   p += w_p n Δλ,   rigid body gets −n Δλ at q
+//! ```
+//!
+//! Friction (positional, Müller et al. 2020): the relative tangential displacement `Δp_t` of
+//! the particle against the body's material point over the substep is removed completely
+//! while the accumulated tangential multiplier stays under `μ_s λ_n` (sticking), otherwise
+//! only up to `μ_d λ_n` (sliding). The velocity pass sets the relative normal velocity of
+//! each active contact to `−e·v_n⁻` (`v_n⁻` the approach speed at the substep start; `e = 0`
+//! when `|v_n⁻| < 2|g|h`, so resting contacts do not jitter).
+
+use nalgebra::{Point3, Vector3};
+use rapier3d::geometry::ColliderSet;
+use tetpbd::Particles;
+
+use crate::bodies::BodyProxy;
+use crate::frame::{ColliderProxy, ParticleContact};
+use crate::shape_query::surface_point;
+
+/// One sweep over a soft body's particle contacts. Returns the number of degenerate
+/// evaluations (no usable normal).
+pub(crate) fn project_contacts(
+    contacts: &mut [ParticleContact],
+    p: &mut Particles,
+    bodies: &mut [BodyProxy],
+    colliders: &[ColliderProxy],
+    set: &ColliderSet,
+) -> u64 {
+    let mut degenerate = 0;
+    for c in contacts {
+        let cp = &colliders[c.collider];
+        let Some(shape) = set.get(cp.handle).map(|co| co.shape()) else {
+            continue;
+        };
+        let i = c.particle as usize;
+        let x = p.positions()[i];
+        let pose = cp.pose(bodies);
+        let fallback = c.has_normal.then_some(c.normal);
+        let Some(sp) = surface_point(shape, cp.rule, &pose, &x, fallback) else {
+            degenerate += 1;
+            continue;
+        };
+        let (q, n) = (sp.point, sp.normal);
+        if !c.evaluated {
+            c.evaluated = true;
+            let vb = cp
+                .body
+                .map_or(Vector3::zeros(), |b| bodies[b].velocity_at(&q));
+            c.v_n_pre = n.dot(&(p.velocities()[i] - vb));
+        }
+        let c_val = sp.distance - c.thickness;
+        if c_val >= 0.0 {
+            continue;
+        }
+        c.active = true;
+        c.ever_active = true;
+        c.has_normal = true;
+        c.normal = n;
+        c.point = q;
+        c.depth = c.depth.max(-c_val);
+        if !c.solve {
+            continue;
+        }
+        let w_p = p.inv_masses()[i];
+        let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_at(&q, &n));
+        let wsum = w_p + w_b;
+        if wsum.is_nan() || wsum <= 0.0 {
+            continue;
+        }
+        let dl = -c_val / wsum;
+        p.positions_mut()[i] += n * (w_p * dl);
+        if let Some(b) = cp.body {
+            bodies[b].apply_position_impulse(&(-n * dl), &q);
+        }
+        c.lambda_n += dl;
+        c.sub_impulse += n * dl;
+        friction(c, p, bodies, cp, &q, &n);
+    }
+    degenerate
+}
+
+fn friction(
+    c: &mut ParticleContact,
+    p: &mut Particles,
+    bodies: &mut [BodyProxy],
+    cp: &ColliderProxy,
+    q: &Vector3<f32>,
+    n: &Vector3<f32>,
+) {
+    let i = c.particle as usize;
+    let x = p.positions()[i];
+    let x_prev = p.prev_positions()[i];
+    let body_motion = match cp.body {
+        Some(b) => {
+            let body = &bodies[b];
+            let local = body.pose.inverse_transform_point(&Point3::from(*q));
+            (body.pose * local).coords - (body.prev * local).coords
+        }
+        None => Vector3::zeros(),
+    };
+    let dp = (x - x_prev) - body_motion;
+    let dpt = dp - n * n.dot(&dp);
+    let len = dpt.norm();
+    if len.is_nan() || len <= 1e-9 {
+        return;
+    }
+    let t = dpt / len;
+    let w_p = p.inv_masses()[i];
+    let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_at(q, &t));
+    if (w_p + w_b).is_nan() || w_p + w_b <= 0.0 {
+        return;
+    }
+    let full = len / (w_p + w_b);
+    let applied = if c.lambda_t + full <= c.mu_s * c.lambda_n {
+        full
+    } else {
+        full.min((c.mu_d * c.lambda_n - c.lambda_t).max(0.0))
+    };
+    if applied <= 0.0 {
+        return;
+    }
+    p.positions_mut()[i] -= t * (w_p * applied);
+    if let Some(b) = cp.body {
+        bodies[b].apply_position_impulse(&(t * applied), q);
+    }
+    c.lambda_t += applied;
+    c.sub_impulse -= t * applied;
+}
+
+/// Velocity pass after a substep: restitution for the contacts active in it, then the
+/// per-substep state is reset. `threshold` is the approach speed below which restitution
+/// is 0, m/s.
+pub(crate) fn velocity_pass(
+    contacts: &mut [ParticleContact],
+    p: &mut Particles,
+    bodies: &mut [BodyProxy],
+    colliders: &[ColliderProxy],
+    h: f32,
+    threshold: f32,
+) {
+    for c in contacts {
+        if c.active && c.solve {
+            let cp = &colliders[c.collider];
+            let i = c.particle as usize;
+            let (q, n) = (c.point, c.normal);
+            let vb = cp
+                .body
+                .map_or(Vector3::zeros(), |b| bodies[b].velocity_at(&q));
+            let vn = n.dot(&(p.velocities()[i] - vb));
+            let e = if c.v_n_pre < -threshold {
+                c.restitution
+            } else {
+                0.0
+            };
+            let target = (-e * c.v_n_pre).max(0.0);
+            let w_p = p.inv_masses()[i];
+            let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_at(&q, &n));
+            if w_p + w_b > 0.0 {
+                let j = (target - vn) / (w_p + w_b);
+                p.velocities_mut()[i] += n * (w_p * j);
+                if let Some(b) = cp.body {
+                    bodies[b].apply_velocity_impulse(&(-n * j), &q);
+                }
+                c.impulse += n * j;
+            }
+        }
+        c.impulse += c.sub_impulse / h;
+        c.sub_impulse = Vector3::zeros();
+        c.lambda_n = 0.0;
+        c.lambda_t = 0.0;
+        c.active = false;
+        c.evaluated = false;
+    }
+}

@@ -1,0 +1,256 @@
+//! [`Coupling`]: one call that advances a rapier scene and the soft bodies of a hecs world
+//! by one frame.
+
+use std::time::Instant;
+
+use hecs::World;
+use rapier3d::dynamics::{
+    CCDSolver, ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet,
+    RigidBodySet, SoftBodySet,
+};
+use rapier3d::geometry::{BroadPhaseBvh, ColliderSet, NarrowPhase};
+use rapier3d::math::Vector;
+use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline, PhysicsWorld, QueryFilter};
+use tetpbd::{Solver, SolverSettings};
+
+use crate::convert::to_na;
+use crate::error::CouplingError;
+use crate::frame::Frame;
+use crate::hook::CouplingHook;
+use crate::material::SoftCollider;
+use crate::report::{ContactReport, CouplingStats};
+
+/// Settings of a [`Coupling`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct CouplingSettings {
+    /// Extra distance around soft bodies and colliders when candidates are gathered once per
+    /// frame, m (≥ 0). Contacts closer than the margin plus each body's motion over the frame
+    /// are evaluated in every substep.
+    pub margin: f32,
+    /// Collision properties of soft bodies without a [`SoftCollider`] component.
+    pub default_collider: SoftCollider,
+}
+
+impl Default for CouplingSettings {
+    fn default() -> Self {
+        CouplingSettings {
+            margin: 0.02,
+            default_collider: SoftCollider::default(),
+        }
+    }
+}
+
+impl CouplingSettings {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<(), CouplingError> {
+        if !(self.margin.is_finite() && self.margin >= 0.0) {
+            return Err(CouplingError::BadSetting {
+                name: "margin (m)",
+                value: self.margin,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The user's rapier state, borrowed for one coupled step. Every field is the argument of
+/// the same name of [`PhysicsPipeline::step`]; the integrator keeps owning all of it.
+pub struct RapierContext<'a> {
+    /// The integrator's physics pipeline.
+    pub pipeline: &'a mut PhysicsPipeline,
+    /// Gravity, m/s² (also used for the soft bodies).
+    pub gravity: Vector,
+    /// Integration parameters; their `dt` is the frame time of the soft bodies too.
+    pub integration_parameters: &'a IntegrationParameters,
+    /// Islands.
+    pub islands: &'a mut IslandManager,
+    /// Broad phase; its BVH finds the colliders near each soft body.
+    pub broad_phase: &'a mut BroadPhaseBvh,
+    /// Narrow phase (its query dispatcher runs the queries).
+    pub narrow_phase: &'a mut NarrowPhase,
+    /// Rigid bodies.
+    pub bodies: &'a mut RigidBodySet,
+    /// Colliders.
+    pub colliders: &'a mut ColliderSet,
+    /// Impulse joints.
+    pub impulse_joints: &'a mut ImpulseJointSet,
+    /// Multibody joints.
+    pub multibody_joints: &'a mut MultibodyJointSet,
+    /// rapier's own soft bodies (independent of `tetpbd`'s).
+    pub soft_bodies: &'a mut SoftBodySet,
+    /// CCD solver.
+    pub ccd_solver: &'a mut CCDSolver,
+    /// Physics hooks.
+    pub hooks: &'a dyn PhysicsHooks,
+    /// Event handler.
+    pub events: &'a dyn EventHandler,
+}
+
+impl<'a> RapierContext<'a> {
+    /// Borrows every part of a rapier [`PhysicsWorld`], with no hooks and no events.
+    pub fn from_physics_world(w: &'a mut PhysicsWorld) -> Self {
+        RapierContext {
+            pipeline: &mut w.physics_pipeline,
+            gravity: w.gravity,
+            integration_parameters: &w.integration_parameters,
+            islands: &mut w.islands,
+            broad_phase: &mut w.broad_phase,
+            narrow_phase: &mut w.narrow_phase,
+            bodies: &mut w.bodies,
+            colliders: &mut w.colliders,
+            impulse_joints: &mut w.impulse_joints,
+            multibody_joints: &mut w.multibody_joints,
+            soft_bodies: &mut w.soft_bodies,
+            ccd_solver: &mut w.ccd_solver,
+            hooks: &(),
+            events: &(),
+        }
+    }
+}
+
+/// Two-way coupling of `tetpbd` soft bodies with a rapier scene.
+///
+/// # One frame: [`Coupling::step`]
+///
+/// 1. Every non-fixed rigid body's pose `P₀` is recorded, then **rapier steps first**
+///    (`PhysicsPipeline::step` with the borrowed state): rigid–rigid contacts, joints,
+///    gravity on rigid bodies, kinematic targets. Bodies end at `P₁`.
+/// 2. **The soft substeps run** ([`tetpbd::Solver::step_with`], `dt` and gravity taken from
+///    rapier). Once per frame, surface particles and rigid corners near each collider are
+///    gathered from rapier's broad-phase BVH. In every substep each rigid body stands at the
+///    interpolation of `P₀ → P₁` plus the offset the soft body pushed it by; contacts and
+///    attachments are XPBD constraints projected after the soft body's own constraints, with
+///    dynamic bodies taking part through their generalized inverse mass.
+/// 3. The dynamic bodies the soft bodies touched get their final pose and velocity written
+///    back (`P₁` plus offset, rapier's velocity plus the offset's velocity).
+///
+/// Who integrates what: rapier integrates rigid bodies under gravity, rigid contacts and
+/// joints; the coupling integrates the soft bodies and the *reaction* of soft contacts and
+/// attachments on rigid bodies, which rapier sees at its next step as an already-moved pose
+/// and changed velocity. Rapier steps first so that the soft bodies see where the rigid
+/// bodies really are this frame (kinematic platforms carry soft bodies without a frame of
+/// lag); the price is that a soft push on a rigid body is resolved against rigid–rigid
+/// contacts one frame later (a box pressed into the ground by a soft body is pushed out by
+/// rapier at the next step).
+#[derive(Clone, Debug)]
+pub struct Coupling {
+    solver: Solver,
+    settings: CouplingSettings,
+    frame: Frame,
+    reports: Vec<ContactReport>,
+}
+
+impl Coupling {
+    /// A coupling with validated settings. The solver's `dt` and `gravity` are replaced by
+    /// rapier's at every step.
+    pub fn new(solver: SolverSettings, settings: CouplingSettings) -> Result<Self, CouplingError> {
+        settings.validate()?;
+        Ok(Coupling {
+            solver: Solver::new(solver)?,
+            settings,
+            frame: Frame::default(),
+            reports: Vec::new(),
+        })
+    }
+
+    /// The soft-body solver.
+    pub fn solver(&self) -> &Solver {
+        &self.solver
+    }
+
+    /// The soft-body solver, for changing its settings (validated at the next step).
+    pub fn solver_mut(&mut self) -> &mut Solver {
+        &mut self.solver
+    }
+
+    /// The coupling settings.
+    pub fn settings(&self) -> &CouplingSettings {
+        &self.settings
+    }
+
+    /// The coupling settings, for changing them (validated at the next step).
+    pub fn settings_mut(&mut self) -> &mut CouplingSettings {
+        &mut self.settings
+    }
+
+    /// The soft–rigid contacts of the last step.
+    pub fn contacts(&self) -> &[ContactReport] {
+        &self.reports
+    }
+
+    /// Advances rapier and every soft body of `world` by one frame (see the type docs for
+    /// the order). Settings are validated before anything moves.
+    pub fn step(
+        &mut self,
+        world: &mut World,
+        ctx: RapierContext<'_>,
+    ) -> Result<CouplingStats, CouplingError> {
+        let start = Instant::now();
+        self.settings.validate()?;
+        let dt = ctx.integration_parameters.dt;
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(CouplingError::BadRapierDt { value: dt });
+        }
+        let gravity = to_na(ctx.gravity);
+        if !gravity.iter().all(|g| g.is_finite()) {
+            return Err(CouplingError::NonFiniteGravity);
+        }
+        self.solver.settings.dt = dt;
+        self.solver.settings.gravity = gravity;
+        self.solver.settings.validate()?;
+
+        self.frame.capture_start(ctx.bodies);
+        let t = Instant::now();
+        ctx.pipeline.step(
+            ctx.gravity,
+            ctx.integration_parameters,
+            ctx.islands,
+            ctx.broad_phase,
+            ctx.narrow_phase,
+            ctx.bodies,
+            ctx.colliders,
+            ctx.impulse_joints,
+            ctx.multibody_joints,
+            ctx.soft_bodies,
+            ctx.ccd_solver,
+            ctx.hooks,
+            ctx.events,
+        );
+        let rigid_time = t.elapsed();
+
+        self.frame.dt = dt;
+        self.frame.substeps = self.solver.settings.substeps;
+        self.frame.gravity = gravity.norm();
+        self.frame.stats = CouplingStats::default();
+        let soft = {
+            let qp = ctx.broad_phase.as_query_pipeline(
+                ctx.narrow_phase.query_dispatcher(),
+                ctx.bodies,
+                ctx.colliders,
+                QueryFilter::default(),
+            );
+            let mut hook = CouplingHook {
+                frame: &mut self.frame,
+                qp,
+                default_collider: self.settings.default_collider,
+                margin: self.settings.margin,
+                reports: &mut self.reports,
+            };
+            self.solver.step_with(world, &mut hook)?
+        };
+        let mut stats = std::mem::take(&mut self.frame.stats);
+        for b in &self.frame.bodies {
+            if let Some(rb) = ctx.bodies.get_mut(b.handle) {
+                if !b.write_back(rb) {
+                    stats.non_finite_bodies += 1;
+                } else if b.is_dynamic() && b.touched {
+                    stats.bodies_written += 1;
+                }
+            }
+        }
+        stats.soft = soft;
+        stats.rigid_time = rigid_time;
+        stats.total_time = start.elapsed();
+        Ok(stats)
+    }
+}

@@ -1,0 +1,359 @@
+//! The per-frame state of the coupling: soft bodies, rigid proxies and constraint
+//! candidates gathered once per frame from rapier's broad-phase BVH.
+
+use std::collections::BTreeMap;
+
+use hecs::{Entity, World};
+use nalgebra::{Isometry3, Vector3};
+use rapier3d::dynamics::{CoefficientCombineRule, RigidBodyHandle, RigidBodySet};
+use rapier3d::geometry::{Aabb, ColliderHandle, ColliderSet};
+use rapier3d::parry::bounding_volume::BoundingVolume;
+use rapier3d::pipeline::QueryPipeline;
+use tetpbd::{Particles, Surface};
+
+use crate::attachment::{AttachTarget, Attachments};
+use crate::bodies::BodyProxy;
+use crate::convert::{pose_to_glam, pose_to_na, to_glam};
+use crate::corner::{gather_corners, CornerContact};
+use crate::material::SoftCollider;
+use crate::report::CouplingStats;
+use crate::shape_query::InsideRule;
+
+/// A soft body taking part in the frame.
+#[derive(Clone, Debug)]
+pub(crate) struct SoftEntry {
+    pub entity: Entity,
+    pub contacts: std::ops::Range<usize>,
+    pub corners: std::ops::Range<usize>,
+    pub attachments: std::ops::Range<usize>,
+}
+
+/// A collider near a soft body.
+#[derive(Clone, Debug)]
+pub(crate) struct ColliderProxy {
+    pub handle: ColliderHandle,
+    pub body: Option<usize>,
+    pub local: Isometry3<f32>,
+    pub rule: InsideRule,
+    pub friction: f32,
+    pub friction_rule: CoefficientCombineRule,
+    pub restitution: f32,
+    pub restitution_rule: CoefficientCombineRule,
+}
+
+impl ColliderProxy {
+    /// World pose at the current substep.
+    pub fn pose(&self, bodies: &[BodyProxy]) -> Isometry3<f32> {
+        match self.body {
+            Some(b) => bodies[b].pose * self.local,
+            None => self.local,
+        }
+    }
+}
+
+/// A surface particle near a collider: an XPBD inequality contact re-evaluated every
+/// iteration of every substep.
+#[derive(Clone, Debug)]
+pub(crate) struct ParticleContact {
+    pub particle: u32,
+    pub collider: usize,
+    pub mu_d: f32,
+    pub mu_s: f32,
+    pub restitution: f32,
+    pub thickness: f32,
+    pub solve: bool,
+    pub lambda_n: f32,
+    pub lambda_t: f32,
+    pub v_n_pre: f32,
+    pub evaluated: bool,
+    pub active: bool,
+    pub ever_active: bool,
+    pub has_normal: bool,
+    pub normal: Vector3<f32>,
+    pub point: Vector3<f32>,
+    pub depth: f32,
+    pub sub_impulse: Vector3<f32>,
+    pub impulse: Vector3<f32>,
+}
+
+/// An attachment in the frame.
+#[derive(Clone, Debug)]
+pub(crate) struct AttachRun {
+    pub particle: u32,
+    pub body: Option<usize>,
+    pub local: Vector3<f32>,
+    pub start: Vector3<f32>,
+    pub end: Vector3<f32>,
+    pub compliance: f32,
+    pub lambda: f32,
+}
+
+/// Everything the coupling keeps for one frame (allocations reused across frames).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Frame {
+    pub start_poses: Vec<((u32, u32), Isometry3<f32>)>,
+    pub soft: Vec<SoftEntry>,
+    pub bodies: Vec<BodyProxy>,
+    body_index: BTreeMap<(u32, u32), usize>,
+    pub colliders: Vec<ColliderProxy>,
+    collider_index: BTreeMap<(u32, u32), usize>,
+    pub contacts: Vec<ParticleContact>,
+    pub corners: Vec<CornerContact>,
+    pub attachments: Vec<AttachRun>,
+    pub substep: u32,
+    pub substeps: u32,
+    pub dt: f32,
+    pub gravity: f32,
+    pub stats: CouplingStats,
+}
+
+/// What candidate gathering needs besides the frame.
+pub(crate) struct GatherInput<'q, 'a> {
+    pub qp: &'q QueryPipeline<'a>,
+    pub default_collider: &'q SoftCollider,
+    pub margin: f32,
+}
+
+impl Frame {
+    /// Records every non-fixed body's pose before rapier's step.
+    pub fn capture_start(&mut self, bodies: &RigidBodySet) {
+        self.start_poses.clear();
+        for (h, b) in bodies.iter() {
+            if !b.is_fixed() {
+                self.start_poses
+                    .push((h.into_raw_parts(), pose_to_na(b.position())));
+            }
+        }
+    }
+
+    fn start_pose(&self, handle: RigidBodyHandle) -> Option<Isometry3<f32>> {
+        let key = handle.into_raw_parts();
+        self.start_poses
+            .binary_search_by(|(k, _)| k.cmp(&key))
+            .ok()
+            .map(|i| self.start_poses[i].1)
+    }
+
+    /// The proxy of `handle`, created on first use; `None` when the body does not exist.
+    pub fn body_proxy(&mut self, handle: RigidBodyHandle, bodies: &RigidBodySet) -> Option<usize> {
+        let key = handle.into_raw_parts();
+        if let Some(&i) = self.body_index.get(&key) {
+            return Some(i);
+        }
+        let rb = bodies.get(handle)?;
+        let start = self
+            .start_pose(handle)
+            .unwrap_or_else(|| pose_to_na(rb.position()));
+        self.bodies.push(BodyProxy::new(handle, rb, start, self.dt));
+        self.body_index.insert(key, self.bodies.len() - 1);
+        Some(self.bodies.len() - 1)
+    }
+
+    fn collider_proxy(
+        &mut self,
+        handle: ColliderHandle,
+        bodies: &RigidBodySet,
+        colliders: &ColliderSet,
+    ) -> Option<usize> {
+        let key = handle.into_raw_parts();
+        if let Some(&i) = self.collider_index.get(&key) {
+            return Some(i);
+        }
+        let co = colliders.get(handle)?;
+        let (body, local) = match co.parent() {
+            Some(parent) => {
+                let b = self.body_proxy(parent, bodies)?;
+                let local = co
+                    .position_wrt_parent()
+                    .map(pose_to_na)
+                    .unwrap_or_else(Isometry3::identity);
+                (Some(b), local)
+            }
+            None => (None, pose_to_na(co.position())),
+        };
+        self.colliders.push(ColliderProxy {
+            handle,
+            body,
+            local,
+            rule: InsideRule::of(co.shape()),
+            friction: co.friction(),
+            friction_rule: co.friction_combine_rule(),
+            restitution: co.restitution(),
+            restitution_rule: co.restitution_combine_rule(),
+        });
+        self.collider_index.insert(key, self.colliders.len() - 1);
+        Some(self.colliders.len() - 1)
+    }
+
+    /// Swept world AABB of a collider proxy over the frame.
+    fn swept_aabb(&self, c: usize, colliders: &ColliderSet) -> Option<Aabb> {
+        let cp = &self.colliders[c];
+        let shape = colliders.get(cp.handle)?.shape();
+        let (start, end) = match cp.body {
+            Some(b) => {
+                let (s, e) = self.bodies[b].frame_poses();
+                (s * cp.local, e * cp.local)
+            }
+            None => (cp.local, cp.local),
+        };
+        Some(shape.compute_swept_aabb(&pose_to_glam(&start), &pose_to_glam(&end)))
+    }
+
+    /// Clears the previous frame and gathers this frame's candidates.
+    pub fn gather(&mut self, world: &mut World, input: &GatherInput<'_, '_>) {
+        self.soft.clear();
+        self.bodies.clear();
+        self.body_index.clear();
+        self.colliders.clear();
+        self.collider_index.clear();
+        self.contacts.clear();
+        self.corners.clear();
+        self.attachments.clear();
+        self.substep = 0;
+        let qp = input.qp;
+        let dt = self.dt;
+        let fall = 0.5 * self.gravity * dt * dt;
+        for (entity, p, surface, sc, att) in world.query_mut::<(
+            Entity,
+            &Particles,
+            &Surface,
+            Option<&SoftCollider>,
+            Option<&Attachments>,
+        )>() {
+            let sc = sc.copied().unwrap_or(*input.default_collider);
+            let c0 = self.contacts.len();
+            let k0 = self.corners.len();
+            let a0 = self.attachments.len();
+            if sc.enabled && !surface.vertices().is_empty() {
+                let reach = input.margin + sc.thickness + p.max_speed() * dt + fall;
+                let (lo, hi) = surface_bounds(p, surface);
+                let aabb = Aabb::new(to_glam(&lo), to_glam(&hi)).loosened(reach);
+                let near: Vec<ColliderHandle> = qp
+                    .intersect_aabb_conservative(aabb)
+                    .filter(|(_, co)| {
+                        co.is_enabled()
+                            && !co.is_sensor()
+                            && sc.collision_groups.test(co.collision_groups())
+                    })
+                    .map(|(h, _)| h)
+                    .collect();
+                for handle in near {
+                    let Some(ci) = self.collider_proxy(handle, qp.bodies, qp.colliders) else {
+                        continue;
+                    };
+                    let Some(caabb) = self.swept_aabb(ci, qp.colliders) else {
+                        continue;
+                    };
+                    let caabb = caabb.loosened(reach - p.max_speed() * dt);
+                    let Some(co) = qp.colliders.get(handle) else {
+                        continue;
+                    };
+                    let solve = sc.solver_groups.test(co.solver_groups());
+                    let cp = &self.colliders[ci];
+                    let (mu_d, mu_s) = sc.combined_friction(cp.friction, cp.friction_rule);
+                    let e = sc.combined_restitution(cp.restitution, cp.restitution_rule);
+                    for &i in surface.vertices() {
+                        let x = p.positions()[i as usize];
+                        let y = x + p.velocities()[i as usize] * dt;
+                        let pa = Aabb::new(to_glam(&x.inf(&y)), to_glam(&x.sup(&y)));
+                        if !pa.intersects(&caabb) {
+                            continue;
+                        }
+                        self.contacts.push(ParticleContact {
+                            particle: i,
+                            collider: ci,
+                            mu_d,
+                            mu_s,
+                            restitution: e,
+                            thickness: sc.thickness,
+                            solve,
+                            lambda_n: 0.0,
+                            lambda_t: 0.0,
+                            v_n_pre: 0.0,
+                            evaluated: false,
+                            active: false,
+                            ever_active: false,
+                            has_normal: false,
+                            normal: Vector3::zeros(),
+                            point: Vector3::zeros(),
+                            depth: 0.0,
+                            sub_impulse: Vector3::zeros(),
+                            impulse: Vector3::zeros(),
+                        });
+                    }
+                    if sc.triangles && solve {
+                        gather_corners(
+                            &mut self.corners,
+                            co.shape(),
+                            ci,
+                            &caabb,
+                            p,
+                            surface,
+                            dt,
+                            sc.thickness,
+                        );
+                    }
+                }
+            }
+            if let Some(att) = att {
+                for a in &att.items {
+                    if a.particle as usize >= p.len() {
+                        self.stats.skipped_attachments += 1;
+                        continue;
+                    }
+                    let run = match a.target {
+                        AttachTarget::Body {
+                            handle,
+                            local_point,
+                        } => match self.body_proxy(handle, qp.bodies) {
+                            Some(b) => AttachRun {
+                                particle: a.particle,
+                                body: Some(b),
+                                local: local_point,
+                                start: Vector3::zeros(),
+                                end: Vector3::zeros(),
+                                compliance: a.compliance,
+                                lambda: 0.0,
+                            },
+                            None => {
+                                self.stats.skipped_attachments += 1;
+                                continue;
+                            }
+                        },
+                        AttachTarget::Point { position, previous } => AttachRun {
+                            particle: a.particle,
+                            body: None,
+                            local: Vector3::zeros(),
+                            start: previous,
+                            end: position,
+                            compliance: a.compliance,
+                            lambda: 0.0,
+                        },
+                    };
+                    self.attachments.push(run);
+                }
+            }
+            self.soft.push(SoftEntry {
+                entity,
+                contacts: c0..self.contacts.len(),
+                corners: k0..self.corners.len(),
+                attachments: a0..self.attachments.len(),
+            });
+        }
+        self.stats.candidates = self.contacts.len();
+        self.stats.corner_candidates = self.corners.len();
+        self.stats.attachments = self.attachments.len();
+    }
+}
+
+/// Bounds of a body's surface particles, m.
+fn surface_bounds(p: &Particles, surface: &Surface) -> (Vector3<f32>, Vector3<f32>) {
+    let mut lo = Vector3::repeat(f32::INFINITY);
+    let mut hi = Vector3::repeat(f32::NEG_INFINITY);
+    for &i in surface.vertices() {
+        let x = p.positions()[i as usize];
+        lo = lo.inf(&x);
+        hi = hi.sup(&x);
+    }
+    (lo, hi)
+}

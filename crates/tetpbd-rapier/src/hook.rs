@@ -1,0 +1,181 @@
+//! The [`tetpbd::SubstepHook`] that runs the coupling inside the soft solver's substeps.
+
+use hecs::World;
+use rapier3d::pipeline::QueryPipeline;
+use tetpbd::{Particles, SubstepHook, Surface};
+
+use crate::attachment::{anchor_of, project_attachments, Attachments};
+use crate::contact::{project_contacts, velocity_pass};
+use crate::corner::project_corners;
+use crate::frame::{Frame, GatherInput};
+use crate::material::SoftCollider;
+use crate::report::{ContactReport, SoftFeature};
+use crate::shape_query::surface_point;
+
+/// Borrows the frame state and rapier's query pipeline for one soft step.
+pub(crate) struct CouplingHook<'q, 'a> {
+    pub frame: &'q mut Frame,
+    pub qp: QueryPipeline<'a>,
+    pub default_collider: SoftCollider,
+    pub margin: f32,
+    pub reports: &'q mut Vec<ContactReport>,
+}
+
+impl CouplingHook<'_, '_> {
+    fn frac(&self) -> f32 {
+        (self.frame.substep as f32 / self.frame.substeps.max(1) as f32).min(1.0)
+    }
+}
+
+impl SubstepHook for CouplingHook<'_, '_> {
+    fn begin_frame(&mut self, world: &mut World, _dt: f32) {
+        let input = GatherInput {
+            qp: &self.qp,
+            default_collider: &self.default_collider,
+            margin: self.margin,
+        };
+        self.frame.gather(world, &input);
+    }
+
+    fn begin_substep(&mut self, _world: &mut World, h: f32) {
+        self.frame.substep += 1;
+        let frac = self.frac();
+        for b in &mut self.frame.bodies {
+            b.begin_substep(frac, h);
+        }
+        for a in &mut self.frame.attachments {
+            a.lambda = 0.0;
+        }
+    }
+
+    fn project(&mut self, world: &mut World, h: f32) {
+        let frac = self.frac();
+        let Frame {
+            soft,
+            bodies,
+            colliders,
+            contacts,
+            corners,
+            attachments,
+            stats,
+            ..
+        } = &mut *self.frame;
+        for s in soft.iter() {
+            let Ok((p, surface)) = world.query_one_mut::<(&mut Particles, &Surface)>(s.entity)
+            else {
+                continue;
+            };
+            stats.degenerate_contacts += project_contacts(
+                &mut contacts[s.contacts.clone()],
+                p,
+                bodies,
+                colliders,
+                self.qp.colliders,
+            );
+            project_corners(
+                &mut corners[s.corners.clone()],
+                p,
+                surface,
+                bodies,
+                colliders,
+            );
+            project_attachments(&mut attachments[s.attachments.clone()], p, bodies, frac, h);
+        }
+    }
+
+    fn end_substep(&mut self, world: &mut World, h: f32) {
+        let threshold = 2.0 * self.frame.gravity * h;
+        let Frame {
+            soft,
+            bodies,
+            colliders,
+            contacts,
+            corners,
+            ..
+        } = &mut *self.frame;
+        for b in bodies.iter_mut() {
+            b.end_substep(h);
+        }
+        for s in soft.iter() {
+            let Ok(p) = world.query_one_mut::<&mut Particles>(s.entity) else {
+                continue;
+            };
+            velocity_pass(
+                &mut contacts[s.contacts.clone()],
+                p,
+                bodies,
+                colliders,
+                h,
+                threshold,
+            );
+        }
+        for k in corners.iter_mut() {
+            k.impulse += k.sub_impulse / h;
+            k.sub_impulse = nalgebra::Vector3::zeros();
+        }
+    }
+
+    fn end_frame(&mut self, world: &mut World, _dt: f32) {
+        let frame = &mut *self.frame;
+        self.reports.clear();
+        let mut max_pen = 0.0f32;
+        let mut max_att = 0.0f32;
+        for s in &frame.soft {
+            let Ok((p, att)) =
+                world.query_one_mut::<(&Particles, Option<&mut Attachments>)>(s.entity)
+            else {
+                continue;
+            };
+            for c in &frame.contacts[s.contacts.clone()] {
+                let cp = &frame.colliders[c.collider];
+                if let Some(shape) = self.qp.colliders.get(cp.handle).map(|co| co.shape()) {
+                    let pose = cp.pose(&frame.bodies);
+                    let x = p.positions()[c.particle as usize];
+                    let fb = c.has_normal.then_some(c.normal);
+                    if let Some(sp) = surface_point(shape, cp.rule, &pose, &x, fb) {
+                        if c.solve {
+                            max_pen = max_pen.max(-sp.distance);
+                        }
+                    }
+                }
+                if c.ever_active {
+                    self.reports.push(ContactReport {
+                        collider: cp.handle,
+                        entity: s.entity,
+                        feature: SoftFeature::Particle(c.particle),
+                        point: c.point,
+                        normal: c.normal,
+                        depth: c.depth,
+                        impulse: c.impulse,
+                        solved: c.solve,
+                    });
+                }
+            }
+            for k in &frame.corners[s.corners.clone()] {
+                if k.ever_active {
+                    self.reports.push(ContactReport {
+                        collider: frame.colliders[k.collider].handle,
+                        entity: s.entity,
+                        feature: SoftFeature::Triangle(k.triangle),
+                        point: k.point,
+                        normal: k.normal,
+                        depth: k.depth,
+                        impulse: k.impulse,
+                        solved: true,
+                    });
+                }
+            }
+            for a in &frame.attachments[s.attachments.clone()] {
+                let anchor = anchor_of(a, &frame.bodies, 1.0);
+                let x = p.positions()[a.particle as usize];
+                max_att = max_att.max((x - anchor).norm());
+            }
+            if let Some(att) = att {
+                att.roll_targets();
+            }
+        }
+        frame.stats.max_penetration = max_pen.max(0.0);
+        frame.stats.max_attachment_error = max_att;
+        frame.stats.contacts = self.reports.len();
+    }
+}

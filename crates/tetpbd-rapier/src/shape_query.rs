@@ -1,0 +1,105 @@
+//! Signed distance from a point to a rapier collider's shape, through parry's point
+//! projection.
+//!
+//! Solid shapes (ball, cuboid, capsule, cylinder, cone, convex polyhedron, compound of
+//! those, and their rounded variants) tell parry whether the point is inside. Two shapes
+//! have no inside of their own and get a documented rule instead:
+//!
+//! * a **heightfield** is solid below its surface: a point whose offset from its projection
+//!   points down (local −y) is inside;
+//! * a **triangle mesh** without pseudo-normals (not built with `TriMeshFlags::ORIENTED` or
+//!   `FIX_INTERNAL_EDGES`) is one-sided: a point behind the face it projects onto (against
+//!   the counter-clockwise winding normal) is inside. Oriented meshes use parry's answer.
+
+use nalgebra::{Isometry3, Point3, Vector3};
+use rapier3d::parry::query::PointQuery;
+use rapier3d::parry::shape::Shape;
+
+use crate::convert::{to_glam, to_na};
+
+/// How "inside" is decided for a shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum InsideRule {
+    /// parry's `is_inside`.
+    Solid,
+    /// Below the heightfield's surface.
+    HeightField,
+    /// Behind the projected triangle of a non-oriented mesh.
+    OneSidedMesh,
+}
+
+impl InsideRule {
+    /// The rule of `shape`.
+    pub fn of(shape: &dyn Shape) -> InsideRule {
+        if shape.as_heightfield().is_some() {
+            InsideRule::HeightField
+        } else if shape
+            .as_trimesh()
+            .is_some_and(|m| m.pseudo_normals().is_none())
+        {
+            InsideRule::OneSidedMesh
+        } else {
+            InsideRule::Solid
+        }
+    }
+}
+
+/// Closest point `q` on the shape's surface (world, m), unit normal `n` pointing from the
+/// shape towards `p`'s outside side, and the signed distance `(p − q)·n` (negative inside).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SurfacePoint {
+    pub point: Vector3<f32>,
+    pub normal: Vector3<f32>,
+    pub distance: f32,
+}
+
+/// Projects `p` (world) onto `shape` placed at `pose`. `fallback` is the normal used when
+/// `p` lies exactly on the surface; without it such a point returns `None`.
+pub(crate) fn surface_point(
+    shape: &dyn Shape,
+    rule: InsideRule,
+    pose: &Isometry3<f32>,
+    p: &Vector3<f32>,
+    fallback: Option<Vector3<f32>>,
+) -> Option<SurfacePoint> {
+    let local = pose.inverse_transform_point(&Point3::from(*p)).coords;
+    let lp = to_glam(&local);
+    let (proj_point, inside) = match rule {
+        InsideRule::Solid => {
+            let proj = shape.project_local_point(lp, false);
+            (to_na(proj.point), proj.is_inside)
+        }
+        InsideRule::HeightField => {
+            let proj = shape.project_local_point(lp, false);
+            let q = to_na(proj.point);
+            (q, local.y < q.y)
+        }
+        InsideRule::OneSidedMesh => {
+            let mesh = shape.as_trimesh()?;
+            let (proj, _) = mesh.project_local_point_and_get_feature(lp);
+            let q = to_na(proj.point);
+            let behind = mesh
+                .triangle(proj.subshape)
+                .normal()
+                .is_some_and(|n| (local - q).dot(&to_na(n)) < 0.0);
+            (q, behind)
+        }
+    };
+    let d = local - proj_point;
+    let dist = d.norm();
+    if !dist.is_finite() || !proj_point.iter().all(|c| c.is_finite()) {
+        return None;
+    }
+    let point = pose * Point3::from(proj_point);
+    let (normal, distance) = if dist > 1e-7 {
+        let n_local = if inside { -d / dist } else { d / dist };
+        (pose.rotation * n_local, if inside { -dist } else { dist })
+    } else {
+        (fallback?, 0.0)
+    };
+    Some(SurfacePoint {
+        point: point.coords,
+        normal,
+        distance,
+    })
+}
