@@ -289,6 +289,7 @@ impl SoftBodyBuilder {
                 inv_masses,
                 masses,
                 rest_positions: mesh.vertices,
+                residuals: vec![Vector3::zeros(); n],
             },
             tetrahedra: Tetrahedra {
                 indices: mesh.tets,

@@ -22,6 +22,9 @@ pub struct Particles {
     pub(crate) inv_masses: Vec<f32>,
     pub(crate) masses: Vec<f32>,
     pub(crate) rest_positions: Vec<Vector3<f32>>,
+    /// Rounding residual of the current substep's position updates (see
+    /// [`crate::systems::add_compensated`]); zeroed by prediction.
+    pub(crate) residuals: Vec<Vector3<f32>>,
 }
 
 impl Particles {

@@ -38,15 +38,59 @@ pub fn predict(world: &mut World, h: f32, gravity: Vector3<f32>, damping: f32) {
             prev_positions,
             velocities,
             inv_masses,
+            residuals,
             ..
         } = p;
         for i in 0..positions.len() {
             prev_positions[i] = positions[i];
+            residuals[i] = Vector3::zeros();
             if inv_masses[i] > 0.0 {
                 velocities[i] = (velocities[i] + a * h) * keep;
             }
-            positions[i] += velocities[i] * h;
+            add_compensated(&mut positions[i], &mut residuals[i], velocities[i] * h);
         }
+    }
+}
+
+/// `x += d`, keeping the rounding error of the sum in `r` (Fast2Sum: exact while
+/// `|x| ≥ |d|`, which holds for the small corrections of a substep).
+///
+/// Why: a substep's corrections are often a few ulps of the position (10+ substeps, stiff
+/// constraints), and round-to-nearest then biases them. The velocity update adds the residual
+/// back, `v = (x − x_prev + r)/h`, so velocities, and with them momentum, see the exact sum
+/// of the corrections. Positions themselves stay rounded.
+#[inline(always)]
+pub fn add_compensated(x: &mut Vector3<f32>, r: &mut Vector3<f32>, d: Vector3<f32>) {
+    let old = *x;
+    let new = old + d;
+    *r += d - (new - old);
+    *x = new;
+}
+
+/// [`constraint::apply`] with compensated position updates ([`add_compensated`]).
+#[inline(always)]
+fn apply<const N: usize>(
+    x: &mut [Vector3<f32>],
+    r: &mut [Vector3<f32>],
+    idx: [usize; N],
+    w: [f32; N],
+    e: &constraint::Evaluated<f32, N>,
+    lambda: &mut f32,
+    alpha_tilde: f32,
+) -> bool {
+    let mut w_grad_sq = 0.0;
+    for k in 0..N {
+        w_grad_sq += w[k] * e.grad[k].norm_squared();
+    }
+    match constraint::xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
+        Some(dl) => {
+            *lambda += dl;
+            for k in 0..N {
+                add_compensated(&mut x[idx[k]], &mut r[idx[k]], e.grad[k] * (w[k] * dl));
+            }
+            true
+        }
+        None => false,
     }
 }
 
@@ -72,6 +116,7 @@ pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
     for (p, e) in world.query_mut::<(&mut Particles, &mut EdgeConstraints)>() {
         let alpha_tilde = e.compliance / (h * h);
         let x = &mut p.positions;
+        let r = &mut p.residuals;
         let w = &p.inv_masses;
         for (k, &[a, b]) in e.edges.iter().enumerate() {
             let (a, b) = (a as usize, b as usize);
@@ -90,8 +135,8 @@ pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
                 continue;
             };
             e.lambdas[k] += dl;
-            x[a] += n * (w[a] * dl);
-            x[b] -= n * (w[b] * dl);
+            add_compensated(&mut x[a], &mut r[a], n * (w[a] * dl));
+            add_compensated(&mut x[b], &mut r[b], n * (-w[b] * dl));
             count.applied += 1;
         }
     }
@@ -107,6 +152,7 @@ pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
     {
         let alpha_tilde = vf.compliance / (h * h);
         let x = &mut p.positions;
+        let r = &mut p.residuals;
         let w = &p.inv_masses;
         for (t, tet) in tets.indices.iter().enumerate() {
             for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
@@ -120,9 +166,7 @@ pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
                     vf.rest_heights[t][k],
                 );
                 let applied = match e {
-                    Some(e) => {
-                        constraint::apply(x, idx, wi, &e, &mut vf.lambdas[t][k], alpha_tilde)
-                    }
+                    Some(e) => apply(x, r, idx, wi, &e, &mut vf.lambdas[t][k], alpha_tilde),
                     None => false,
                 };
                 if applied {
@@ -144,6 +188,7 @@ pub fn project_volume(world: &mut World, h: f32) -> ProjectionCount {
     {
         let alpha_tilde = vol.compliance / (h * h);
         let x = &mut p.positions;
+        let r = &mut p.residuals;
         let w = &p.inv_masses;
         for (t, tet) in tets.indices.iter().enumerate() {
             let idx = tet.map(|i| i as usize);
@@ -155,7 +200,7 @@ pub fn project_volume(world: &mut World, h: f32) -> ProjectionCount {
                 &x[idx[3]],
                 tets.rest_volumes[t],
             );
-            if constraint::apply(x, idx, wi, &e, &mut vol.lambdas[t], alpha_tilde) {
+            if apply(x, r, idx, wi, &e, &mut vol.lambdas[t], alpha_tilde) {
                 count.applied += 1;
             } else if wi.iter().any(|w| *w > 0.0) {
                 count.degenerate += 1;
@@ -174,7 +219,8 @@ pub struct VelocityUpdate {
     pub clamped: u64,
 }
 
-/// Sets `v = (x − x_prev) / h`.
+/// Sets `v = (x − x_prev + r) / h`, with `r` the rounding residual of the substep's
+/// position updates (see [`add_compensated`]).
 ///
 /// With `max_correction_speed = Some(s)`, the part of the new velocity that the constraint
 /// projections added, `(x − x_prev)/h − v_pred` (with `v_pred` the predicted velocity, still
@@ -190,17 +236,18 @@ pub fn update_velocities(
     h: f32,
     max_correction_speed: Option<f32>,
 ) -> VelocityUpdate {
-    let inv_h = 1.0 / h;
     let mut out = VelocityUpdate::default();
     for p in world.query_mut::<&mut Particles>() {
         let Particles {
             positions,
             prev_positions,
             velocities,
+            residuals,
             ..
         } = p;
         for i in 0..positions.len() {
-            let mut v = (positions[i] - prev_positions[i]) * inv_h;
+            // Divide, not multiply by 1/h: h · (1/h) ≠ 1 in f32, a bias every substep.
+            let mut v = ((positions[i] - prev_positions[i]) + residuals[i]) / h;
             if let Some(limit) = max_correction_speed {
                 let dv = v - velocities[i];
                 let n2 = dv.norm_squared();
