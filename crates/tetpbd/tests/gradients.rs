@@ -1,8 +1,8 @@
 //! Every constraint's analytic gradient against central finite differences in f64.
 
-mod common_rng;
+mod common;
 
-use common_rng::Rng;
+use common::Rng;
 use nalgebra::Vector3;
 use tetpbd::constraint::{edge, signed_volume, vertex_face, volume, Evaluated};
 

@@ -1,8 +1,8 @@
 //! Single projections and the XPBD update, through the solver's systems.
 
-mod common_rng;
+mod common;
 
-use common_rng::Rng;
+use common::Rng;
 use hecs::World;
 use nalgebra::Vector3;
 use tetpbd::constraint::{apply, edge, vertex_face, volume};

@@ -6,9 +6,9 @@
 //! free, so from a globally mirrored or scrambled start the body settles un-inverted in a
 //! wrong (expanded) shape. With edges added, or edges + volume, the shape comes back.
 
-mod common_rng;
+mod common;
 
-use common_rng::Rng;
+use common::Rng;
 use hecs::{Entity, World};
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
