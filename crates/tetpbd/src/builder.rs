@@ -7,6 +7,7 @@ use crate::constraint::{signed_height, signed_volume, VERTEX_FACE_ORDER};
 use crate::error::BuildError;
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::mesh::{Surface, Tetrahedra};
+use crate::ordering::colour_order;
 use crate::particles::Particles;
 
 /// A tetrahedral mesh: vertex positions (m) and tetrahedra as vertex indices.
@@ -249,8 +250,21 @@ impl SoftBodyBuilder {
             .map(|w| if *w > 0.0 { velocity } else { Vector3::zeros() })
             .collect();
         let surface = Surface::from_tetrahedra(&mesh.tets, &mesh.vertices);
+        // Solver order for tetrahedra and edges (see `ordering`); `source` maps back.
+        let order = colour_order(&mesh.tets, n);
+        let tets: Vec<[u32; 4]> = order.iter().map(|&t| mesh.tets[t]).collect();
+        let rest_volumes: Vec<f32> = order.iter().map(|&t| rest_volumes[t]).collect();
+        let source: Vec<u32> = order.iter().map(|&t| t as u32).collect();
+        let mesh = TetMesh {
+            vertices: mesh.vertices,
+            tets,
+        };
         let edges = edge.map(|alpha| {
-            let list = unique_edges(&mesh.tets);
+            let sorted = unique_edges(&mesh.tets);
+            let list: Vec<[u32; 2]> = colour_order(&sorted, n)
+                .iter()
+                .map(|&k| sorted[k])
+                .collect();
             let rest_lengths = list
                 .iter()
                 .map(|[a, b]| (mesh.vertices[*a as usize] - mesh.vertices[*b as usize]).norm())
@@ -294,6 +308,7 @@ impl SoftBodyBuilder {
             tetrahedra: Tetrahedra {
                 indices: mesh.tets,
                 rest_volumes,
+                source,
             },
             surface,
             edges,

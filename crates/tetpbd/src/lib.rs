@@ -31,6 +31,7 @@ mod error;
 mod families;
 pub mod generators;
 mod mesh;
+pub mod ordering;
 mod particles;
 mod solver;
 mod stats;

@@ -9,7 +9,9 @@ use crate::constraint::signed_volume;
 
 /// The tetrahedra of one soft body with their signed rest volumes (a hecs component).
 ///
-/// Indices refer to the body's [`crate::Particles`]. A tetrahedron may have either
+/// Indices refer to the body's [`crate::Particles`]. The tetrahedra are stored in solver
+/// order (colour classes, see [`crate::ordering`]), not in the order they were given:
+/// [`Tetrahedra::source`] maps each back to its index in the input mesh. A tetrahedron may have either
 /// orientation; its rest volume keeps the sign it was built with, and it counts as
 /// inverted when its current signed volume has the opposite sign.
 #[derive(Clone, Debug, PartialEq)]
@@ -17,6 +19,7 @@ use crate::constraint::signed_volume;
 pub struct Tetrahedra {
     pub(crate) indices: Vec<[u32; 4]>,
     pub(crate) rest_volumes: Vec<f32>,
+    pub(crate) source: Vec<u32>,
 }
 
 impl Tetrahedra {
@@ -33,6 +36,11 @@ impl Tetrahedra {
     /// Particle indices of each tetrahedron.
     pub fn indices(&self) -> &[[u32; 4]] {
         &self.indices
+    }
+
+    /// For each stored tetrahedron, its index in the mesh the body was built from.
+    pub fn source(&self) -> &[u32] {
+        &self.source
     }
 
     /// Signed rest volume of each tetrahedron, m³.

@@ -118,25 +118,26 @@ pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
         let x = &mut p.positions;
         let r = &mut p.residuals;
         let w = &p.inv_masses;
-        for (k, &[a, b]) in e.edges.iter().enumerate() {
+        let rest = &p.rest_positions;
+        let edges = e.edges.iter().zip(&e.rest_lengths).zip(&mut e.lambdas);
+        for ((&[a, b], &d), lambda) in edges {
             let (a, b) = (a as usize, b as usize);
-            let d = e.rest_lengths[k];
             let delta = x[a] - x[b];
             let len = delta.norm();
             let n = if len > 1e-6 * d {
-                delta / len
+                delta * (1.0 / len)
             } else {
                 count.degenerate += 1;
-                (p.rest_positions[a] - p.rest_positions[b]) / d
+                (rest[a] - rest[b]) * (1.0 / d)
             };
-            let wsum = w[a] + w[b];
-            let Some(dl) = constraint::xpbd_delta_lambda(len - d, e.lambdas[k], alpha_tilde, wsum)
+            let (wa, wb) = (w[a], w[b]);
+            let Some(dl) = constraint::xpbd_delta_lambda(len - d, *lambda, alpha_tilde, wa + wb)
             else {
                 continue;
             };
-            e.lambdas[k] += dl;
-            add_compensated(&mut x[a], &mut r[a], n * (w[a] * dl));
-            add_compensated(&mut x[b], &mut r[b], n * (-w[b] * dl));
+            *lambda += dl;
+            add_compensated(&mut x[a], &mut r[a], n * (wa * dl));
+            add_compensated(&mut x[b], &mut r[b], n * (-wb * dl));
             count.applied += 1;
         }
     }

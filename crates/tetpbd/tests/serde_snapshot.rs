@@ -29,8 +29,14 @@ fn take(world: &World, e: Entity, settings: &SolverSettings) -> Snapshot {
         tetrahedra: (*world.get::<&Tetrahedra>(e).unwrap()).clone(),
         surface: (*world.get::<&Surface>(e).unwrap()).clone(),
         edges: world.get::<&EdgeConstraints>(e).ok().map(|c| (*c).clone()),
-        vertex_face: world.get::<&VertexFaceConstraints>(e).ok().map(|c| (*c).clone()),
-        volume: world.get::<&VolumeConstraints>(e).ok().map(|c| (*c).clone()),
+        vertex_face: world
+            .get::<&VertexFaceConstraints>(e)
+            .ok()
+            .map(|c| (*c).clone()),
+        volume: world
+            .get::<&VolumeConstraints>(e)
+            .ok()
+            .map(|c| (*c).clone()),
         settings: settings.clone(),
     }
 }
@@ -87,5 +93,8 @@ fn snapshot_restored_into_a_fresh_world_continues_bit_identically() {
     for (x, y) in a.velocities().iter().zip(b.velocities()) {
         assert_eq!(x.map(f32::to_bits), y.map(f32::to_bits));
     }
-    assert!(a.max_speed() > 0.1, "the body is moving, so the comparison means something");
+    assert!(
+        a.max_speed() > 0.1,
+        "the body is moving, so the comparison means something"
+    );
 }
