@@ -218,7 +218,9 @@ impl SoftBodyBuilder {
                 }
             }
             let threshold = epsilon * longest * longest * longest;
-            if !(vol.abs() > threshold) || vol == 0.0 {
+            // NaN-safe: anything not strictly above the threshold (overflow included) is rejected.
+            if vol.abs().partial_cmp(&threshold) != Some(std::cmp::Ordering::Greater) || vol == 0.0
+            {
                 return Err(BuildError::DegenerateTetrahedron {
                     tet: t,
                     volume: vol,

@@ -130,7 +130,9 @@ pub fn vertex_face<T: RealField + Copy>(
     let m = b.cross(&c);
     let m_len = m.norm();
     let scale = b.norm_squared() + c.norm_squared();
-    if !(m_len > scale * nalgebra::convert::<f64, T>(1e-7)) || m_len <= T::zero() {
+    let threshold = scale * nalgebra::convert::<f64, T>(1e-7);
+    // NaN-safe: a NaN length is "not above the threshold" and reported as degenerate.
+    if m_len.partial_cmp(&threshold) != Some(std::cmp::Ordering::Greater) || m_len <= T::zero() {
         return None;
     }
     let inv = T::one() / m_len;
@@ -233,10 +235,11 @@ pub fn apply<const N: usize>(
     lambda: &mut f32,
     alpha_tilde: f32,
 ) -> bool {
-    let mut w_grad_sq = 0.0;
-    for k in 0..N {
-        w_grad_sq += w[k] * e.grad[k].norm_squared();
-    }
+    let w_grad_sq: f32 = w
+        .iter()
+        .zip(&e.grad)
+        .map(|(w, g)| w * g.norm_squared())
+        .sum();
     match xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
         Some(dl) => {
             *lambda += dl;

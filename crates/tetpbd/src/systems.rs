@@ -78,10 +78,11 @@ fn apply<const N: usize>(
     lambda: &mut f32,
     alpha_tilde: f32,
 ) -> bool {
-    let mut w_grad_sq = 0.0;
-    for k in 0..N {
-        w_grad_sq += w[k] * e.grad[k].norm_squared();
-    }
+    let w_grad_sq: f32 = w
+        .iter()
+        .zip(&e.grad)
+        .map(|(w, g)| w * g.norm_squared())
+        .sum();
     match constraint::xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
         Some(dl) => {
             *lambda += dl;

@@ -14,9 +14,17 @@ fn items_of_one_colour_share_no_particle() {
     assert!(max < 63, "the grid needs {} colours", max + 1);
     for c in 0..=max {
         let mut seen = vec![false; n];
-        for (t, tet) in mesh.tets.iter().enumerate().filter(|(t, _)| colours[*t] == c) {
+        for (t, tet) in mesh
+            .tets
+            .iter()
+            .enumerate()
+            .filter(|(t, _)| colours[*t] == c)
+        {
             for &i in tet {
-                assert!(!seen[i as usize], "colour {c}: tetrahedron {t} reuses particle {i}");
+                assert!(
+                    !seen[i as usize],
+                    "colour {c}: tetrahedron {t} reuses particle {i}"
+                );
                 seen[i as usize] = true;
             }
         }
@@ -26,7 +34,10 @@ fn items_of_one_colour_share_no_particle() {
 #[test]
 fn stored_tetrahedra_map_back_to_the_input() {
     let mesh = box_grid(Vector3::new(1.0, 2.0, 1.0), [3, 4, 2], CellSplit::Five).unwrap();
-    let body = SoftBodyBuilder::new(mesh.clone()).edges(0.0).build().unwrap();
+    let body = SoftBodyBuilder::new(mesh.clone())
+        .edges(0.0)
+        .build()
+        .unwrap();
     let t = &body.tetrahedra;
     let mut seen = vec![false; mesh.tets.len()];
     for (k, &s) in t.source().iter().enumerate() {
