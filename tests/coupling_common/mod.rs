@@ -12,8 +12,13 @@ use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider};
 
 /// A scene at 60 Hz with `substeps` soft substeps.
 pub fn scene(substeps: u32) -> CoupledWorld {
+    let iterations = std::env::var("ITERS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1);
     let solver = SolverSettings {
         substeps,
+        iterations,
         ..SolverSettings::default()
     };
     CoupledWorld::new(solver, CouplingSettings::default()).expect("valid settings")

@@ -13,9 +13,9 @@
 //! Friction (positional, Müller et al. 2020): the relative tangential displacement `Δp_t` of
 //! the particle against the body's material point over the substep is removed completely
 //! while the accumulated tangential multiplier stays under `μ_s λ_n` (sticking), otherwise
-//! only up to `μ_d λ_n` (sliding). The velocity pass sets the relative normal velocity of
-//! each active contact to `−e·v_n⁻` (`v_n⁻` the approach speed at the substep start; `e = 0`
-//! when `|v_n⁻| < 2|g|h`, so resting contacts do not jitter).
+//! only up to `μ_d λ_n` (sliding). The velocity pass then removes the separating normal
+//! velocity the projection gave each contact particle; restitution is applied to the whole
+//! body by [`crate::restitution`].
 
 use nalgebra::{Point3, Vector3};
 use rapier3d::geometry::ColliderSet;
@@ -49,13 +49,6 @@ pub(crate) fn project_contacts(
             continue;
         };
         let (q, n) = (sp.point, sp.normal);
-        if !c.evaluated {
-            c.evaluated = true;
-            let vb = cp
-                .body
-                .map_or(Vector3::zeros(), |b| bodies[b].velocity_at(&q));
-            c.v_n_pre = n.dot(&(p.velocities()[i] - vb));
-        }
         let c_val = sp.distance - c.thickness;
         if c_val >= 0.0 {
             continue;
@@ -135,48 +128,44 @@ fn friction(
     c.sub_impulse -= t * applied;
 }
 
-/// Velocity pass after a substep: restitution for the contacts active in it, then the
-/// per-substep state is reset. `threshold` is the approach speed below which restitution
-/// is 0, m/s.
+/// Velocity pass after a substep, per particle: the relative normal velocity of every
+/// contact active in the substep is set to zero (Müller et al. 2020 with `e = 0`), which
+/// removes the separating velocity the position projection created. Restitution itself
+/// acts on the whole body (see [`crate::restitution`]).
 pub(crate) fn velocity_pass(
     contacts: &mut [ParticleContact],
     p: &mut Particles,
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
-    h: f32,
-    threshold: f32,
 ) {
-    for c in contacts {
-        if c.active && c.solve {
-            let cp = &colliders[c.collider];
-            let i = c.particle as usize;
-            let (q, n) = (c.point, c.normal);
-            let vb = cp
-                .body
-                .map_or(Vector3::zeros(), |b| bodies[b].velocity_at(&q));
-            let vn = n.dot(&(p.velocities()[i] - vb));
-            let e = if c.v_n_pre < -threshold {
-                c.restitution
-            } else {
-                0.0
-            };
-            let target = (-e * c.v_n_pre).max(0.0);
-            let w_p = p.inv_masses()[i];
-            let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_at(&q, &n));
-            if w_p + w_b > 0.0 {
-                let j = (target - vn) / (w_p + w_b);
-                p.velocities_mut()[i] += n * (w_p * j);
-                if let Some(b) = cp.body {
-                    bodies[b].apply_velocity_impulse(&(-n * j), &q);
-                }
-                c.impulse += n * j;
+    for c in contacts.iter_mut().filter(|c| c.active && c.solve) {
+        let cp = &colliders[c.collider];
+        let i = c.particle as usize;
+        let (q, n) = (c.point, c.normal);
+        let vb = cp
+            .body
+            .map_or(Vector3::zeros(), |b| bodies[b].velocity_at(&q));
+        let vn = n.dot(&(p.velocities()[i] - vb));
+        let w_p = p.inv_masses()[i];
+        let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_at(&q, &n));
+        if vn > 0.0 && w_p + w_b > 0.0 {
+            let j = -vn / (w_p + w_b);
+            p.velocities_mut()[i] += n * (w_p * j);
+            if let Some(b) = cp.body {
+                bodies[b].apply_velocity_impulse(&(-n * j), &q);
             }
+            c.impulse += n * j;
         }
+    }
+}
+
+/// Resets the per-substep state of the contacts; the substep's impulses join the frame's.
+pub(crate) fn finish_substep(contacts: &mut [ParticleContact], h: f32) {
+    for c in contacts {
         c.impulse += c.sub_impulse / h;
         c.sub_impulse = Vector3::zeros();
         c.lambda_n = 0.0;
         c.lambda_t = 0.0;
         c.active = false;
-        c.evaluated = false;
     }
 }

@@ -23,6 +23,8 @@ use crate::shape_query::InsideRule;
 #[derive(Clone, Debug)]
 pub(crate) struct SoftEntry {
     pub entity: Entity,
+    /// Centre-of-mass velocity after the prediction of the current substep, m/s.
+    pub v_cm_pre: Vector3<f32>,
     pub contacts: std::ops::Range<usize>,
     pub corners: std::ops::Range<usize>,
     pub attachments: std::ops::Range<usize>,
@@ -64,8 +66,6 @@ pub(crate) struct ParticleContact {
     pub solve: bool,
     pub lambda_n: f32,
     pub lambda_t: f32,
-    pub v_n_pre: f32,
-    pub evaluated: bool,
     pub active: bool,
     pub ever_active: bool,
     pub has_normal: bool,
@@ -100,6 +100,8 @@ pub(crate) struct Frame {
     pub contacts: Vec<ParticleContact>,
     pub corners: Vec<CornerContact>,
     pub attachments: Vec<AttachRun>,
+    /// Impact episodes in progress (kept across frames).
+    pub episodes: Vec<crate::restitution::Episode>,
     pub substep: u32,
     pub substeps: u32,
     pub dt: f32,
@@ -269,8 +271,6 @@ impl Frame {
                             solve,
                             lambda_n: 0.0,
                             lambda_t: 0.0,
-                            v_n_pre: 0.0,
-                            evaluated: false,
                             active: false,
                             ever_active: false,
                             has_normal: false,
@@ -335,6 +335,7 @@ impl Frame {
             }
             self.soft.push(SoftEntry {
                 entity,
+                v_cm_pre: Vector3::zeros(),
                 contacts: c0..self.contacts.len(),
                 corners: k0..self.corners.len(),
                 attachments: a0..self.attachments.len(),

@@ -5,11 +5,13 @@ use rapier3d::pipeline::QueryPipeline;
 use tetpbd::{Particles, SubstepHook, Surface};
 
 use crate::attachment::{anchor_of, project_attachments, Attachments};
-use crate::contact::{project_contacts, velocity_pass};
+use crate::contact::{finish_substep, project_contacts, velocity_pass};
 use crate::corner::project_corners;
+use crate::damping::{damp, DeformationDamping};
 use crate::frame::{Frame, GatherInput};
 use crate::material::SoftCollider;
 use crate::report::{ContactReport, SoftFeature};
+use crate::restitution::{com_velocity, end_episodes, restitution_pass};
 use crate::shape_query::surface_point;
 
 /// Borrows the frame state and rapier's query pipeline for one soft step.
@@ -37,8 +39,13 @@ impl SubstepHook for CouplingHook<'_, '_> {
         self.frame.gather(world, &input);
     }
 
-    fn begin_substep(&mut self, _world: &mut World, h: f32) {
+    fn begin_substep(&mut self, world: &mut World, h: f32) {
         self.frame.substep += 1;
+        for s in &mut self.frame.soft {
+            if let Ok(p) = world.query_one_mut::<&Particles>(s.entity) {
+                s.v_cm_pre = com_velocity(p).0;
+            }
+        }
         let frac = self.frac();
         for b in &mut self.frame.bodies {
             b.begin_substep(frac, h);
@@ -91,24 +98,36 @@ impl SubstepHook for CouplingHook<'_, '_> {
             colliders,
             contacts,
             corners,
+            episodes,
             ..
         } = &mut *self.frame;
         for b in bodies.iter_mut() {
             b.end_substep(h);
         }
         for s in soft.iter() {
-            let Ok(p) = world.query_one_mut::<&mut Particles>(s.entity) else {
+            let Ok((p, damping)) =
+                world.query_one_mut::<(&mut Particles, Option<&DeformationDamping>)>(s.entity)
+            else {
                 continue;
             };
-            velocity_pass(
-                &mut contacts[s.contacts.clone()],
+            if let Some(d) = damping {
+                damp(p, d.rate(), h);
+            }
+            let range = s.contacts.clone();
+            velocity_pass(&mut contacts[range.clone()], p, bodies, colliders);
+            restitution_pass(
+                episodes,
+                s.entity,
+                &mut contacts[range.clone()],
                 p,
+                &s.v_cm_pre,
                 bodies,
                 colliders,
-                h,
                 threshold,
             );
+            finish_substep(&mut contacts[range], h);
         }
+        end_episodes(episodes);
         for k in corners.iter_mut() {
             k.impulse += k.sub_impulse / h;
             k.sub_impulse = nalgebra::Vector3::zeros();

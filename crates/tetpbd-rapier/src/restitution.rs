@@ -1,0 +1,170 @@
+//! Restitution of a whole soft body against a collider (Poisson's hypothesis on the
+//! centre of mass).
+//!
+//! A soft body's impact lasts several substeps and involves many particles, so restitution
+//! cannot be a per-particle velocity rule: setting a few contact particles to `−e·v` is
+//! averaged away by the body's constraints, and the numerical springiness of a stiff XPBD
+//! body makes it bounce off a contact with `e = 0`. Instead each (soft body, collider) pair
+//! in contact runs an *impact episode*:
+//!
+//! 1. it begins at the first substep with an active contact; `v⁻ = n·(v_cm − v_rigid(q))` is
+//!    the approach speed of the body's centre of mass before that substep (`n`, `q` the mean
+//!    normal and point of the active contacts). Only an approach faster than `2|g|h` is an
+//!    impact (resting contacts never bounce);
+//! 2. compression ends at the first substep where the relative normal velocity `v_n` of the
+//!    centre of mass is ≥ 0; the body then receives the uniform velocity change that makes
+//!    `v_n = −e·v⁻` (with the opposite impulse on a dynamic rigid body, generalized inverse
+//!    mass at `q`);
+//! 3. while the contact lasts, `v_n` is capped at `−e·v⁻`, so the body's elastic recoil does
+//!    not add bounce; the episode ends with the last active contact (kept across frames).
+//!
+//! `e` is the largest combined restitution among the pair's contacts.
+
+use hecs::Entity;
+use nalgebra::Vector3;
+use rapier3d::geometry::ColliderHandle;
+use tetpbd::Particles;
+
+use crate::bodies::BodyProxy;
+use crate::frame::{ColliderProxy, ParticleContact};
+
+/// One impact episode of a (soft body, collider) pair.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Episode {
+    key: (u64, (u32, u32)),
+    approach: f32,
+    compressing: bool,
+    seen: bool,
+}
+
+/// Centre-of-mass velocity and mass of the free particles of `p`.
+pub(crate) fn com_velocity(p: &Particles) -> (Vector3<f32>, f32) {
+    let mut m = 0.0;
+    let mut mv = Vector3::zeros();
+    for i in 0..p.len() {
+        if p.inv_masses()[i] > 0.0 {
+            m += p.masses()[i];
+            mv += p.velocities()[i] * p.masses()[i];
+        }
+    }
+    if m > 0.0 {
+        (mv / m, m)
+    } else {
+        (Vector3::zeros(), 0.0)
+    }
+}
+
+/// Runs the episodes of one soft body after a substep's velocity update. `contacts` are the
+/// body's contacts (contiguous per collider), `v_cm_pre` its centre-of-mass velocity before
+/// the substep.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn restitution_pass(
+    episodes: &mut Vec<Episode>,
+    entity: Entity,
+    contacts: &mut [ParticleContact],
+    p: &mut Particles,
+    v_cm_pre: &Vector3<f32>,
+    bodies: &mut [BodyProxy],
+    colliders: &[ColliderProxy],
+    threshold: f32,
+) {
+    let (v_cm, mass) = com_velocity(p);
+    if mass <= 0.0 {
+        return;
+    }
+    let mut start = 0;
+    while start < contacts.len() {
+        let ci = contacts[start].collider;
+        let mut end = start;
+        while end < contacts.len() && contacts[end].collider == ci {
+            end += 1;
+        }
+        let group = &mut contacts[start..end];
+        start = end;
+        let mut n = Vector3::zeros();
+        let mut q = Vector3::zeros();
+        let mut count = 0usize;
+        let mut e = 0.0f32;
+        for c in group.iter().filter(|c| c.active && c.solve) {
+            n += c.normal;
+            q += c.point;
+            count += 1;
+            e = e.max(c.restitution);
+        }
+        let len = n.norm();
+        if count == 0 || len.is_nan() || len <= 1e-6 {
+            continue;
+        }
+        let n = n / len;
+        let q = q / count as f32;
+        let cp = &colliders[ci];
+        let vb = cp
+            .body
+            .map_or(Vector3::zeros(), |b| bodies[b].velocity_at(&q));
+        let key = (entity.to_bits().get(), collider_key(cp.handle));
+        let k = match episodes.binary_search_by(|ep| ep.key.cmp(&key)) {
+            Ok(k) => k,
+            Err(k) => {
+                let approach = n.dot(&(v_cm_pre - vb));
+                episodes.insert(
+                    k,
+                    Episode {
+                        key,
+                        approach,
+                        compressing: approach < -threshold,
+                        seen: false,
+                    },
+                );
+                k
+            }
+        };
+        let ep = &mut episodes[k];
+        ep.seen = true;
+        if ep.approach >= -threshold {
+            continue;
+        }
+        let v_n = n.dot(&(v_cm - vb));
+        let target = -e * ep.approach;
+        let dv = if ep.compressing {
+            if v_n < 0.0 {
+                continue;
+            }
+            ep.compressing = false;
+            target - v_n
+        } else if v_n > target {
+            target - v_n
+        } else {
+            continue;
+        };
+        let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_at(&q, &n));
+        let j = dv / (1.0 / mass + w_b);
+        if !j.is_finite() {
+            continue;
+        }
+        let dv_soft = n * (j / mass);
+        for i in 0..p.len() {
+            if p.inv_masses()[i] > 0.0 {
+                p.velocities_mut()[i] += dv_soft;
+            }
+        }
+        if let Some(b) = cp.body {
+            bodies[b].apply_velocity_impulse(&(-n * j), &q);
+        }
+        let share = n * (j / count as f32);
+        for c in group.iter_mut().filter(|c| c.active && c.solve) {
+            c.impulse += share;
+        }
+    }
+}
+
+/// Drops the episodes of pairs with no active contact this substep; clears the marks.
+pub(crate) fn end_episodes(episodes: &mut Vec<Episode>) {
+    episodes.retain(|ep| ep.seen);
+    for ep in episodes.iter_mut() {
+        ep.seen = false;
+    }
+}
+
+fn collider_key(h: ColliderHandle) -> (u32, u32) {
+    h.into_raw_parts()
+}
