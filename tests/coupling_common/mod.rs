@@ -12,10 +12,11 @@ use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider};
 
 /// A scene at 60 Hz with `substeps` soft substeps.
 pub fn scene(substeps: u32) -> CoupledWorld {
-    let iterations = std::env::var("ITERS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(1);
+    scene_with(substeps, 1)
+}
+
+/// A scene at 60 Hz with `substeps` soft substeps of `iterations` iterations.
+pub fn scene_with(substeps: u32, iterations: u32) -> CoupledWorld {
     let solver = SolverSettings {
         substeps,
         iterations,
@@ -41,9 +42,21 @@ pub fn soft_box(
     at: Vector3<f32>,
     collider: SoftCollider,
 ) -> Entity {
+    soft_box_with_density(scene, size, cells, at, 1000.0, collider)
+}
+
+/// [`soft_box`] with a density in kg/m³.
+pub fn soft_box_with_density(
+    scene: &mut CoupledWorld,
+    size: Vector3<f32>,
+    cells: [u32; 3],
+    at: Vector3<f32>,
+    density: f32,
+    collider: SoftCollider,
+) -> Entity {
     let mesh = generators::box_grid(size, cells, CellSplit::Six).expect("mesh");
     let body = SoftBodyBuilder::new(mesh)
-        .density(1000.0)
+        .density(density)
         .edges(0.0)
         .volume(0.0)
         .translation(at)

@@ -1,12 +1,19 @@
 //! Rigid bodies inside the soft substeps: one proxy per body a soft body touches.
 //!
-//! rapier has already advanced every body from its start pose `P₀` to its end pose `P₁`
-//! when the soft substeps run. Inside substep `k` a body stands at the interpolation of
-//! `P₀ → P₁` at `t = (k+1)·h`, composed with an *offset* that the soft contacts and
-//! attachments build up: a centre-of-mass translation `dx` and a rotation `dq`, each moving on
-//! with its own velocity (`dv`, `dω`), exactly as XPBD integrates a rigid body (Müller et al.
-//! 2020). With no soft interaction the offset stays zero and the body ends at `P₁` bit for
-//! bit. Fixed and kinematic bodies never get an offset (infinite mass).
+//! rapier has already advanced every body from its start pose `P₀` (velocity `v₀`) to its
+//! end pose `P₁` (velocity `v₁`) when the soft substeps run. Inside substep `k`, at
+//! `t = (k+1)·h`, a body stands at its *base* pose composed with an *offset* that the soft
+//! contacts and attachments build up: a centre-of-mass translation `dx` and a rotation `dq`,
+//! each moving on with its own velocity (`dv`, `dω`), as XPBD integrates a rigid body (Müller
+//! et al. 2020). Fixed and kinematic bodies never get an offset (infinite mass).
+//!
+//! The base of a kinematic body is the linear interpolation `P₀ → P₁`. The base of a
+//! dynamic body spreads rapier's velocity change `v₁ − v₀` (gravity, rigid contacts,
+//! joints) evenly over the frame: `c(t) = c₀ + v₀t + ½(v₁ − v₀)t²/dt`, rotation
+//! interpolated. A heavy body resting on a soft one is then pushed by its weight a little
+//! every substep instead of hitting the soft body with a frame's worth of gravity at once.
+//! Its end position is `c₀ + ½(v₀ + v₁)dt` (plus offset) instead of rapier's `c₀ + v₁dt`;
+//! only bodies a soft body actually touched are written back.
 
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
@@ -31,10 +38,11 @@ pub(crate) struct BodyProxy {
     com_end: Vector3<f32>,
     rot_start: UnitQuaternion<f32>,
     rot_end: UnitQuaternion<f32>,
-    v_base: Vector3<f32>,
+    v_start: Vector3<f32>,
     w_base: Vector3<f32>,
     v_end: Vector3<f32>,
     w_end: Vector3<f32>,
+    dt: f32,
     inv_mass: Vector3<f32>,
     inv_inertia: Matrix3<f32>,
     dx: Vector3<f32>,
@@ -54,7 +62,12 @@ pub(crate) struct BodyProxy {
 
 impl BodyProxy {
     /// A proxy of `body`, whose pose before rapier's step was `start` (m, rad).
-    pub fn new(handle: RigidBodyHandle, body: &RigidBody, start: Isometry3<f32>, dt: f32) -> Self {
+    pub fn new(
+        handle: RigidBodyHandle,
+        body: &RigidBody,
+        (start, v_start): (Isometry3<f32>, Vector3<f32>),
+        dt: f32,
+    ) -> Self {
         let kind = if body.is_dynamic() {
             BodyKind::Dynamic
         } else if body.is_kinematic() {
@@ -67,13 +80,22 @@ impl BodyProxy {
         let com_local = to_na(body.local_center_of_mass());
         let com_start = start * nalgebra::Point3::from(com_local);
         let com_end = end * nalgebra::Point3::from(com_local);
-        let (v_base, w_base) = if kind == BodyKind::Fixed {
-            (Vector3::zeros(), Vector3::zeros())
-        } else {
-            (
-                (com_end.coords - com_start.coords) / dt,
+        let v_end = to_na(body.linvel());
+        let (v_start, v_end_base, w_base) = match kind {
+            BodyKind::Fixed => (Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
+            BodyKind::Kinematic => {
+                let v = (com_end.coords - com_start.coords) / dt;
+                (
+                    v,
+                    v,
+                    (end.rotation * start.rotation.inverse()).scaled_axis() / dt,
+                )
+            }
+            BodyKind::Dynamic => (
+                v_start,
+                v_end,
                 (end.rotation * start.rotation.inverse()).scaled_axis() / dt,
-            )
+            ),
         };
         let (inv_mass, inv_inertia) = if kind == BodyKind::Dynamic {
             let mp = body.mass_properties();
@@ -92,9 +114,10 @@ impl BodyProxy {
             com_end: com_end.coords,
             rot_start: start.rotation,
             rot_end: end.rotation,
-            v_base,
+            v_start,
             w_base,
-            v_end: to_na(body.linvel()),
+            v_end: v_end_base,
+            dt,
             w_end: to_na(body.angvel()),
             inv_mass,
             inv_inertia,
@@ -137,7 +160,11 @@ impl BodyProxy {
             return;
         }
         self.frac = frac;
-        let com = self.com_start.lerp(&self.com_end, frac) + self.dx;
+        let t = frac * self.dt;
+        let com = self.com_start
+            + self.v_start * t
+            + (self.v_end - self.v_start) * (0.5 * t * frac)
+            + self.dx;
         let rot = self.dq * self.rot_start.nlerp(&self.rot_end, frac);
         self.pose = Isometry3::from_parts(Translation3::from(com - rot * self.com_local), rot);
     }
@@ -197,7 +224,8 @@ impl BodyProxy {
             BodyKind::Fixed => Vector3::zeros(),
             _ => {
                 let w = self.w_base + self.dw;
-                self.v_base + self.dv + w.cross(&(q - self.com()))
+                let v_base = self.v_start.lerp(&self.v_end, self.frac);
+                v_base + self.dv + w.cross(&(q - self.com()))
             }
         }
     }

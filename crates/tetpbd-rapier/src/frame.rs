@@ -91,7 +91,7 @@ pub(crate) struct AttachRun {
 /// Everything the coupling keeps for one frame (allocations reused across frames).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Frame {
-    pub start_poses: Vec<((u32, u32), Isometry3<f32>)>,
+    pub start_poses: Vec<((u32, u32), (Isometry3<f32>, Vector3<f32>))>,
     pub soft: Vec<SoftEntry>,
     pub bodies: Vec<BodyProxy>,
     body_index: BTreeMap<(u32, u32), usize>,
@@ -122,13 +122,15 @@ impl Frame {
         self.start_poses.clear();
         for (h, b) in bodies.iter() {
             if !b.is_fixed() {
-                self.start_poses
-                    .push((h.into_raw_parts(), pose_to_na(b.position())));
+                self.start_poses.push((
+                    h.into_raw_parts(),
+                    (pose_to_na(b.position()), crate::convert::to_na(b.linvel())),
+                ));
             }
         }
     }
 
-    fn start_pose(&self, handle: RigidBodyHandle) -> Option<Isometry3<f32>> {
+    fn start_pose(&self, handle: RigidBodyHandle) -> Option<(Isometry3<f32>, Vector3<f32>)> {
         let key = handle.into_raw_parts();
         self.start_poses
             .binary_search_by(|(k, _)| k.cmp(&key))
@@ -143,9 +145,12 @@ impl Frame {
             return Some(i);
         }
         let rb = bodies.get(handle)?;
-        let start = self
-            .start_pose(handle)
-            .unwrap_or_else(|| pose_to_na(rb.position()));
+        let start = self.start_pose(handle).unwrap_or_else(|| {
+            (
+                pose_to_na(rb.position()),
+                crate::convert::to_na(rb.linvel()),
+            )
+        });
         self.bodies.push(BodyProxy::new(handle, rb, start, self.dt));
         self.body_index.insert(key, self.bodies.len() - 1);
         Some(self.bodies.len() - 1)
