@@ -19,6 +19,9 @@ use crate::material::SoftCollider;
 use crate::report::CouplingStats;
 use crate::shape_query::InsideRule;
 
+/// A body's pose (m, rad) and linear velocity (m/s) before rapier's step.
+pub(crate) type StartState = (Isometry3<f32>, Vector3<f32>);
+
 /// A soft body taking part in the frame.
 #[derive(Clone, Debug)]
 pub(crate) struct SoftEntry {
@@ -91,7 +94,7 @@ pub(crate) struct AttachRun {
 /// Everything the coupling keeps for one frame (allocations reused across frames).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Frame {
-    pub start_poses: Vec<((u32, u32), (Isometry3<f32>, Vector3<f32>))>,
+    pub start_poses: Vec<((u32, u32), StartState)>,
     pub soft: Vec<SoftEntry>,
     pub bodies: Vec<BodyProxy>,
     body_index: BTreeMap<(u32, u32), usize>,
@@ -130,7 +133,7 @@ impl Frame {
         }
     }
 
-    fn start_pose(&self, handle: RigidBodyHandle) -> Option<(Isometry3<f32>, Vector3<f32>)> {
+    fn start_pose(&self, handle: RigidBodyHandle) -> Option<StartState> {
         let key = handle.into_raw_parts();
         self.start_poses
             .binary_search_by(|(k, _)| k.cmp(&key))
