@@ -146,7 +146,12 @@ pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
 }
 
 /// One Gauss–Seidel sweep over every body's [`VertexFaceConstraints`], the four
-/// constraints of a tetrahedron one after another. A degenerate face is skipped and counted.
+/// constraints of a tetrahedron one after another.
+///
+/// A degenerate face (collinear or coincident points, no plane) is counted and given a
+/// fallback: `p1` is held at its rest height above `p0` along the face's rest-pose normal.
+/// That constraint is linear in `p0` and `p1`, always defined, and re-expands a tetrahedron
+/// collapsed to a point or a line.
 pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
     let mut count = ProjectionCount::default();
     for (p, tets, vf) in
@@ -169,12 +174,24 @@ pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
                 );
                 let applied = match e {
                     Some(e) => apply(x, r, idx, wi, &e, &mut vf.lambdas[t][k], alpha_tilde),
-                    None => false,
+                    None => {
+                        // Degenerate face: no plane. Fallback (documented, counted): hold p1 at
+                        // the rest height above p0 along the rest face normal, a linear
+                        // constraint in p0 and p1 that re-expands a collapsed tetrahedron.
+                        count.degenerate += 1;
+                        let rest = idx.map(|i| p.rest_positions[i]);
+                        let n = (rest[2] - rest[0]).cross(&(rest[3] - rest[0]));
+                        let n = n / n.norm().max(f32::MIN_POSITIVE);
+                        let e = constraint::Evaluated {
+                            c: (x[idx[1]] - x[idx[0]]).dot(&n) - vf.rest_heights[t][k],
+                            grad: [-n, n, Vector3::zeros(), Vector3::zeros()],
+                        };
+                        apply(x, r, idx, wi, &e, &mut vf.lambdas[t][k], alpha_tilde);
+                        false
+                    }
                 };
                 if applied {
                     count.applied += 1;
-                } else if wi.iter().any(|w| *w > 0.0) {
-                    count.degenerate += 1;
                 }
             }
         }

@@ -1,0 +1,234 @@
+//! Running one scene under one configuration and measuring it.
+
+use nalgebra::Vector3;
+use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, TetMesh, Tetrahedra};
+
+use crate::config::Config;
+
+/// How the body starts, relative to its rest pose.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Start {
+    /// At rest.
+    Rest,
+    /// Mirrored through the plane x = 0: every tetrahedron inverted.
+    Mirrored,
+    /// Flattened onto the plane y = 0.
+    Flattened,
+    /// Every vertex at one point.
+    Collapsed,
+    /// Every vertex at a deterministic pseudo-random point inside a cube of this half size, m.
+    Scrambled(f32),
+    /// One vertex moved by this offset, m.
+    Dragged(u32, Vector3<f32>),
+}
+
+/// One scene: a mesh, how it starts, and how it is stepped.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The mesh.
+    pub mesh: TetMesh,
+    /// Pinned vertices.
+    pub pinned: Vec<u32>,
+    /// The initial state.
+    pub start: Start,
+    /// Solver settings (frame dt, substeps, gravity, safety net).
+    pub settings: SolverSettings,
+    /// Frames to run.
+    pub frames: usize,
+    /// Multiplies the soft compliances (1 = the configuration's own).
+    pub compliance_scale: f32,
+    /// Relative volume epsilon of the builder.
+    pub epsilon: f32,
+    /// The case demands recovery: no inverted tetrahedron and volume within 1 % at the end.
+    pub require_recovery: bool,
+    /// The body falls freely for the whole run: the reference energy is `½M(g t)²`.
+    pub free_fall: bool,
+}
+
+impl Scene {
+    /// A scene with default settings: 60 frames of 1/60 s, 10 substeps, gravity, no safety net.
+    pub fn new(mesh: TetMesh) -> Scene {
+        Scene {
+            mesh,
+            pinned: Vec::new(),
+            start: Start::Rest,
+            settings: SolverSettings::default(),
+            frames: 60,
+            compliance_scale: 1.0,
+            epsilon: SoftBodyBuilder::DEFAULT_EPSILON,
+            require_recovery: false,
+            free_fall: false,
+        }
+    }
+}
+
+/// What one run measured.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Outcome {
+    /// The builder's error, if the mesh was rejected (a clean outcome, not a failure).
+    pub build_error: Option<String>,
+    /// The solver's settings error, if rejected.
+    pub settings_error: Option<String>,
+    /// Every position and velocity finite at every frame.
+    pub finite: bool,
+    /// Non-finite resets the solver's safety net made.
+    pub non_finite_resets: u64,
+    /// Velocity clamps the correction-speed safety net made.
+    pub velocity_clamps: u64,
+    /// Peak kinetic energy over the run divided by the reference energy
+    /// `max(KE₀, M·9.81 m/s²·L, ½M(g t)² for free fall)`, with L the rest bounding-box diagonal.
+    pub peak_ke_ratio: f32,
+    /// First frame with no inverted tetrahedron and total volume within 1 % of rest.
+    pub recovered_at: Option<usize>,
+    /// Inverted tetrahedra at the end.
+    pub final_inverted: usize,
+    /// |total volume / rest − 1| at the end.
+    pub final_volume_error: f32,
+    /// Final max |C| per family (edge m, vertex–face m, volume m³), where present.
+    pub final_max_c: [Option<f32>; 3],
+    /// Largest particle speed at the end, m/s.
+    pub final_max_speed: f32,
+    /// Kinetic energy at the end divided by the reference energy.
+    pub final_ke_ratio: f32,
+    /// Whether the case demanded recovery.
+    pub require_recovery: bool,
+}
+
+impl Outcome {
+    /// Energy bound: the peak kinetic energy may not exceed this multiple of the reference.
+    pub const ENERGY_BOUND: f32 = 10.0;
+
+    /// Finite throughout with no non-finite reset and no inverted tetrahedron at the end; then
+    /// for a body started at rest, peak kinetic energy ≤ [`Self::ENERGY_BOUND`] × the
+    /// reference; for a body released from a deformed state (whose hard constraints hold no
+    /// defined energy), recovered at the end and its kinetic energy decayed to ≤ 10 % of its
+    /// peak. A mesh the builder rejected with a typed error passes (a clean outcome).
+    pub fn pass(&self) -> bool {
+        if self.build_error.is_some() || self.settings_error.is_some() {
+            return true;
+        }
+        let base = self.finite && self.non_finite_resets == 0 && self.final_inverted == 0;
+        if self.require_recovery {
+            base && self.final_volume_error < 0.01
+                && self.final_ke_ratio <= 0.1 * self.peak_ke_ratio.max(1e-12)
+        } else {
+            base && self.peak_ke_ratio <= Self::ENERGY_BOUND
+        }
+    }
+}
+
+fn hash_unit(mut s: u64) -> f32 {
+    s ^= s >> 33;
+    s = s.wrapping_mul(0xff51_afd7_ed55_8ccd);
+    s ^= s >> 33;
+    s = s.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    s ^= s >> 33;
+    (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+}
+
+/// Runs `scene` under `config`.
+pub fn run_scene(scene: &Scene, config: &Config) -> Outcome {
+    let mut out = Outcome {
+        finite: true,
+        require_recovery: scene.require_recovery,
+        ..Outcome::default()
+    };
+    let builder = SoftBodyBuilder::new(scene.mesh.clone())
+        .density(1000.0)
+        .pinned(scene.pinned.iter().copied())
+        .volume_epsilon(scene.epsilon);
+    let body = match config.apply(builder, scene.compliance_scale).build() {
+        Ok(b) => b,
+        Err(e) => {
+            out.build_error = Some(e.to_string());
+            return out;
+        }
+    };
+    let mut solver = match Solver::new(scene.settings.clone()) {
+        Ok(s) => s,
+        Err(e) => {
+            out.settings_error = Some(e.to_string());
+            return out;
+        }
+    };
+    solver.settings.measure_error = true;
+    let (lo, hi) = body.particles.aabb();
+    let size = (hi - lo).norm().max(1e-9);
+    let mass = body.particles.total_mass();
+    let mut world = hecs::World::new();
+    let e = body.spawn(&mut world);
+    {
+        let Ok(mut p) = world.get::<&mut Particles>(e) else {
+            return out;
+        };
+        let centre = (lo + hi) / 2.0;
+        for i in 0..p.len() {
+            let x = p.positions()[i];
+            let y = match &scene.start {
+                Start::Rest => x,
+                Start::Mirrored => Vector3::new(2.0 * centre.x - x.x, x.y, x.z),
+                Start::Flattened => Vector3::new(x.x, centre.y, x.z),
+                Start::Collapsed => centre,
+                Start::Scrambled(half) => {
+                    let s = i as u64 * 3;
+                    centre + Vector3::new(hash_unit(s), hash_unit(s + 1), hash_unit(s + 2)) * *half
+                }
+                Start::Dragged(v, offset) if *v as usize == i => x + offset,
+                Start::Dragged(..) => x,
+            };
+            if p.set_position(i, y).is_err() {
+                out.finite = false;
+                return out;
+            }
+        }
+    }
+    let ke0 = world
+        .get::<&Particles>(e)
+        .map_or(0.0, |p| p.kinetic_energy());
+    let g = scene.settings.gravity.norm();
+    let t_end = scene.frames as f32 * scene.settings.dt;
+    let mut reference = ke0.max(mass * 9.81 * size);
+    if scene.free_fall {
+        reference = reference.max(0.5 * mass * (g * t_end).powi(2));
+    }
+    let mut peak = 0.0f32;
+    for frame in 1..=scene.frames {
+        let stats = match solver.step(&mut world) {
+            Ok(s) => s,
+            Err(err) => {
+                out.settings_error = Some(err.to_string());
+                return out;
+            }
+        };
+        out.non_finite_resets += stats.non_finite_resets;
+        out.velocity_clamps += stats.velocity_clamps;
+        let (Ok(p), Ok(t)) = (world.get::<&Particles>(e), world.get::<&Tetrahedra>(e)) else {
+            return out;
+        };
+        let finite = p
+            .positions()
+            .iter()
+            .chain(p.velocities())
+            .all(|x| x.iter().all(|c| c.is_finite()));
+        out.finite &= finite;
+        peak = peak.max(p.kinetic_energy());
+        out.final_inverted = stats.inverted.unwrap_or(0);
+        out.final_volume_error = (t.volume_ratio(p.positions()) - 1.0).abs();
+        if out.recovered_at.is_none() && out.final_inverted == 0 && out.final_volume_error < 0.01 {
+            out.recovered_at = Some(frame);
+        }
+        let max = |s: &tetpbd::FamilyStats| (s.count > 0).then(|| s.after.map_or(0.0, |e| e.max));
+        out.final_max_c = [
+            max(&stats.edge),
+            max(&stats.vertex_face),
+            max(&stats.volume),
+        ];
+        out.final_max_speed = p.max_speed();
+    }
+    out.peak_ke_ratio = peak / reference;
+    out.final_ke_ratio = world
+        .get::<&Particles>(e)
+        .map_or(f32::INFINITY, |p| p.kinetic_energy())
+        / reference;
+    out
+}

@@ -1,0 +1,116 @@
+//! The stability suite's bounds, asserted. `docs/stability.md` shows the whole matrix,
+//! including the cells that still fail (slivers; the vertex–face family alone from released
+//! deformations).
+
+use tetpbd_stability::{all_cases, run_scene, CaseKind, Config, ConstraintSet, Outcome};
+
+fn fast_cases(net: Option<f32>) -> Vec<tetpbd_stability::Case> {
+    all_cases(net)
+        .into_iter()
+        .filter(|c| c.kind == CaseKind::Fast)
+        .collect()
+}
+
+fn describe(case: &tetpbd_stability::Case, config: &Config, o: &Outcome) -> String {
+    format!(
+        "{} / {} under {}: {o:?}",
+        case.group,
+        case.name,
+        config.label()
+    )
+}
+
+/// Never NaN, never a non-finite reset, whatever the case and configuration.
+fn assert_finite(net: Option<f32>) {
+    for case in fast_cases(net) {
+        for config in Config::all() {
+            let o = run_scene(&case.scene, &config);
+            assert!(
+                o.finite && o.non_finite_resets == 0,
+                "{}",
+                describe(&case, &config, &o)
+            );
+        }
+    }
+}
+
+#[test]
+fn every_fast_case_stays_finite_without_safety_net() {
+    assert_finite(None);
+}
+
+#[test]
+fn every_fast_case_stays_finite_with_safety_net() {
+    assert_finite(Some(10.0));
+}
+
+/// The configurations that pass every fast case but the sliver plate.
+#[test]
+fn hard_edges_volume_and_vertex_face_edges_pass_every_fast_case_but_slivers() {
+    let configs = [
+        Config {
+            set: ConstraintSet::EdgesVolume,
+            soft: false,
+        },
+        Config {
+            set: ConstraintSet::VertexFaceEdges,
+            soft: false,
+        },
+    ];
+    for case in fast_cases(None) {
+        if case.name.starts_with("slivers") {
+            continue;
+        }
+        for config in &configs {
+            let o = run_scene(&case.scene, config);
+            assert!(o.pass(), "{}", describe(&case, config, &o));
+        }
+    }
+}
+
+#[test]
+fn soft_edges_volume_passes_every_fast_case() {
+    let config = Config {
+        set: ConstraintSet::EdgesVolume,
+        soft: true,
+    };
+    for case in fast_cases(None) {
+        let o = run_scene(&case.scene, &config);
+        assert!(o.pass(), "{}", describe(&case, &config, &o));
+    }
+}
+
+#[test]
+fn collapsed_vertex_face_body_recovers_with_the_degenerate_fallback() {
+    let config = Config {
+        set: ConstraintSet::VertexFace,
+        soft: false,
+    };
+    let case = all_cases(Some(10.0))
+        .into_iter()
+        .find(|c| c.name == "collapsed to a point")
+        .expect("case exists");
+    let o = run_scene(&case.scene, &config);
+    assert!(o.pass() && o.recovered_at.is_some(), "{o:?}");
+}
+
+#[test]
+#[ignore = "long: run in release by .ci/run"]
+fn long_cases_pass_with_hard_edges_and_volume() {
+    let config = Config {
+        set: ConstraintSet::EdgesVolume,
+        soft: false,
+    };
+    for case in all_cases(None)
+        .into_iter()
+        .filter(|c| c.kind == CaseKind::Long)
+    {
+        let o = run_scene(&case.scene, &config);
+        assert!(o.pass(), "{}", describe(&case, &config, &o));
+        assert!(
+            o.final_max_speed < 1e-3,
+            "resting speed {} m/s",
+            o.final_max_speed
+        );
+    }
+}
