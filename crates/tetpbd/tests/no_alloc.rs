@@ -1,0 +1,81 @@
+//! A step allocates nothing once the scene has run its first frame.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use nalgebra::Vector3;
+use tetpbd::generators::{ball, box_grid, CellSplit};
+use tetpbd::{SoftBodyBuilder, Solver, SolverSettings};
+
+/// Counts allocations made by the current thread (tests run on several threads).
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+// SAFETY: forwards every call to the system allocator unchanged; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as ours.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as ours.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as ours.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations() -> u64 {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+#[test]
+fn the_counter_counts() {
+    let before = allocations();
+    std::hint::black_box(vec![1u8; 16]);
+    assert_eq!(allocations() - before, 1);
+}
+
+#[test]
+fn steps_after_the_first_allocate_nothing() {
+    let mut world = hecs::World::new();
+    SoftBodyBuilder::new(box_grid(Vector3::new(1.0, 1.0, 1.0), [3, 3, 3], CellSplit::Six).unwrap())
+        .edges(0.0)
+        .volume(0.0)
+        .build()
+        .unwrap()
+        .spawn(&mut world);
+    SoftBodyBuilder::new(ball(0.5, 3, CellSplit::Five).unwrap())
+        .vertex_face(1e-6)
+        .translation(Vector3::new(3.0, 0.0, 0.0))
+        .build()
+        .unwrap()
+        .spawn(&mut world);
+    for measure in [false, true] {
+        let mut solver = Solver::new(SolverSettings {
+            measure_error: measure,
+            measure_before: measure,
+            max_correction_speed: Some(10.0),
+            ..Default::default()
+        })
+        .unwrap();
+        solver.step(&mut world).unwrap();
+        let before = allocations();
+        for _ in 0..10 {
+            solver.step(&mut world).unwrap();
+        }
+        assert_eq!(allocations() - before, 0, "measure_error = {measure}");
+    }
+}
