@@ -12,7 +12,7 @@ use crate::engines::Model;
 use crate::report::Row;
 use crate::scenes::{Scene, SceneKind};
 
-const FONT: &[u8] = include_bytes!("../../../assets/DejaVuSans-subset.ttf");
+pub const FONT: &[u8] = include_bytes!("../../../assets/DejaVuSans-subset.ttf");
 const SIZE: (u32, u32) = (1800, 1150);
 const FLOOR: f64 = 1e-9;
 
@@ -22,6 +22,8 @@ struct Panel {
     title: &'static str,
     metric: fn(&Row) -> f64,
     only_hard: bool,
+    /// Leave out the rows whose reference did not converge (see [`Row::reference_ok`]).
+    needs_reference: bool,
 }
 
 const PANELS: [Panel; 4] = [
@@ -30,29 +32,33 @@ const PANELS: [Panel; 4] = [
         title: "a) hanging beam at rest: max deviation from converged reference / length",
         metric: |r| f64::from(r.dev.max),
         only_hard: false,
+        needs_reference: true,
     },
     Panel {
         kind: SceneKind::HangingBeam,
         title: "a) hanging beam, hard models: RMS edge strain at rest (exact: 0)",
         metric: |r| f64::from(r.edge_strain_rms),
         only_hard: true,
+        needs_reference: false,
     },
     Panel {
         kind: SceneKind::Squash,
         title: "b) squash & release: max deviation from converged reference / size",
         metric: |r| f64::from(r.dev.max),
         only_hard: false,
+        needs_reference: true,
     },
     Panel {
         kind: SceneKind::Squash,
         title: "b) squash & release: max |volume error| %, second half of the run",
         metric: |r| f64::from(r.late_volume_err_pct),
         only_hard: false,
+        needs_reference: false,
     },
 ];
 
 /// The models in plotting order (first appearance in `rows`).
-fn models(rows: &[Row]) -> Vec<Model> {
+pub fn models(rows: &[Row]) -> Vec<Model> {
     let mut m: Vec<Model> = Vec::new();
     for r in rows {
         if !m.contains(&r.model) {
@@ -71,13 +77,16 @@ fn color(model: &Model, k: usize) -> RGBColor {
         RGBColor(90, 210, 200),
         RGBColor(140, 210, 90),
     ];
-    const RAPIER: [RGBColor; 5] = [
+    const RAPIER: [RGBColor; 7] = [
         RGBColor(200, 0, 0),
         RGBColor(240, 120, 0),
         RGBColor(150, 0, 150),
         RGBColor(210, 80, 150),
+        RGBColor(110, 0, 0),
         RGBColor(120, 70, 20),
+        RGBColor(200, 170, 0),
     ];
+
     match model {
         Model::Ours { .. } => OURS[k % OURS.len()],
         Model::Rapier { .. } => RAPIER[k % RAPIER.len()],
@@ -85,7 +94,7 @@ fn color(model: &Model, k: usize) -> RGBColor {
 }
 
 /// Colours by model, ours and rapier counted separately.
-fn palette(models: &[Model]) -> Vec<RGBColor> {
+pub fn palette(models: &[Model]) -> Vec<RGBColor> {
     let (mut o, mut r) = (0, 0);
     models
         .iter()
@@ -141,7 +150,11 @@ fn draw_on<DB: DrawingBackend>(
         };
         let sel: Vec<&Row> = rows
             .iter()
-            .filter(|r| r.scene == scene.name && (!panel.only_hard || r.model.is_hard()))
+            .filter(|r| {
+                r.scene == scene.name
+                    && (!panel.only_hard || r.model.is_hard())
+                    && (!panel.needs_reference || r.reference_ok())
+            })
             .collect();
         draw_panel(area, panel, &sel, &all_models, &colors)?;
     }
@@ -259,6 +272,8 @@ fn draw_legend<DB: DrawingBackend>(
         "error of each model vs its own",
         "   converged reference (see summary)",
         "errors below 1e-9 drawn at 1e-9",
+        "deviation panels leave out models",
+        "   whose reference moved > 1e-3",
     ];
     for n in notes {
         area.draw(&Text::new(n, (10, y), text.clone()))?;

@@ -10,6 +10,10 @@ use crate::engines::Model;
 use crate::metrics::{Deviation, Reference, RunResult};
 use crate::scenes::{Scene, DT};
 
+/// Largest last change (relative to the body size) of a numerical reference whose deviations
+/// are quoted in the headline and drawn in the deviation panels.
+pub const REFERENCE_TOLERANCE: f32 = 1e-3;
+
 /// One run of one configuration, summarised.
 #[derive(Clone, Debug)]
 pub struct Row {
@@ -110,6 +114,13 @@ impl Row {
         }
     }
 
+    /// `true` when the row's reference is exact or changed by at most
+    /// [`REFERENCE_TOLERANCE`] when its substeps were last doubled, so that a deviation from it
+    /// is an error that can be quoted.
+    pub fn reference_ok(&self) -> bool {
+        self.ref_change <= REFERENCE_TOLERANCE
+    }
+
     /// `substeps×iterations`.
     pub fn budget(&self) -> String {
         format!("{}x{}", self.substeps, self.iterations)
@@ -187,14 +198,34 @@ pub fn squash_volume_csv(rows: &[Row], squash: &str) -> String {
     s
 }
 
+/// How the run went, for the summary.
+#[derive(Clone, Debug)]
+pub struct RunInfo {
+    /// `--quick` smoke run.
+    pub quick: bool,
+    /// Wall time of the whole command, s.
+    pub elapsed_s: f64,
+    /// `/proc/loadavg` (1, 5, 15 min) when the sweep started.
+    pub load_start: String,
+    /// `/proc/loadavg` when the sweep ended.
+    pub load_end: String,
+}
+
+/// The 1, 5 and 15 minute load averages, or "unknown".
+pub fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|| "unknown".to_string())
+}
+
 /// Writes every file of the report into `out`.
 pub fn write_all(
     out: &Path,
     scenes: &[Scene],
     rows: &[Row],
     references: &[(&'static str, Model, u32, f32)],
-    quick: bool,
-    elapsed_s: f64,
+    info: &RunInfo,
 ) -> io::Result<()> {
     fs::create_dir_all(out)?;
     fs::write(out.join("results.csv"), results_csv(rows))?;
@@ -208,6 +239,7 @@ pub fn write_all(
         squash_volume_csv(rows, squash),
     )?;
     crate::plot::draw(out, scenes, rows).map_err(io::Error::other)?;
-    let md = crate::summary::markdown(scenes, rows, references, quick, elapsed_s);
+    crate::plot_volume::draw(out, rows, squash).map_err(io::Error::other)?;
+    let md = crate::summary::markdown(scenes, rows, references, info);
     fs::write(out.join("summary.md"), md)
 }

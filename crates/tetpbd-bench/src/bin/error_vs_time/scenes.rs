@@ -144,22 +144,10 @@ impl Scene {
         }
         m
     }
-
-    /// Height (y extent) of the rest mesh, m.
-    pub fn rest_height(&self) -> f32 {
-        height(&self.mesh.vertices)
-    }
 }
 
 /// Signed volume of tetrahedron `t` at `x`, m³.
 pub fn tet_volume(t: &[u32; 4], x: &[Vector3<f32>]) -> f32 {
     let [a, b, c, d] = t.map(|i| x[i as usize]);
     signed_volume(&a, &b, &c, &d)
-}
-
-/// y extent of a point set, m.
-pub fn height(x: &[Vector3<f32>]) -> f32 {
-    let lo = x.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
-    let hi = x.iter().map(|p| p.y).fold(f32::NEG_INFINITY, f32::max);
-    hi - lo
 }

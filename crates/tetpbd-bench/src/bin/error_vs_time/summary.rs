@@ -6,7 +6,7 @@ use std::process::Command;
 
 use crate::engines::Model;
 use crate::pareto::{compare, median, Point};
-use crate::report::Row;
+use crate::report::{Row, RunInfo};
 use crate::scenes::{Scene, SceneKind};
 
 fn command_line(cmd: &str, args: &[&str]) -> Option<String> {
@@ -65,19 +65,24 @@ fn commit() -> String {
 struct Metric {
     name: &'static str,
     f: fn(&Row) -> f64,
+    /// Only rows whose reference converged (see [`Row::reference_ok`]).
+    needs_reference: bool,
 }
 
 const DEV: Metric = Metric {
     name: "max deviation from converged reference (relative to body size)",
     f: |r| f64::from(r.dev.max),
+    needs_reference: true,
 };
 const STRAIN: Metric = Metric {
     name: "RMS edge strain",
     f: |r| f64::from(r.edge_strain_rms),
+    needs_reference: false,
 };
 const LATE_VOLUME: Metric = Metric {
     name: "max |volume error| % over the second half",
     f: |r| f64::from(r.late_volume_err_pct),
+    needs_reference: false,
 };
 
 fn points(rows: &[Row], idx: &[usize], m: &Metric) -> Vec<Point> {
@@ -114,6 +119,7 @@ fn headline(s: &mut String, rows: &[Row], scene: &str, m: &Metric, hard_only: bo
                     && r.model.engine() == engine
                     && r.finite
                     && (!hard_only || r.model.is_hard())
+                    && (!m.needs_reference || r.reference_ok())
             })
             .collect()
     };
@@ -126,7 +132,7 @@ fn headline(s: &mut String, rows: &[Row], scene: &str, m: &Metric, hard_only: bo
     let range = |v: &[f64]| {
         let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        format!("{lo:.2}–{hi:.2}")
+        format!("{}–{}", sig(lo), sig(hi))
     };
     let which = if hard_only {
         "hard models only"
@@ -134,11 +140,32 @@ fn headline(s: &mut String, rows: &[Row], scene: &str, m: &Metric, hard_only: bo
         "all models"
     };
     let _ = writeln!(s, "**{scene}, {which}, error = {}.** ", m.name);
+    if m.needs_reference {
+        let mut out: Vec<String> = Vec::new();
+        for r in rows
+            .iter()
+            .filter(|r| r.scene == scene && !r.reference_ok())
+        {
+            let l = format!("{} ({:.1e})", r.model.label(), r.ref_change);
+            if !out.contains(&l) && (!hard_only || r.model.is_hard()) {
+                out.push(l);
+            }
+        }
+        if !out.is_empty() {
+            let _ = writeln!(
+                s,
+                "Left out because their reference still moved by more than {:e} of the body size when its substeps were doubled: {}. ",
+                crate::report::REFERENCE_TOLERANCE,
+                out.join(", ")
+            );
+        }
+    }
     match median(speed.clone()) {
         Some(x) => {
             let _ = writeln!(
                 s,
-                "At equal error, tetpbd's front is **{x:.2}× faster** than rapier's (median over the {} of {} rapier Pareto points tetpbd reaches; range {}). ",
+                "At equal error, rapier's time / tetpbd's time = **{}** (median over the {} of {} rapier Pareto points that tetpbd reaches; range {}; above 1 tetpbd is faster). ",
+                sig(x),
                 speed.len(),
                 matches.len(),
                 range(&speed)
@@ -156,7 +183,7 @@ fn headline(s: &mut String, rows: &[Row], scene: &str, m: &Metric, hard_only: bo
         Some(x) => {
             let _ = writeln!(
                 s,
-                "At equal time, tetpbd's error is **{}× smaller** (median over the {} of {} rapier Pareto points with a tetpbd run at most as costly; range {}).\n",
+                "At equal time, rapier's error / tetpbd's error = **{}** (median over the {} of {} rapier Pareto points with a tetpbd run at most as costly; range {}; above 1 tetpbd is more accurate).\n",
                 sig(x),
                 gain.len(),
                 matches.len(),
@@ -206,9 +233,9 @@ pub fn markdown(
     scenes: &[Scene],
     rows: &[Row],
     references: &[(&'static str, Model, u32, f32)],
-    quick: bool,
-    elapsed_s: f64,
+    info: &RunInfo,
 ) -> String {
+    let (quick, elapsed_s) = (info.quick, info.elapsed_s);
     let mut s = String::new();
     let date = command_line("date", &["-u", "+%Y-%m-%d %H:%M UTC"])
         .unwrap_or_else(|| "unknown".to_string());
@@ -220,8 +247,8 @@ pub fn markdown(
     if quick {
         let _ = writeln!(s, "**This is a `--quick` smoke run: fewer models, budgets, frames and a cheaper reference. Do not quote it.**\n");
     }
-    let _ = writeln!(s, "- Machine: {}\n- Date: {date}\n- Commit: {}\n- Every run single-threaded, one after the other (tetpbd has no parallel solver yet; rapier built without its `parallel` feature).\n", machine(), commit());
-    let _ = writeln!(s, "![error vs time](plot.png)\n\nData: [results.csv](results.csv) (one row per run), [squash_volume.csv](squash_volume.csv) (volume error per frame of every squash run).\n");
+    let _ = writeln!(s, "- Machine: {}\n- Date: {date}\n- Commit: {}\n- Load average (1/5/15 min) at start: {}, at end: {} (the machine is shared; a load above 1 on 2 cores inflates the times of both engines alike).\n- Every run single-threaded, one after the other (tetpbd has no parallel solver yet; rapier built without its `parallel` feature).\n", machine(), commit(), info.load_start, info.load_end);
+    let _ = writeln!(s, "![error vs time](plot.png)\n\nData: [results.csv](results.csv) (one row per run), [squash_volume.csv](squash_volume.csv) (volume error per frame of every squash run), drawn for one budget in [squash_volume.png](squash_volume.png).\n");
     let _ = writeln!(s, "## Headline (Pareto fronts)\n");
     let _ = writeln!(s, "Each engine's Pareto front is the set of its runs that no other run of the same engine beats in both median ms per frame and error. At each rapier front point we take tetpbd's cheapest run with an error at most rapier's (equal error) and tetpbd's most accurate run costing at most rapier's (equal time).\n");
     for scene in scenes {
