@@ -253,7 +253,7 @@ impl SoftBodyBuilder {
             .collect();
         let surface = Surface::from_tetrahedra(&mesh.tets, &mesh.vertices);
         // Solver order for tetrahedra and edges (see `ordering`); `source` maps back.
-        let order = colour_order(&mesh.tets, n);
+        let (order, tet_classes) = colour_order(&mesh.tets, n);
         let tets: Vec<[u32; 4]> = order.iter().map(|&t| mesh.tets[t]).collect();
         let rest_volumes: Vec<f32> = order.iter().map(|&t| rest_volumes[t]).collect();
         let source: Vec<u32> = order.iter().map(|&t| t as u32).collect();
@@ -263,10 +263,8 @@ impl SoftBodyBuilder {
         };
         let edges = edge.map(|alpha| {
             let sorted = unique_edges(&mesh.tets);
-            let list: Vec<[u32; 2]> = colour_order(&sorted, n)
-                .iter()
-                .map(|&k| sorted[k])
-                .collect();
+            let (edge_order, classes) = colour_order(&sorted, n);
+            let list: Vec<[u32; 2]> = edge_order.iter().map(|&k| sorted[k]).collect();
             let rest_lengths = list
                 .iter()
                 .map(|[a, b]| (mesh.vertices[*a as usize] - mesh.vertices[*b as usize]).norm())
@@ -276,6 +274,7 @@ impl SoftBodyBuilder {
                 edges: list,
                 rest_lengths,
                 compliance: alpha,
+                classes,
             }
         });
         let vertex_face = vertex_face.map(|alpha| VertexFaceConstraints {
@@ -311,6 +310,7 @@ impl SoftBodyBuilder {
                 indices: mesh.tets,
                 rest_volumes,
                 source,
+                classes: tet_classes,
             },
             surface,
             edges,

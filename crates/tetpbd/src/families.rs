@@ -16,6 +16,8 @@ pub struct EdgeConstraints {
     pub(crate) lambdas: Vec<f32>,
     /// Compliance α, m/N (inverse stiffness; 0 = rigid). Must be finite and ≥ 0.
     pub(crate) compliance: f32,
+    /// Colour classes of `edges` (edges of one class share no particle).
+    pub(crate) classes: crate::ordering::ColourClasses,
 }
 
 /// Vertex–face constraints: four per tetrahedron, each vertex held at its signed rest height

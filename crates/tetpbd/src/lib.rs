@@ -32,7 +32,10 @@ mod families;
 pub mod generators;
 mod mesh;
 pub mod ordering;
+#[cfg(feature = "parallel")]
+mod parallel;
 mod particles;
+mod projection;
 mod solver;
 mod stats;
 pub mod systems;

@@ -20,6 +20,8 @@ pub struct Tetrahedra {
     pub(crate) indices: Vec<[u32; 4]>,
     pub(crate) rest_volumes: Vec<f32>,
     pub(crate) source: Vec<u32>,
+    /// Colour classes of `indices` (tetrahedra of one class share no particle).
+    pub(crate) classes: crate::ordering::ColourClasses,
 }
 
 impl Tetrahedra {

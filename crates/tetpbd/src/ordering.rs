@@ -26,10 +26,47 @@ pub fn greedy_colours<const N: usize>(items: &[[u32; N]], particles: usize) -> V
         .collect()
 }
 
-/// The permutation that sorts `items` by greedy colour, stable within a colour.
-pub fn colour_order<const N: usize>(items: &[[u32; N]], particles: usize) -> Vec<usize> {
+/// Items sorted into colour classes.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ColourClasses {
+    /// Start of each class in the sorted order, then the total: class `k` is
+    /// `starts[k]..starts[k + 1]`.
+    pub starts: Vec<u32>,
+    /// Whether the last class is the overflow class (colour 63), whose items may share
+    /// particles and must run serially.
+    pub overflow: bool,
+}
+
+impl ColourClasses {
+    /// The classes as ranges, each with `true` when its items are independent.
+    pub fn ranges(&self) -> impl Iterator<Item = (std::ops::Range<usize>, bool)> + '_ {
+        let n = self.starts.len().saturating_sub(1);
+        self.starts
+            .windows(2)
+            .enumerate()
+            .map(move |(k, w)| (w[0] as usize..w[1] as usize, !(self.overflow && k + 1 == n)))
+    }
+}
+
+/// The permutation that sorts `items` by greedy colour (stable within a colour), and the
+/// resulting classes.
+pub fn colour_order<const N: usize>(
+    items: &[[u32; N]],
+    particles: usize,
+) -> (Vec<usize>, ColourClasses) {
     let colours = greedy_colours(items, particles);
     let mut order: Vec<usize> = (0..items.len()).collect();
     order.sort_by_key(|&i| colours[i]);
-    order
+    let mut starts = Vec::new();
+    let mut last = None;
+    for (k, &i) in order.iter().enumerate() {
+        if last != Some(colours[i]) {
+            starts.push(k as u32);
+            last = Some(colours[i]);
+        }
+    }
+    starts.push(items.len() as u32);
+    let overflow = last == Some(63);
+    (order, ColourClasses { starts, overflow })
 }

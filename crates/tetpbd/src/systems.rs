@@ -12,6 +12,7 @@ use crate::constraint::{self, VERTEX_FACE_ORDER};
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::mesh::Tetrahedra;
 use crate::particles::{ExternalAcceleration, Particles};
+use crate::projection::{self, SliceAccess};
 use crate::stats::{ErrorAccumulator, ErrorStats};
 
 /// Projections done and skipped by one call of a family system.
@@ -21,6 +22,24 @@ pub struct ProjectionCount {
     pub applied: u64,
     /// Degenerate configurations skipped or handled by a fallback direction.
     pub degenerate: u64,
+}
+
+impl ProjectionCount {
+    #[inline(always)]
+    pub(crate) fn add(&mut self, o: projection::Outcome) {
+        match o {
+            projection::Outcome::Applied => self.applied += 1,
+            projection::Outcome::Degenerate => self.degenerate += 1,
+            projection::Outcome::Skipped => {}
+        }
+    }
+}
+
+impl std::ops::AddAssign for ProjectionCount {
+    fn add_assign(&mut self, o: ProjectionCount) {
+        self.applied += o.applied;
+        self.degenerate += o.degenerate;
+    }
 }
 
 /// Saves `x` as the substep start, applies gravity plus each body's
@@ -67,34 +86,6 @@ pub fn add_compensated(x: &mut Vector3<f32>, r: &mut Vector3<f32>, d: Vector3<f3
     *x = new;
 }
 
-/// [`constraint::apply`] with compensated position updates ([`add_compensated`]).
-#[inline(always)]
-fn apply<const N: usize>(
-    x: &mut [Vector3<f32>],
-    r: &mut [Vector3<f32>],
-    idx: [usize; N],
-    w: [f32; N],
-    e: &constraint::Evaluated<f32, N>,
-    lambda: &mut f32,
-    alpha_tilde: f32,
-) -> bool {
-    let w_grad_sq: f32 = w
-        .iter()
-        .zip(&e.grad)
-        .map(|(w, g)| w * g.norm_squared())
-        .sum();
-    match constraint::xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
-        Some(dl) => {
-            *lambda += dl;
-            for k in 0..N {
-                add_compensated(&mut x[idx[k]], &mut r[idx[k]], e.grad[k] * (w[k] * dl));
-            }
-            true
-        }
-        None => false,
-    }
-}
-
 /// Sets every multiplier λ to zero (start of a substep).
 pub fn reset_lambdas(world: &mut World) {
     for e in world.query_mut::<&mut EdgeConstraints>() {
@@ -108,45 +99,32 @@ pub fn reset_lambdas(world: &mut World) {
     }
 }
 
-/// One Gauss–Seidel sweep over every body's [`EdgeConstraints`].
+/// One Gauss–Seidel sweep over every body's [`EdgeConstraints`], in solver (colour) order.
 ///
 /// A zero-length edge (`|p0 − p1| < 1e-6 d`) is pushed apart along its rest-pose direction
-/// and counted as degenerate.
+/// and counted as degenerate. With the `parallel` feature, the edges of one colour class
+/// (which share no particle) are projected concurrently; the result is bit-identical to the
+/// serial sweep.
 pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
     let mut count = ProjectionCount::default();
     for (p, e) in world.query_mut::<(&mut Particles, &mut EdgeConstraints)>() {
         let alpha_tilde = e.compliance / (h * h);
-        let x = &mut p.positions;
-        let r = &mut p.residuals;
-        let w = &p.inv_masses;
-        let rest = &p.rest_positions;
+        #[cfg(feature = "parallel")]
+        if e.edges.len() >= crate::parallel::MIN_PARALLEL {
+            count += crate::parallel::edges(p, e, alpha_tilde);
+            continue;
+        }
+        let mut acc = access(p);
         let edges = e.edges.iter().zip(&e.rest_lengths).zip(&mut e.lambdas);
-        for ((&[a, b], &d), lambda) in edges {
-            let (a, b) = (a as usize, b as usize);
-            let delta = x[a] - x[b];
-            let len = delta.norm();
-            let n = if len > 1e-6 * d {
-                delta * (1.0 / len)
-            } else {
-                count.degenerate += 1;
-                (rest[a] - rest[b]) * (1.0 / d)
-            };
-            let (wa, wb) = (w[a], w[b]);
-            let Some(dl) = constraint::xpbd_delta_lambda(len - d, *lambda, alpha_tilde, wa + wb)
-            else {
-                continue;
-            };
-            *lambda += dl;
-            add_compensated(&mut x[a], &mut r[a], n * (wa * dl));
-            add_compensated(&mut x[b], &mut r[b], n * (-wb * dl));
-            count.applied += 1;
+        for ((&edge, &d), lambda) in edges {
+            count.add(projection::edge(&mut acc, edge, d, lambda, alpha_tilde));
         }
     }
     count
 }
 
-/// One Gauss–Seidel sweep over every body's [`VertexFaceConstraints`], the four
-/// constraints of a tetrahedron one after another.
+/// One Gauss–Seidel sweep over every body's [`VertexFaceConstraints`]: the four constraints
+/// of a tetrahedron one after another, tetrahedra in solver (colour) order.
 ///
 /// A degenerate face (collinear or coincident points, no plane) is counted and given a
 /// fallback: `p1` is held at its rest height above `p0` along the face's rest-pose normal.
@@ -158,75 +136,59 @@ pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
         world.query_mut::<(&mut Particles, &Tetrahedra, &mut VertexFaceConstraints)>()
     {
         let alpha_tilde = vf.compliance / (h * h);
-        let x = &mut p.positions;
-        let r = &mut p.residuals;
-        let w = &p.inv_masses;
-        for (t, tet) in tets.indices.iter().enumerate() {
-            for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
-                let idx = order.map(|o| tet[o] as usize);
-                let wi = idx.map(|i| w[i]);
-                let e = constraint::vertex_face(
-                    &x[idx[0]],
-                    &x[idx[1]],
-                    &x[idx[2]],
-                    &x[idx[3]],
-                    vf.rest_heights[t][k],
-                );
-                let applied = match e {
-                    Some(e) => apply(x, r, idx, wi, &e, &mut vf.lambdas[t][k], alpha_tilde),
-                    None => {
-                        // Degenerate face: no plane. Fallback (documented, counted): hold p1 at
-                        // the rest height above p0 along the rest face normal, a linear
-                        // constraint in p0 and p1 that re-expands a collapsed tetrahedron.
-                        count.degenerate += 1;
-                        let rest = idx.map(|i| p.rest_positions[i]);
-                        let n = (rest[2] - rest[0]).cross(&(rest[3] - rest[0]));
-                        let n = n / n.norm().max(f32::MIN_POSITIVE);
-                        let e = constraint::Evaluated {
-                            c: (x[idx[1]] - x[idx[0]]).dot(&n) - vf.rest_heights[t][k],
-                            grad: [-n, n, Vector3::zeros(), Vector3::zeros()],
-                        };
-                        apply(x, r, idx, wi, &e, &mut vf.lambdas[t][k], alpha_tilde);
-                        false
-                    }
-                };
-                if applied {
-                    count.applied += 1;
-                }
-            }
+        #[cfg(feature = "parallel")]
+        if tets.len() >= crate::parallel::MIN_PARALLEL {
+            count += crate::parallel::vertex_face(p, tets, vf, alpha_tilde);
+            continue;
+        }
+        let mut acc = access(p);
+        let items = tets
+            .indices
+            .iter()
+            .zip(&vf.rest_heights)
+            .zip(&mut vf.lambdas);
+        for ((&tet, heights), lambdas) in items {
+            let (a, d) = projection::vertex_face(&mut acc, tet, heights, lambdas, alpha_tilde);
+            count.applied += u64::from(a);
+            count.degenerate += u64::from(d);
         }
     }
     count
 }
 
-/// One Gauss–Seidel sweep over every body's [`VolumeConstraints`]. A tetrahedron whose
-/// gradients vanish (all four points collinear) is skipped and counted.
+/// One Gauss–Seidel sweep over every body's [`VolumeConstraints`], in solver (colour)
+/// order. A tetrahedron whose gradients vanish (all four points collinear) is skipped and
+/// counted.
 pub fn project_volume(world: &mut World, h: f32) -> ProjectionCount {
     let mut count = ProjectionCount::default();
     for (p, tets, vol) in world.query_mut::<(&mut Particles, &Tetrahedra, &mut VolumeConstraints)>()
     {
         let alpha_tilde = vol.compliance / (h * h);
-        let x = &mut p.positions;
-        let r = &mut p.residuals;
-        let w = &p.inv_masses;
-        for (t, tet) in tets.indices.iter().enumerate() {
-            let idx = tet.map(|i| i as usize);
-            let wi = idx.map(|i| w[i]);
-            let e = constraint::volume(
-                &x[idx[0]],
-                &x[idx[1]],
-                &x[idx[2]],
-                &x[idx[3]],
-                tets.rest_volumes[t],
-            );
-            if apply(x, r, idx, wi, &e, &mut vol.lambdas[t], alpha_tilde) {
-                count.applied += 1;
-            } else if wi.iter().any(|w| *w > 0.0) {
-                count.degenerate += 1;
-            }
+        #[cfg(feature = "parallel")]
+        if tets.len() >= crate::parallel::MIN_PARALLEL {
+            count += crate::parallel::volume(p, tets, vol, alpha_tilde);
+            continue;
+        }
+        let mut acc = access(p);
+        let items = tets
+            .indices
+            .iter()
+            .zip(&tets.rest_volumes)
+            .zip(&mut vol.lambdas);
+        for ((&tet, &v), lambda) in items {
+            count.add(projection::volume(&mut acc, tet, v, lambda, alpha_tilde));
         }
     }
     count
+}
+
+fn access(p: &mut Particles) -> SliceAccess<'_> {
+    SliceAccess {
+        x: &mut p.positions,
+        r: &mut p.residuals,
+        w: &p.inv_masses,
+        rest: &p.rest_positions,
+    }
 }
 
 /// What [`update_velocities`] did besides the plain update.

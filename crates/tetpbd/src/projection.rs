@@ -1,0 +1,172 @@
+//! One projection of one constraint, written once and run by both the serial and the
+//! parallel sweeps through a [`ParticleAccess`].
+
+use nalgebra::Vector3;
+
+use crate::constraint::{self, Evaluated, VERTEX_FACE_ORDER};
+
+/// How a projection reads and moves particles.
+pub(crate) trait ParticleAccess {
+    /// Position of particle `i`.
+    fn x(&self, i: usize) -> Vector3<f32>;
+    /// Inverse mass of particle `i`.
+    fn w(&self, i: usize) -> f32;
+    /// Rest position of particle `i`.
+    fn rest(&self, i: usize) -> Vector3<f32>;
+    /// Moves particle `i` by `d` (compensated, see [`crate::systems::add_compensated`]).
+    fn add(&mut self, i: usize, d: Vector3<f32>);
+}
+
+/// Serial access through the body's own slices.
+pub(crate) struct SliceAccess<'a> {
+    pub x: &'a mut [Vector3<f32>],
+    pub r: &'a mut [Vector3<f32>],
+    pub w: &'a [f32],
+    pub rest: &'a [Vector3<f32>],
+}
+
+impl ParticleAccess for SliceAccess<'_> {
+    #[inline(always)]
+    fn x(&self, i: usize) -> Vector3<f32> {
+        self.x[i]
+    }
+    #[inline(always)]
+    fn w(&self, i: usize) -> f32 {
+        self.w[i]
+    }
+    #[inline(always)]
+    fn rest(&self, i: usize) -> Vector3<f32> {
+        self.rest[i]
+    }
+    #[inline(always)]
+    fn add(&mut self, i: usize, d: Vector3<f32>) {
+        crate::systems::add_compensated(&mut self.x[i], &mut self.r[i], d);
+    }
+}
+
+/// What one projection did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Outcome {
+    Applied,
+    /// Degenerate: skipped, or projected along the documented fallback direction.
+    Degenerate,
+    /// Nothing to do (all particles pinned with α = 0).
+    Skipped,
+}
+
+#[inline(always)]
+fn apply<A: ParticleAccess, const N: usize>(
+    a: &mut A,
+    idx: [usize; N],
+    e: &Evaluated<f32, N>,
+    lambda: &mut f32,
+    alpha_tilde: f32,
+) -> bool {
+    let w = idx.map(|i| a.w(i));
+    let w_grad_sq: f32 = w
+        .iter()
+        .zip(&e.grad)
+        .map(|(w, g)| w * g.norm_squared())
+        .sum();
+    match constraint::xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
+        Some(dl) => {
+            *lambda += dl;
+            for k in 0..N {
+                a.add(idx[k], e.grad[k] * (w[k] * dl));
+            }
+            true
+        }
+        None => false,
+    }
+}
+
+/// Edge `[a, b]` of rest length `d`. A zero-length edge (`|p0 − p1| < 1e-6 d`) is pushed
+/// apart along its rest-pose direction.
+#[inline(always)]
+pub(crate) fn edge<A: ParticleAccess>(
+    acc: &mut A,
+    [a, b]: [u32; 2],
+    d: f32,
+    lambda: &mut f32,
+    alpha_tilde: f32,
+) -> Outcome {
+    let (a, b) = (a as usize, b as usize);
+    let delta = acc.x(a) - acc.x(b);
+    let len = delta.norm();
+    let (n, degenerate) = if len > 1e-6 * d {
+        (delta * (1.0 / len), false)
+    } else {
+        ((acc.rest(a) - acc.rest(b)) * (1.0 / d), true)
+    };
+    let (wa, wb) = (acc.w(a), acc.w(b));
+    let Some(dl) = constraint::xpbd_delta_lambda(len - d, *lambda, alpha_tilde, wa + wb) else {
+        return Outcome::Skipped;
+    };
+    *lambda += dl;
+    acc.add(a, n * (wa * dl));
+    acc.add(b, n * (-wb * dl));
+    if degenerate {
+        Outcome::Degenerate
+    } else {
+        Outcome::Applied
+    }
+}
+
+/// The four vertex–face constraints of one tetrahedron, one after another. A degenerate
+/// face falls back to holding `p1` at its rest height above `p0` along the face's rest
+/// normal (linear in `p0`, `p1`; re-expands a collapsed tetrahedron).
+#[inline(always)]
+pub(crate) fn vertex_face<A: ParticleAccess>(
+    acc: &mut A,
+    tet: [u32; 4],
+    rest_heights: &[f32; 4],
+    lambdas: &mut [f32; 4],
+    alpha_tilde: f32,
+) -> (u32, u32) {
+    let (mut applied, mut degenerate) = (0, 0);
+    for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
+        let idx = order.map(|o| tet[o] as usize);
+        let p = idx.map(|i| acc.x(i));
+        match constraint::vertex_face(&p[0], &p[1], &p[2], &p[3], rest_heights[k]) {
+            Some(e) => {
+                if apply(acc, idx, &e, &mut lambdas[k], alpha_tilde) {
+                    applied += 1;
+                }
+            }
+            None => {
+                degenerate += 1;
+                let rest = idx.map(|i| acc.rest(i));
+                let n = (rest[2] - rest[0]).cross(&(rest[3] - rest[0]));
+                let n = n / n.norm().max(f32::MIN_POSITIVE);
+                let e = Evaluated {
+                    c: (p[1] - p[0]).dot(&n) - rest_heights[k],
+                    grad: [-n, n, Vector3::zeros(), Vector3::zeros()],
+                };
+                apply(acc, idx, &e, &mut lambdas[k], alpha_tilde);
+            }
+        }
+    }
+    (applied, degenerate)
+}
+
+/// The signed volume constraint of one tetrahedron. Vanishing gradients (all four points
+/// collinear) skip it.
+#[inline(always)]
+pub(crate) fn volume<A: ParticleAccess>(
+    acc: &mut A,
+    tet: [u32; 4],
+    rest_volume: f32,
+    lambda: &mut f32,
+    alpha_tilde: f32,
+) -> Outcome {
+    let idx = tet.map(|i| i as usize);
+    let p = idx.map(|i| acc.x(i));
+    let e = constraint::volume(&p[0], &p[1], &p[2], &p[3], rest_volume);
+    if apply(acc, idx, &e, lambda, alpha_tilde) {
+        Outcome::Applied
+    } else if idx.iter().any(|&i| acc.w(i) > 0.0) {
+        Outcome::Degenerate
+    } else {
+        Outcome::Skipped
+    }
+}
