@@ -117,6 +117,50 @@ pub trait SubstepHook {
 /// The empty hook.
 impl SubstepHook for () {}
 
+/// Two hooks run one after the other at every point (e.g. rigid coupling, then soft–soft
+/// contacts).
+impl<A: SubstepHook, B: SubstepHook> SubstepHook for (A, B) {
+    fn begin_frame(&mut self, world: &mut World, dt: f32) {
+        self.0.begin_frame(world, dt);
+        self.1.begin_frame(world, dt);
+    }
+    fn begin_substep(&mut self, world: &mut World, h: f32) {
+        self.0.begin_substep(world, h);
+        self.1.begin_substep(world, h);
+    }
+    fn project(&mut self, world: &mut World, h: f32) {
+        self.0.project(world, h);
+        self.1.project(world, h);
+    }
+    fn end_substep(&mut self, world: &mut World, h: f32) {
+        self.0.end_substep(world, h);
+        self.1.end_substep(world, h);
+    }
+    fn end_frame(&mut self, world: &mut World, dt: f32) {
+        self.0.end_frame(world, dt);
+        self.1.end_frame(world, dt);
+    }
+}
+
+/// A borrowed hook.
+impl<H: SubstepHook + ?Sized> SubstepHook for &mut H {
+    fn begin_frame(&mut self, world: &mut World, dt: f32) {
+        (**self).begin_frame(world, dt);
+    }
+    fn begin_substep(&mut self, world: &mut World, h: f32) {
+        (**self).begin_substep(world, h);
+    }
+    fn project(&mut self, world: &mut World, h: f32) {
+        (**self).project(world, h);
+    }
+    fn end_substep(&mut self, world: &mut World, h: f32) {
+        (**self).end_substep(world, h);
+    }
+    fn end_frame(&mut self, world: &mut World, dt: f32) {
+        (**self).end_frame(world, dt);
+    }
+}
+
 /// Runs frames of the soft-body systems on a [`hecs::World`].
 ///
 /// ```text
