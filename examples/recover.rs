@@ -2,20 +2,46 @@
 //! released; prints its recovery frame by frame with the solver's step statistics.
 //!
 //! ```text
-//! cargo run --release --example recover -- [mirror|flatten|scramble|squash] [vf|ev|vfe|e] [frames] [substeps] [cells]
+//! cargo run --release --example recover -- [mirror|flatten|scramble|squash|nudge] [vf|ev|vfe|e]
+//!     [frames] [substeps] [cells] [--alpha A] [--max-correction-speed V]
 //! ```
 //!
 //! `vf` = vertex–face constraints alone, `ev` = edges + volume, `vfe` = vertex–face + edges,
-//! `e` = edges alone (which cannot un-invert a mirrored body).
+//! `e` = edges alone (which cannot un-invert a mirrored body). `--alpha` sets the compliance of
+//! every family (m/N; volume m⁵/N), default 0; `--max-correction-speed` turns on the solver's
+//! safety net (m/s). Defaults: mirror, vfe, 120 frames, 10 substeps, 4³ cells.
 
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, Tetrahedra};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let all: Vec<String> = std::env::args().skip(1).collect();
+    let flag = |name: &str| -> Result<Option<f32>, Box<dyn std::error::Error>> {
+        match all.iter().position(|a| a == name) {
+            Some(i) => Ok(Some(
+                all.get(i + 1)
+                    .ok_or(format!("{name} needs a value"))?
+                    .parse()?,
+            )),
+            None => Ok(None),
+        }
+    };
+    let alpha = flag("--alpha")?.unwrap_or(0.0);
+    let max_correction_speed = flag("--max-correction-speed")?;
+    let mut args = Vec::new();
+    let mut skip = false;
+    for a in &all {
+        if skip {
+            skip = false;
+        } else if a.starts_with("--") {
+            skip = true;
+        } else {
+            args.push(a.clone());
+        }
+    }
     let mode = args.first().map_or("mirror", String::as_str);
-    let families = args.get(1).map_or("vf", String::as_str);
+    let families = args.get(1).map_or("vfe", String::as_str);
     let frames: usize = args.get(2).map_or(Ok(120), |s| s.parse())?;
     let substeps: u32 = args.get(3).map_or(Ok(10), |s| s.parse())?;
     let cells: u32 = args.get(4).map_or(Ok(4), |s| s.parse())?;
@@ -24,15 +50,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Five)?;
     let b = SoftBodyBuilder::new(mesh).density(1000.0);
     let b = match families {
-        "vf" => b.vertex_face(
-            std::env::var("VF_ALPHA")
-                .ok()
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(0.0),
-        ),
-        "ev" => b.edges(0.0).volume(0.0),
-        "vfe" => b.vertex_face(0.0).edges(0.0),
-        "e" => b.edges(0.0),
+        "vf" => b.vertex_face(alpha),
+        "ev" => b.edges(alpha).volume(alpha),
+        "vfe" => b.vertex_face(alpha).edges(alpha),
+        "e" => b.edges(alpha),
         other => return Err(format!("unknown constraint set `{other}` (vf, ev, vfe, e)").into()),
     };
     let body = b.build()?.spawn(&mut world);
@@ -62,13 +83,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         gravity: Vector3::zeros(),
         substeps,
         damping: 1.0,
-        max_correction_speed: std::env::var("MAX_CORRECTION_SPEED")
-            .ok()
-            .and_then(|s| s.parse().ok()),
+        max_correction_speed,
         measure_error: true,
         ..Default::default()
     })?;
-    println!("mode {mode}, constraints {families}, {cells}³ cells, {substeps} substeps × 1 iteration, dt 1/60 s");
+    println!(
+        "mode {mode}, constraints {families} (α = {alpha}), {cells}³ cells, {substeps} substeps × 1 iteration, dt 1/60 s, safety net {max_correction_speed:?}"
+    );
     println!(
         "frame  inverted  volume%   max|C|edge  max|C|vf   max|C|vol   degenerate  max|v|     ms"
     );
