@@ -43,6 +43,7 @@ pub(crate) struct BodyProxy {
     v_end: Vector3<f32>,
     w_end: Vector3<f32>,
     dt: f32,
+    h: f32,
     inv_mass: Vector3<f32>,
     inv_inertia: Matrix3<f32>,
     dx: Vector3<f32>,
@@ -118,6 +119,7 @@ impl BodyProxy {
             w_base,
             v_end: v_end_base,
             dt,
+            h: dt,
             w_end: to_na(body.angvel()),
             inv_mass,
             inv_inertia,
@@ -214,6 +216,7 @@ impl BodyProxy {
         if self.kind != BodyKind::Dynamic {
             return;
         }
+        self.h = h;
         self.dv = (self.dx - self.dx_sub) / h;
         self.dw = (self.dq * self.dq_sub.inverse()).scaled_axis() / h;
     }
@@ -240,13 +243,15 @@ impl BodyProxy {
         self.touched = true;
     }
 
-    /// Writes the final pose and velocity back to rapier. Returns `false` (and writes
-    /// nothing) when the result is not finite.
+    /// Writes the final pose and velocity back to rapier (the velocity is that of the last
+    /// substep, as in PBD). Returns `false` (and writes nothing) when the result is not
+    /// finite.
     pub fn write_back(&self, body: &mut RigidBody) -> bool {
         if self.kind != BodyKind::Dynamic || !self.touched {
             return true;
         }
-        let v = self.v_end + self.dv;
+        // PBD velocity of the last substep: the base's mean velocity over it plus the offset's.
+        let v = self.v_end - (self.v_end - self.v_start) * (0.5 * self.h / self.dt) + self.dv;
         let w = self.w_end + self.dw;
         let t = self.pose.translation.vector;
         let finite = [v, w, t].iter().all(|x| x.iter().all(|c| c.is_finite()))

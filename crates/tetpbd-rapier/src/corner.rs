@@ -1,41 +1,61 @@
-//! Rigid corners against soft surface triangles.
+//! Rigid features against soft surface triangles.
 //!
-//! A coarse soft body has few surface particles; a sharp rigid corner can slip between
-//! them without any particle entering the rigid shape. This is the seed's vertex–face
-//! constraint with the rigid corner as the vertex: for a corner `v` over a boundary
-//! triangle `(a, b, c)` with outward unit normal `n` and barycentric weights `β` of `v`'s
-//! projection,
+//! A coarse soft body has few surface particles; a sharp rigid corner, or a ball smaller
+//! than the gap between particles, can slip between them without any particle entering the
+//! rigid shape. This is the seed's vertex–face constraint with a rigid point `v` as the
+//! vertex. For a boundary triangle `(a, b, c)` with outward unit normal `n` and barycentric
+//! weights `β` of `v`'s projection onto it:
 //!
 //! ```text
 //! C = (v − (β_a a + β_b b + β_c c))·n − thickness ≥ 0
-//! ∇_v C = n,   ∇_k C = −β_k n   (normal held fixed for the step)
+//! ∇_v C = n,   ∇_k C = −β_k n   (normal held fixed for the projection)
 //! Δλ = −C / (Σ w_k β_k² + w_rigid(v, n))
 //! ```
 //!
 //! The correction is spread over the triangle's particles barycentrically and the opposite
-//! impulse goes to the rigid body at the corner. Corners are the vertices of cuboids, round
-//! cuboids (inner corners, border radius added to the thickness), convex polyhedra, cones
-//! (apex) and triangles. A corner is only caught while it is less than half the triangle's
-//! shortest edge behind it, so triangles on the far side of the body never grab it.
-//! Friction is not applied at corner contacts.
+//! impulse goes to the rigid body at `v`; Coulomb friction acts on the relative tangential
+//! motion as for particles. The rigid points are
+//!
+//! * every vertex of a polyhedral shape (cuboid, convex polyhedron, triangle; the inner
+//!   vertices of the rounded variants, border radius added to the thickness), each its own
+//!   constraint, so a face resting flat on the soft surface pushes evenly;
+//! * for the other shapes with a support map (ball, capsule, cylinder, cone, segment and
+//!   rounded variants), the support point in direction `−n`: the shape's deepest point
+//!   towards the triangle.
+//!
+//! A triangle whose vertex is itself in contact with the collider (in the same iteration)
+//! is skipped: there the particle contacts hold the surface, and two sets of constraints on
+//! the same spot only fight. Triangle meshes, heightfields and compounds take no part (their contacts with the soft
+//! particles still act). `v` is only caught while its projection falls inside the triangle
+//! (within 0.1 % of its barycentric range, so a point on a shared edge is not lost between
+//! two triangles) and it is less than half the triangle's shortest edge behind it, so
+//! triangles on the far side of the body never grab it.
 
 use nalgebra::{Point3, Vector3};
-use rapier3d::geometry::Aabb;
+use rapier3d::geometry::{Aabb, ColliderSet};
 use rapier3d::parry::bounding_volume::BoundingVolume;
 use rapier3d::parry::shape::Shape;
 use tetpbd::{Particles, Surface};
 
 use crate::bodies::BodyProxy;
 use crate::convert::{to_glam, to_na};
-use crate::frame::ColliderProxy;
+use crate::frame::{ColliderProxy, ParticleContact};
 
-/// One rigid corner over one soft surface triangle.
+/// One rigid shape over one soft surface triangle.
 #[derive(Clone, Debug)]
 pub(crate) struct CornerContact {
     pub collider: usize,
-    pub corner: Vector3<f32>,
+    /// A polyhedral shape's corner in its local frame; `None`: the support point.
+    pub corner: Option<Vector3<f32>>,
     pub triangle: u32,
+    /// The particle contacts of the triangle's vertices with the same collider (indices
+    /// into the soft body's contacts).
+    pub vertex_contacts: [Option<usize>; 3],
     pub thickness: f32,
+    pub mu_d: f32,
+    pub mu_s: f32,
+    pub lambda_n: f32,
+    pub lambda_t: f32,
     pub ever_active: bool,
     pub depth: f32,
     pub normal: Vector3<f32>,
@@ -71,8 +91,6 @@ pub(crate) fn corners_of(shape: &dyn Shape) -> (Vec<Vector3<f32>>, f32) {
             c.inner_shape.points().iter().map(|p| to_na(*p)).collect(),
             c.border_radius,
         )
-    } else if let Some(c) = shape.as_cone() {
-        (vec![Vector3::new(0.0, c.half_height, 0.0)], 0.0)
     } else if let Some(t) = shape.as_triangle() {
         (vec![to_na(t.a), to_na(t.b), to_na(t.c)], 0.0)
     } else {
@@ -91,11 +109,17 @@ pub(crate) fn gather_corners(
     surface: &Surface,
     dt: f32,
     thickness: f32,
+    (mu_d, mu_s): (f32, f32),
+    vertex_contacts: &[(u32, usize)],
 ) {
     let (corners, extra) = corners_of(shape);
-    if corners.is_empty() {
+    let corners: Vec<Option<Vector3<f32>>> = if !corners.is_empty() {
+        corners.into_iter().map(Some).collect()
+    } else if shape.as_support_map().is_some() {
+        vec![None]
+    } else {
         return;
-    }
+    };
     let reach = thickness + extra;
     for (t, tri) in surface.triangles().iter().enumerate() {
         let mut lo = Vector3::repeat(f32::INFINITY);
@@ -110,12 +134,23 @@ pub(crate) fn gather_corners(
         if !ta.intersects(collider_aabb) {
             continue;
         }
-        for c in &corners {
+        let vc = tri.map(|i| {
+            vertex_contacts
+                .binary_search_by_key(&i, |(p, _)| *p)
+                .ok()
+                .map(|k| vertex_contacts[k].1)
+        });
+        for corner in &corners {
             out.push(CornerContact {
                 collider,
-                corner: *c,
+                corner: *corner,
                 triangle: t as u32,
+                vertex_contacts: vc,
                 thickness: reach,
+                mu_d,
+                mu_s,
+                lambda_n: 0.0,
+                lambda_t: 0.0,
                 ever_active: false,
                 depth: 0.0,
                 normal: Vector3::zeros(),
@@ -130,19 +165,35 @@ pub(crate) fn gather_corners(
 /// One Gauss–Seidel sweep over a soft body's corner contacts.
 pub(crate) fn project_corners(
     corners: &mut [CornerContact],
+    contacts: &[ParticleContact],
     p: &mut Particles,
     surface: &Surface,
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
+    set: &ColliderSet,
 ) {
     for k in corners {
         let Some(tri) = surface.triangles().get(k.triangle as usize) else {
             continue;
         };
+        // Where a vertex already touches the collider, the particle contacts hold the
+        // surface; the triangle only stops what slips between particles.
+        if k.vertex_contacts
+            .iter()
+            .flatten()
+            .any(|&c| contacts.get(c).is_some_and(|c| c.active))
+        {
+            continue;
+        }
         let idx = tri.map(|i| i as usize);
         let [a, b, c] = idx.map(|i| p.positions()[i]);
         let cp = &colliders[k.collider];
-        let v = (cp.pose(bodies) * Point3::from(k.corner)).coords;
+        let Some(support) = set
+            .get(cp.handle)
+            .and_then(|co| co.shape().as_support_map())
+        else {
+            continue;
+        };
         let m = (b - a).cross(&(c - a));
         let area2 = m.norm();
         let shortest = (b - a).norm().min((c - b).norm()).min((a - c).norm());
@@ -150,6 +201,18 @@ pub(crate) fn project_corners(
             continue;
         }
         let n = m / area2;
+        let pose = cp.pose(bodies);
+        let local = match k.corner {
+            Some(c) => c,
+            None => {
+                let dir = pose.rotation.inverse() * (-n);
+                to_na(support.local_support_point(to_glam(&dir)))
+            }
+        };
+        let v = (pose * Point3::from(local)).coords;
+        if !crate::convert::finite3(&v) {
+            continue;
+        }
         let s = (v - a).dot(&n);
         let c_val = s - k.thickness;
         if c_val >= 0.0 || s < -0.5 * shortest {
@@ -160,10 +223,15 @@ pub(crate) fn project_corners(
         let wa = (b - q).cross(&(c - q)).dot(&n) / area2;
         let wb = (c - q).cross(&(a - q)).dot(&n) / area2;
         let wc = 1.0 - wa - wb;
-        let beta = [wa, wb, wc];
-        if beta.iter().any(|w| *w < 0.0 || *w > 1.0) {
+        // A point on a shared edge must not fall through the crack between two triangles:
+        // accept a small tolerance and clamp.
+        const TOL: f32 = 1e-3;
+        if [wa, wb, wc].iter().any(|w| *w < -TOL || *w > 1.0 + TOL) {
             continue;
         }
+        let clamped = [wa, wb, wc].map(|w| w.clamp(0.0, 1.0));
+        let sum: f32 = clamped.iter().sum();
+        let beta = clamped.map(|w| w / sum);
         let w = idx.map(|i| p.inv_masses()[i]);
         let w_body = cp.body.map_or(0.0, |bi| bodies[bi].inv_mass_at(&v, &n));
         let denom: f32 = (0..3).map(|j| w[j] * beta[j] * beta[j]).sum::<f32>() + w_body;
@@ -183,5 +251,62 @@ pub(crate) fn project_corners(
         k.normal = -n;
         k.point = v;
         k.sub_impulse -= n * dl;
+        k.lambda_n += dl;
+        friction(k, p, idx, beta, bodies, cp.body, &v, &n);
     }
+}
+
+/// Coulomb friction between the rigid point `v` and the triangle (as for particles, see
+/// [`crate::contact`]): the relative tangential motion over the substep is removed while
+/// the tangential multiplier stays under `μ_s λ_n`, else limited to `μ_d λ_n`.
+#[allow(clippy::too_many_arguments)]
+fn friction(
+    k: &mut CornerContact,
+    p: &mut Particles,
+    idx: [usize; 3],
+    beta: [f32; 3],
+    bodies: &mut [BodyProxy],
+    body: Option<usize>,
+    v: &Vector3<f32>,
+    n: &Vector3<f32>,
+) {
+    let tri_motion: Vector3<f32> = (0..3)
+        .map(|j| (p.positions()[idx[j]] - p.prev_positions()[idx[j]]) * beta[j])
+        .sum();
+    let body_motion = body.map_or(Vector3::zeros(), |b| {
+        let rb = &bodies[b];
+        let local = rb.pose.inverse_transform_point(&Point3::from(*v));
+        (rb.pose * local).coords - (rb.prev * local).coords
+    });
+    let d = body_motion - tri_motion;
+    let dt = d - n * n.dot(&d);
+    let len = dt.norm();
+    if len.is_nan() || len <= 1e-9 {
+        return;
+    }
+    let t = dt / len;
+    let w = idx.map(|i| p.inv_masses()[i]);
+    let w_body = body.map_or(0.0, |b| bodies[b].inv_mass_at(v, &t));
+    let denom: f32 = (0..3).map(|j| w[j] * beta[j] * beta[j]).sum::<f32>() + w_body;
+    if denom.is_nan() || denom <= 0.0 {
+        return;
+    }
+    let full = len / denom;
+    let applied = if k.lambda_t + full <= k.mu_s * k.lambda_n {
+        full
+    } else {
+        full.min((k.mu_d * k.lambda_n - k.lambda_t).max(0.0))
+    };
+    if applied <= 0.0 {
+        return;
+    }
+    let x = p.positions_mut();
+    for j in 0..3 {
+        x[idx[j]] += t * (w[j] * beta[j] * applied);
+    }
+    if let Some(b) = body {
+        bodies[b].apply_position_impulse(&(-t * applied), v);
+    }
+    k.lambda_t += applied;
+    k.sub_impulse += t * applied;
 }

@@ -262,6 +262,7 @@ impl Frame {
                     let cp = &self.colliders[ci];
                     let (mu_d, mu_s) = sc.combined_friction(cp.friction, cp.friction_rule);
                     let e = sc.combined_restitution(cp.restitution, cp.restitution_rule);
+                    let first = self.contacts.len();
                     for &i in surface.vertices() {
                         let x = p.positions()[i as usize];
                         let y = x + p.velocities()[i as usize] * dt;
@@ -290,6 +291,9 @@ impl Frame {
                         });
                     }
                     if sc.triangles && solve {
+                        let vertex_contacts: Vec<(u32, usize)> = (first..self.contacts.len())
+                            .map(|k| (self.contacts[k].particle, k - c0))
+                            .collect();
                         gather_corners(
                             &mut self.corners,
                             co.shape(),
@@ -299,6 +303,8 @@ impl Frame {
                             surface,
                             dt,
                             sc.thickness,
+                            (mu_d, mu_s),
+                            &vertex_contacts,
                         );
                     }
                 }

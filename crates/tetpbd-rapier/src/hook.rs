@@ -81,10 +81,12 @@ impl SubstepHook for CouplingHook<'_, '_> {
             );
             project_corners(
                 &mut corners[s.corners.clone()],
+                &contacts[s.contacts.clone()],
                 p,
                 surface,
                 bodies,
                 colliders,
+                self.qp.colliders,
             );
             project_attachments(&mut attachments[s.attachments.clone()], p, bodies, frac, h);
         }
@@ -131,6 +133,8 @@ impl SubstepHook for CouplingHook<'_, '_> {
         for k in corners.iter_mut() {
             k.impulse += k.sub_impulse / h;
             k.sub_impulse = nalgebra::Vector3::zeros();
+            k.lambda_n = 0.0;
+            k.lambda_t = 0.0;
         }
     }
 
