@@ -1,0 +1,120 @@
+//! Contact reports and bad input of the coupled step.
+
+mod coupling_common;
+
+use coupling_common::{ground, particles, scene, soft_box};
+use nalgebra::Vector3;
+use rapier3d::math::Vector;
+use tetpbd::SolverSettings;
+use tetpbd_rapier::{
+    CoupledWorld, CouplingError, CouplingSettings, SoftCollider, SoftColliderBuilder, SoftFeature,
+};
+
+/// A soft cube at rest on the ground: its contacts name the ground and the cube, sit on the
+/// ground's surface with upward normals, and their impulses carry the cube's weight.
+#[test]
+fn resting_contacts_carry_the_weight() {
+    let mut s = scene(10);
+    let (_, g) = ground(&mut s);
+    let e = soft_box(
+        &mut s,
+        Vector3::repeat(0.2),
+        [2, 2, 2],
+        Vector3::new(0.0, 0.1025, 0.0),
+        SoftCollider::default(),
+    );
+    for _ in 0..120 {
+        s.step().expect("step");
+    }
+    let stats = s.step().expect("step");
+    let reports = s.coupling.contacts();
+    let dt = s.physics.integration_parameters.dt;
+    let weight = particles(&s, e).total_mass() * 9.81;
+    let total: Vector3<f32> = reports.iter().map(|c| c.impulse).sum();
+    println!(
+        "{} contacts, total impulse {total:?} N·s, weight × dt {:.5} N·s",
+        reports.len(),
+        weight * dt
+    );
+    assert_eq!(stats.contacts, reports.len());
+    assert_eq!(reports.len(), 9, "the bottom face has 9 particles");
+    for c in reports {
+        assert_eq!(c.collider, g);
+        assert_eq!(c.entity, e);
+        assert!(matches!(c.feature, SoftFeature::Particle(_)));
+        assert!(c.solved);
+        assert!(
+            (c.normal - Vector3::y()).norm() < 1e-3,
+            "normal {:?}",
+            c.normal
+        );
+        assert!(c.point.y.abs() < 1e-4, "point {:?}", c.point);
+        assert!(c.depth >= 0.0 && c.depth < 0.01);
+    }
+    assert!((total.y - weight * dt).abs() < 0.02 * weight * dt);
+    assert!(total.x.abs() + total.z.abs() < 0.01 * weight * dt);
+}
+
+#[test]
+fn bad_settings_are_rejected_before_anything_moves() {
+    let bad_margin = CouplingSettings {
+        margin: -1.0,
+        ..CouplingSettings::default()
+    };
+    assert!(matches!(
+        CoupledWorld::new(SolverSettings::default(), bad_margin),
+        Err(CouplingError::BadSetting { .. })
+    ));
+    let no_substeps = SolverSettings {
+        substeps: 0,
+        ..SolverSettings::default()
+    };
+    assert!(matches!(
+        CoupledWorld::new(no_substeps, CouplingSettings::default()),
+        Err(CouplingError::Solver(_))
+    ));
+    assert!(matches!(
+        SoftColliderBuilder::new().friction(-0.1).build(),
+        Err(CouplingError::BadCoefficient { .. })
+    ));
+    assert!(matches!(
+        SoftColliderBuilder::new().restitution(1.5).build(),
+        Err(CouplingError::BadCoefficient { .. })
+    ));
+    assert!(matches!(
+        SoftColliderBuilder::new().thickness(f32::NAN).build(),
+        Err(CouplingError::BadCoefficient { .. })
+    ));
+
+    let mut s = scene(10);
+    let e = soft_box(
+        &mut s,
+        Vector3::repeat(0.2),
+        [1, 1, 1],
+        Vector3::new(0.0, 1.0, 0.0),
+        SoftCollider::default(),
+    );
+    let before = particles(&s, e);
+    s.physics.integration_parameters.dt = 0.0;
+    assert_eq!(
+        s.step().map(|_| ()),
+        Err(CouplingError::BadRapierDt { value: 0.0 })
+    );
+    s.physics.integration_parameters.dt = 1.0 / 60.0;
+    s.physics.gravity = Vector::new(0.0, f32::INFINITY, 0.0);
+    assert_eq!(s.step().map(|_| ()), Err(CouplingError::NonFiniteGravity));
+    s.physics.gravity = Vector::new(0.0, -9.81, 0.0);
+    s.coupling.settings_mut().margin = f32::NAN;
+    assert!(matches!(
+        s.step().map(|_| ()),
+        Err(CouplingError::BadSetting { .. })
+    ));
+    assert_eq!(
+        particles(&s, e),
+        before,
+        "a rejected step moved the soft body"
+    );
+    s.coupling.settings_mut().margin = 0.02;
+    s.step().expect("step");
+    assert!(particles(&s, e).center_of_mass().y < 1.0);
+}
