@@ -292,3 +292,42 @@ pub fn converged(model: Model, scene: &Scene, start: u32, max: u32) -> Reference
         prev = next;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Rotation3, Vector3};
+
+    #[test]
+    fn rest_shape_has_no_error_and_alignment_removes_rigid_motion() {
+        let scene = Scene::squash(true);
+        let rest = &scene.mesh.vertices;
+        let o = observe(&scene, rest);
+        assert!(o.volume_err_pct.abs() < 1e-4 && o.edge_strain_max < 1e-6 && o.inverted == 0);
+        let r = Rotation3::from_euler_angles(0.3, -0.7, 1.1);
+        let moved: Vec<Vector3<f32>> = rest
+            .iter()
+            .map(|p| r * p + Vector3::new(0.5, -2.0, 3.0))
+            .collect();
+        let aligned = align(&moved, rest);
+        let worst = aligned
+            .iter()
+            .zip(rest)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f32::max);
+        assert!(worst < 1e-5, "{worst}");
+        let squashed = observe(&scene, &scene.start);
+        assert!((squashed.volume_err_pct + 50.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn recovery_is_the_start_of_the_last_good_stretch() {
+        let good = Observables::default();
+        let bad = Observables {
+            volume_err_pct: 5.0,
+            ..good
+        };
+        assert_eq!(recovery_time(&[bad, good, bad, good, good]), Some(4.0 * DT));
+        assert_eq!(recovery_time(&[good, bad]), None);
+    }
+}

@@ -110,10 +110,15 @@ mod tests {
 
     #[test]
     fn compare_finds_equal_error_and_equal_time_points() {
-        let m = compare(&[p(1.0, 0.1, 0), p(4.0, 0.01, 1)], &[p(2.0, 0.05, 2)]);
-        assert_eq!(m.len(), 1);
-        assert_eq!(m[0].speedup(), Some(2.0));
+        let ours = [p(1.0, 0.1, 0), p(4.0, 0.01, 1)];
+        let m = compare(&ours, &[p(2.0, 0.05, 2), p(8.0, 0.02, 3)]);
+        assert_eq!(m.len(), 2);
+        // Equal error 0.05: our cheapest is the 4 ms run; equal time 2 ms: our 1 ms run.
+        assert_eq!(m[0].at_equal_error.map(|q| q.row), Some(1));
+        assert_eq!(m[0].speedup(), Some(0.5));
         assert!((m[0].accuracy_gain().unwrap() - 0.5).abs() < 1e-12);
+        assert_eq!(m[1].speedup(), Some(2.0));
+        assert!((m[1].accuracy_gain().unwrap() - 2.0).abs() < 1e-12);
         assert_eq!(median(vec![3.0, 1.0, 2.0, f64::NAN]), Some(2.0));
     }
 }
