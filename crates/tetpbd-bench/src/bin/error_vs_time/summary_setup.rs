@@ -70,11 +70,11 @@ pub fn setup(
     }
     let _ = writeln!(s, "\nAll runs at a frame dt of 1/60 s. tetpbd: `Solver` with `substeps` substeps of `iterations` Gauss–Seidel sweeps, families in the default order (volume, vertex–face, edge), `measure_error: true` (the measurement is excluded from the time). rapier: `PhysicsWorld::step` with `integration_parameters.num_solver_iterations` = substeps (its soft-body substep count), every other integration and soft-body setting at its default (one internal PGS iteration plus the soft body's 3 additional ones, impact-adaptive substeps allowed, re-sweep of strained constraints at 0.75), no collider on the body, sleeping off, built from the same vertices, tetrahedra (`cells`), masses and pinned vertices; the volume model also gets the same edge list (`unique_edges`). The `Fem` solver runs with rapier's default `SoftFemParameters` (CG tolerance 1e-5, at most 20 CG iterations, direct factorisation up to 600 degrees of freedom, which covers both meshes). rapier has no separate iteration count in this sweep. tetpbd's `max_correction_speed` safety net is off (its default).\n");
     let _ = writeln!(s, "## Metrics\n");
-    let _ = writeln!(s, "- **deviation from converged reference**: for the hard models the exact answer, the rest shape (every edge, height and volume held; rapier's 1e6 Hz springs sag by about g/ω² ≈ 2.5e-13 m); for the soft models the same model and mesh run by the same solver with one iteration and doubled substeps until the answer changes by < 1e-6 of the body size or the cap is reached (the table gives the substeps kept and the last change, which bounds how far the reference itself is from converged). Reported as the largest particle distance to the reference divided by the body size (beam length 2 m, cube 1 m): after the last frame for the beam; over every frame for the squash, after the best rigid alignment (Kabsch) of each frame onto the reference, so that the shape is compared and not where the free block drifted or turned. Each engine is compared with its own reference, because the two engines' soft models are not the same material.\n- **RMS edge strain** `|l/l₀ − 1|` over the mesh edges, and **total-volume error** (Σ signed volumes / Σ rest volumes − 1), computed from positions in the same way for both engines. For the hard models (tetpbd α = 0; rapier's volume model at {:e} Hz) the exact answer keeps every edge and volume at rest, so every strain and volume error is solver error: this is the like-for-like comparison.\n- tetpbd's own per-family RMS and max |C| (`StepStats` with `measure_error`), inverted tetrahedra, ns per projection: in results.csv.\n- **time**: median wall ms per frame over the measured frames.\n", crate::engines::RAPIER_HARD_HZ);
+    let _ = writeln!(s, "- **deviation from converged reference**: for the hard models the exact answer, the rest shape (every edge, height and volume held; rapier's 1e6 Hz springs sag by about g/ω² ≈ 2.5e-13 m); for the soft models the same model and mesh run by the same solver with one iteration and doubled substeps until the answer changes by < 1e-6 of the body size or the cap is reached (the table gives the substeps kept and the last change, which bounds how far the reference itself is from converged). Reported as the largest particle distance to the reference divided by the body size (beam length 2 m, cube 1 m): after the last frame for the beam; over every frame for the squash, after the best rigid alignment (Kabsch) of each frame onto the reference, so that the shape is compared and not where the free block drifted or turned. A beam that has not settled by the last frame (see `final_speed_m_s` in results.csv) counts its remaining motion as error. Each engine is compared with its own reference, because the two engines' soft models are not the same material.\n- **RMS edge strain** `|l/l₀ − 1|` over the mesh edges, and **total-volume error** (Σ signed volumes / Σ rest volumes − 1), computed from positions in the same way for both engines. For the hard models (tetpbd α = 0; rapier's volume model at {:e} Hz) the exact answer keeps every edge and volume at rest, so every strain and volume error is solver error: this is the like-for-like comparison.\n- tetpbd's own per-family RMS and max |C| (`StepStats` with `measure_error`), inverted tetrahedra, ns per projection: in results.csv.\n- **time to recover** (squash): the first time after which the total volume stays within 1 % of rest and the RMS edge strain below 1 %.\n- **time**: median wall ms per frame over the measured frames of two runs of each configuration (pooled).\n", crate::engines::RAPIER_HARD_HZ);
     let _ = writeln!(s, "## Where the models differ\n");
     let _ = writeln!(s, "tetpbd's soft compliances (α per constraint, XPBD) and rapier's materials (frequency-normalised softness for the volume model, Young's modulus for the corotational and Neo-Hookean cells) are different materials: a soft tetpbd beam and a rapier corotational beam do not sag the same amount, so their errors are measured against their own references and only the shared observables (volume kept, edge stretch, shape against the reference) are compared. rapier's 'hard' volume model is a 1e6 Hz spring, which rapier saturates at the substep rate rather than treating as rigid.\n");
     let _ = writeln!(s, "## Per model\n");
-    let _ = writeln!(s, "| scene | model | ns/projection (median over budgets) | cheapest budget: ms, deviation, recover s | largest budget: ms, deviation, recover s, inverted (max) |\n|---|---|---:|---|---|");
+    let _ = writeln!(s, "| scene | model | ns/projection (median over budgets) | cheapest budget: ms, deviation, recover s | largest budget: ms, deviation, recover s, inverted (max), final speed m/s |\n|---|---|---:|---|---|");
     for sc in scenes {
         for m in &models {
             let mine: Vec<&Row> = rows
@@ -97,7 +97,7 @@ pub fn setup(
             };
             let _ = writeln!(
                 s,
-                "| {} | {} | {ns} | {}: {:.3}, {:.2e}, {} | {}: {:.3}, {:.2e}, {}, {} |",
+                "| {} | {} | {ns} | {}: {:.3}, {:.2e}, {} | {}: {:.3}, {:.2e}, {}, {}, {:.2e} |",
                 sc.name,
                 m.label(),
                 lo.budget(),
@@ -108,7 +108,8 @@ pub fn setup(
                 hi.ms,
                 hi.dev.max,
                 rec(hi),
-                hi.max_inverted
+                hi.max_inverted,
+                hi.final_speed
             );
         }
     }
