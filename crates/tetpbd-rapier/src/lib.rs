@@ -36,6 +36,10 @@ mod report;
 mod restitution;
 mod scene;
 mod shape_query;
+mod soft_bvh;
+mod soft_contact;
+mod soft_gather;
+mod soft_project;
 
 pub use attachment::{AttachTarget, Attachment, Attachments};
 pub use coupling::{Coupling, CouplingSettings, RapierContext};
@@ -44,6 +48,7 @@ pub use error::CouplingError;
 pub use material::{SoftCollider, SoftColliderBuilder};
 pub use report::{ContactReport, CouplingStats, SoftFeature};
 pub use scene::CoupledWorld;
+pub use soft_contact::{SelfCollision, SoftContactSettings, SoftContactStats, SoftContacts};
 
 pub use rapier3d;
 pub use tetpbd;

@@ -1,0 +1,327 @@
+//! Per-body acceleration structures of soft–soft contacts: parry BVHs over a soft body's
+//! surface triangles and tetrahedra, refitted as the body deforms, and the small triangle
+//! geometry the contacts need.
+//!
+//! Everything a body's cache stores is in *surface-local* indices (position in
+//! [`tetpbd::Surface::vertices`]), so the contact solver can work on a flat copy of the
+//! surface particles of every body in the frame.
+
+use nalgebra::Vector3;
+use rapier3d::parry::bounding_volume::Aabb;
+use rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
+use rapier3d::parry::query::PointProjection;
+use tetpbd::{Surface, Tetrahedra};
+
+use crate::convert::to_glam;
+
+/// Cached structures of one soft body, kept across frames while its mesh is unchanged.
+pub(crate) struct BodyCache {
+    /// The surface triangles the cache was built from (particle indices), to detect changes.
+    pub source_triangles: Vec<[u32; 3]>,
+    /// Number of particles and tetrahedra when built, to detect changes.
+    pub particle_count: usize,
+    pub tet_count: usize,
+    /// Particle index of each surface-local vertex (a copy of `Surface::vertices`).
+    pub vertices: Vec<u32>,
+    /// Surface triangles in surface-local indices.
+    pub triangles: Vec<[u32; 3]>,
+    /// Tetrahedra (particle indices).
+    pub tets: Vec<[u32; 4]>,
+    /// BVH over `triangles` (leaf `t` is triangle `t`).
+    pub tri_bvh: Bvh,
+    /// BVH over `tets` (leaf `t` is tetrahedron `t`).
+    pub tet_bvh: Bvh,
+    pub workspace: BvhWorkspace,
+    /// Self-collision exclusion: for surface-local vertex `k`, the sorted particle indices
+    /// sharing a tetrahedron with it (itself included), `ring[ring_start[k]..ring_start[k+1]]`.
+    /// Empty until a self-colliding body needs it.
+    pub ring_start: Vec<u32>,
+    pub ring: Vec<u32>,
+}
+
+impl BodyCache {
+    /// Builds the cache, or `None` when the mesh refers to particles that do not exist.
+    pub fn build(surface: &Surface, tets: &Tetrahedra, particle_count: usize) -> Option<Self> {
+        let n = particle_count as u32;
+        let vertices = surface.vertices().to_vec();
+        if vertices.iter().any(|&i| i >= n) || tets.indices().iter().flatten().any(|&i| i >= n) {
+            return None;
+        }
+        let local = |i: u32| vertices.binary_search(&i).ok().map(|k| k as u32);
+        let mut triangles = Vec::with_capacity(surface.triangles().len());
+        for t in surface.triangles() {
+            triangles.push([local(t[0])?, local(t[1])?, local(t[2])?]);
+        }
+        let empty = Aabb::new(to_glam(&Vector3::zeros()), to_glam(&Vector3::zeros()));
+        let tri_bvh = Bvh::from_iter(
+            BvhBuildStrategy::Binned,
+            (0..triangles.len()).map(|t| (t, empty)),
+        );
+        let tet_bvh = Bvh::from_iter(
+            BvhBuildStrategy::Binned,
+            (0..tets.len()).map(|t| (t, empty)),
+        );
+        Some(BodyCache {
+            source_triangles: surface.triangles().to_vec(),
+            particle_count,
+            tet_count: tets.len(),
+            vertices,
+            triangles,
+            tets: tets.indices().to_vec(),
+            tri_bvh,
+            tet_bvh,
+            workspace: BvhWorkspace::default(),
+            ring_start: Vec::new(),
+            ring: Vec::new(),
+        })
+    }
+
+    /// `true` while the cache still describes this mesh.
+    pub fn matches(&self, surface: &Surface, tets: &Tetrahedra, particle_count: usize) -> bool {
+        self.particle_count == particle_count
+            && self.tet_count == tets.len()
+            && self.source_triangles == surface.triangles()
+    }
+
+    /// Refits the triangle BVH to the boxes of the triangles at `x` (surface-local
+    /// positions), each vertex's box grown by its `motion` (m).
+    pub fn refit_triangles(&mut self, x: &[Vector3<f32>], motion: &[f32]) {
+        for (t, tri) in self.triangles.iter().enumerate() {
+            let (mut lo, mut hi) = (Vector3::repeat(f32::MAX), Vector3::repeat(f32::MIN));
+            for &k in tri {
+                let r = Vector3::repeat(motion[k as usize]);
+                lo = lo.inf(&(x[k as usize] - r));
+                hi = hi.sup(&(x[k as usize] + r));
+            }
+            let aabb = Aabb::new(to_glam(&lo), to_glam(&hi));
+            self.tri_bvh.insert_or_update_partially(aabb, t as u32, 0.0);
+        }
+        self.tri_bvh.refit(&mut self.workspace);
+    }
+
+    /// Refits the tetrahedron BVH to the particle positions `p` (all particles).
+    pub fn refit_tets(&mut self, p: &[Vector3<f32>]) {
+        for (t, tet) in self.tets.iter().enumerate() {
+            let (mut lo, mut hi) = (Vector3::repeat(f32::MAX), Vector3::repeat(f32::MIN));
+            for &i in tet {
+                lo = lo.inf(&p[i as usize]);
+                hi = hi.sup(&p[i as usize]);
+            }
+            let aabb = Aabb::new(to_glam(&lo), to_glam(&hi));
+            self.tet_bvh.insert_or_update_partially(aabb, t as u32, 0.0);
+        }
+        self.tet_bvh.refit(&mut self.workspace);
+    }
+
+    /// Builds the one-ring exclusion lists (once) for self collision.
+    pub fn ensure_rings(&mut self) {
+        if !self.ring_start.is_empty() || self.vertices.is_empty() {
+            return;
+        }
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        for tet in &self.tets {
+            for &a in tet {
+                if let Ok(k) = self.vertices.binary_search(&a) {
+                    for &b in tet {
+                        pairs.push((k as u32, b));
+                    }
+                }
+            }
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        self.ring_start = vec![0; self.vertices.len() + 1];
+        self.ring = Vec::with_capacity(pairs.len());
+        for (k, b) in pairs {
+            self.ring_start[k as usize + 1] += 1;
+            self.ring.push(b);
+        }
+        for k in 0..self.vertices.len() {
+            self.ring_start[k + 1] += self.ring_start[k];
+        }
+    }
+
+    /// `true` when surface triangle `t` touches surface-local vertex `k` or one of its
+    /// tetrahedron neighbours (never a self-collision pair).
+    pub fn excluded(&self, k: usize, t: usize) -> bool {
+        let own = self.vertices[k];
+        let ring = match (self.ring_start.get(k), self.ring_start.get(k + 1)) {
+            (Some(&a), Some(&b)) => &self.ring[a as usize..b as usize],
+            _ => &[][..],
+        };
+        self.triangles[t].iter().any(|&v| {
+            let i = self.vertices[v as usize];
+            i == own || ring.binary_search(&i).is_ok()
+        })
+    }
+
+    /// `true` when `x` lies strictly inside one of the body's tetrahedra at positions `p`.
+    pub fn contains(&self, x: &Vector3<f32>, p: &[Vector3<f32>]) -> bool {
+        let q = to_glam(x);
+        let aabb = Aabb::new(q, q);
+        let inside = self
+            .tet_bvh
+            .intersect_aabb(&aabb)
+            .any(|t| in_tet(x, &self.tets[t as usize].map(|i| p[i as usize])));
+        inside
+    }
+
+    /// The surface triangle closest to `x` (surface-local positions `xs`).
+    pub fn closest_triangle(&self, x: &Vector3<f32>, xs: &[Vector3<f32>]) -> Option<usize> {
+        let tris = &self.triangles;
+        let best = self.tri_bvh.project_point(to_glam(x), f32::MAX, |t, _| {
+            let [a, b, c] = tris.get(t as usize)?.map(|k| xs[k as usize]);
+            let w = closest_barycentric(x, &a, &b, &c);
+            let q = a * w[0] + b * w[1] + c * w[2];
+            q.iter()
+                .all(|v| v.is_finite())
+                .then(|| PointProjection::new(false, to_glam(&q)))
+        })?;
+        Some(best.0 as usize)
+    }
+}
+
+/// `true` when `x` lies strictly inside the tetrahedron `t` (either orientation).
+pub(crate) fn in_tet(x: &Vector3<f32>, t: &[Vector3<f32>; 4]) -> bool {
+    let vol = |a: &Vector3<f32>, b: &Vector3<f32>, c: &Vector3<f32>, d: &Vector3<f32>| {
+        (b - a).dot(&(c - a).cross(&(d - a)))
+    };
+    let total = vol(&t[0], &t[1], &t[2], &t[3]);
+    if total == 0.0 || !total.is_finite() {
+        return false;
+    }
+    let s = total.signum();
+    vol(x, &t[1], &t[2], &t[3]) * s > 0.0
+        && vol(&t[0], x, &t[2], &t[3]) * s > 0.0
+        && vol(&t[0], &t[1], x, &t[3]) * s > 0.0
+        && vol(&t[0], &t[1], &t[2], x) * s > 0.0
+}
+
+/// Unit normal `(b − a) × (c − a) / |…|` of a triangle, or `None` when it is degenerate.
+#[inline]
+pub(crate) fn triangle_normal(
+    a: &Vector3<f32>,
+    b: &Vector3<f32>,
+    c: &Vector3<f32>,
+) -> Option<Vector3<f32>> {
+    let m = (b - a).cross(&(c - a));
+    let len = m.norm();
+    let scale = (b - a).norm_squared() + (c - a).norm_squared();
+    (len.is_finite() && len > 1e-7 * scale && len > 0.0).then(|| m / len)
+}
+
+/// Barycentric coordinates of the projection of `x` onto the plane of `(a, b, c)` with unit
+/// normal `n` (unclamped: negative outside the triangle).
+#[inline]
+pub(crate) fn plane_barycentric(
+    x: &Vector3<f32>,
+    a: &Vector3<f32>,
+    b: &Vector3<f32>,
+    c: &Vector3<f32>,
+    n: &Vector3<f32>,
+) -> [f32; 3] {
+    let area = (b - a).cross(&(c - a)).dot(n);
+    if area.abs() <= f32::MIN_POSITIVE {
+        return [1.0 / 3.0; 3];
+    }
+    let wa = (b - x).cross(&(c - x)).dot(n) / area;
+    let wb = (c - x).cross(&(a - x)).dot(n) / area;
+    [wa, wb, 1.0 - wa - wb]
+}
+
+/// Barycentric coordinates of the point of triangle `(a, b, c)` closest to `x`
+/// (Ericson, "Real-Time Collision Detection", 5.1.5).
+pub(crate) fn closest_barycentric(
+    x: &Vector3<f32>,
+    a: &Vector3<f32>,
+    b: &Vector3<f32>,
+    c: &Vector3<f32>,
+) -> [f32; 3] {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = x - a;
+    let d1 = ab.dot(&ap);
+    let d2 = ac.dot(&ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let bp = x - b;
+    let d3 = ab.dot(&bp);
+    let d4 = ac.dot(&bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return [0.0, 1.0, 0.0];
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = safe_div(d1, d1 - d3);
+        return [1.0 - v, v, 0.0];
+    }
+    let cp = x - c;
+    let d5 = ab.dot(&cp);
+    let d6 = ac.dot(&cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return [0.0, 0.0, 1.0];
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = safe_div(d2, d2 - d6);
+        return [1.0 - w, 0.0, w];
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = safe_div(d4 - d3, (d4 - d3) + (d5 - d6));
+        return [0.0, 1.0 - w, w];
+    }
+    let denom = va + vb + vc;
+    let v = safe_div(vb, denom);
+    let w = safe_div(vc, denom);
+    [1.0 - v - w, v, w]
+}
+
+#[inline]
+fn safe_div(a: f32, b: f32) -> f32 {
+    let r = a / b;
+    if r.is_finite() {
+        r.clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn closest_point_regions() {
+        let a = Vector3::new(0.0, 0.0, 0.0);
+        let b = Vector3::new(1.0, 0.0, 0.0);
+        let c = Vector3::new(0.0, 1.0, 0.0);
+        let w = closest_barycentric(&Vector3::new(0.25, 0.25, 3.0), &a, &b, &c);
+        assert!((w[0] - 0.5).abs() < 1e-6 && (w[1] - 0.25).abs() < 1e-6);
+        assert_eq!(
+            closest_barycentric(&Vector3::new(-1.0, -1.0, 0.0), &a, &b, &c),
+            [1.0, 0.0, 0.0]
+        );
+        let w = closest_barycentric(&Vector3::new(1.0, 1.0, 0.0), &a, &b, &c);
+        assert!((w[1] - 0.5).abs() < 1e-6 && (w[2] - 0.5).abs() < 1e-6);
+        let n = triangle_normal(&a, &b, &c).expect("normal");
+        let p = plane_barycentric(&Vector3::new(2.0, 0.0, 1.0), &a, &b, &c, &n);
+        assert!((p[1] - 2.0).abs() < 1e-6 && (p[0] + 1.0).abs() < 1e-6);
+        assert!(triangle_normal(&a, &b, &(b * 2.0)).is_none());
+    }
+
+    #[test]
+    fn inside_tetrahedron() {
+        let t = [
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(0.0, 1.0, 0.0),
+            Vector3::new(0.0, 0.0, 1.0),
+        ];
+        assert!(in_tet(&Vector3::new(0.1, 0.1, 0.1), &t));
+        assert!(!in_tet(&Vector3::new(0.5, 0.5, 0.5), &t));
+        let flipped = [t[0], t[2], t[1], t[3]];
+        assert!(in_tet(&Vector3::new(0.1, 0.1, 0.1), &flipped));
+    }
+}

@@ -1,0 +1,258 @@
+//! [`SoftContacts`]: soft–soft and self collision of `tetpbd` bodies, as a
+//! [`tetpbd::SubstepHook`].
+//!
+//! # The constraint
+//!
+//! A surface particle `p` of one body against a surface triangle `(a, b, c)` of another body
+//! (or of the same body, for bodies with the [`SelfCollision`] component), with the
+//! triangle's outward unit normal `n` and thickness `δ` (the seed's vertex–face constraint
+//! with a thickness):
+//!
+//! ```text
+//! C  = (p − q)·n − δ ≥ 0,   q = β_a a + β_b b + β_c c   (β: barycentric point of p on the triangle)
+//! ∇p C = n,   ∇a C = −β_a n,   ∇b C = −β_b n,   ∇c C = −β_c n   (n held fixed)
+//! Δλ = (−C − α̃λ) / (w_p + β_a² w_a + β_b² w_b + β_c² w_c + α̃),   λ ≥ 0
+//! ```
+//!
+//! so the correction is spread barycentrically over the triangle's three particles and both
+//! bodies move according to their inverse masses. Only violated constraints are projected
+//! (an inequality), every iteration of every substep. Friction is positional (Müller et al.
+//! 2020): the relative tangential displacement of `p` against `q` over the substep is removed
+//! while the tangential multiplier stays under `μ_s λ`, otherwise only up to `μ_d λ`. After
+//! each substep the separating normal velocity a contact's projection created is removed
+//! (restitution 0), so corrections do not turn into bounces.
+//!
+//! # Candidates (once per frame)
+//!
+//! Bodies are paired by a sweep over their AABBs (never all pairs). Each body keeps a parry
+//! BVH over its surface triangles, refitted every frame. Each particle has a *motion bound*
+//! `m = |v| dt + ½ a_max dt²` (`a_max` = [`SoftContactSettings::max_acceleration`]); a
+//! particle–triangle pair is a candidate when the particle's box grown by `m + margin + δ`
+//! meets the triangle's box grown by its vertices' bounds. A candidate is kept only when the
+//! particle starts the frame on the outer side of the triangle's plane (`d₀ ≥ −δ`), and it is
+//! active only while the particle is inside the triangle's prism and less than the frame's
+//! relative motion behind it. That is what catches a fast particle: one that crosses a
+//! thin sheet within a substep is still within `m` of the face it came from, and is pushed
+//! back to it, while a particle resting under the sheet is never pulled through it.
+//!
+//! # Deep overlap and the speed bound
+//!
+//! A surface particle that starts the frame *inside* another body (strictly inside one of
+//! its tetrahedra) gets one contact with that body's closest surface triangle, active at any
+//! depth. For every contact the separation a substep may produce is bounded: with `d_prev`
+//! the particle's signed distance to the triangle's plane at the start of the substep, the
+//! target is `min(δ, d_prev + S h)`, `S` = [`SoftContactSettings::max_separation_speed`].
+//!
+//! **Bound:** a contact never pushes its particle away from its triangle faster than `S`
+//! (m/s, relative normal speed over a substep), whatever the depth; and the velocity pass
+//! removes the separating velocity afterwards, so overlapping bodies walk apart by at most
+//! `S·dt` per frame instead of being shot apart. Every substep in which a violated contact's
+//! target was limited this way counts as one clamp in [`SoftContactStats::clamps`].
+//!
+//! # Limits
+//!
+//! Vertex–triangle only: two edges crossing without a vertex passing a face are not
+//! detected. A sheet must be thicker than `δ`. Self collision excludes the triangles of the
+//! particle's tetrahedron neighbours, and has no deep-overlap recovery (a body already
+//! folded through itself stays so).
+
+use hecs::World;
+use tetpbd::SubstepHook;
+
+use crate::error::CouplingError;
+use crate::soft_gather::{ContactFrame, Gather};
+
+/// Opt-in marker component: this soft body also collides with itself (surface particles
+/// against its own surface triangles, excluding those of their tetrahedron neighbours).
+/// A body without it pays nothing for self collision.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SelfCollision;
+
+/// Settings of [`SoftContacts`]. Build with [`SoftContacts::new`] or
+/// [`SoftContacts::set_settings`], which validate them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SoftContactSettings {
+    /// Contact thickness `δ`: the distance kept between a particle and another surface, m
+    /// (> 0). Sheets must be thicker than this.
+    pub thickness: f32,
+    /// Extra candidate distance on top of the motion bound, m (≥ 0).
+    pub margin: f32,
+    /// Acceleration assumed in the motion bound `|v| dt + ½ a dt²`, m/s² (≥ 0); should be at
+    /// least gravity.
+    pub max_acceleration: f32,
+    /// `S`: the largest relative normal speed at which a contact separates two surfaces,
+    /// m/s (> 0). Bounds how fast deep overlaps are resolved (see the module docs).
+    pub max_separation_speed: f32,
+    /// Static friction coefficient between soft bodies (≥ 0, dimensionless).
+    pub static_friction: f32,
+    /// Dynamic friction coefficient between soft bodies (≥ 0, dimensionless).
+    pub dynamic_friction: f32,
+    /// Contact compliance, m/N (≥ 0; 0 = hard contact).
+    pub compliance: f32,
+}
+
+impl Default for SoftContactSettings {
+    fn default() -> Self {
+        SoftContactSettings {
+            thickness: 0.005,
+            margin: 0.01,
+            max_acceleration: 20.0,
+            max_separation_speed: 2.0,
+            static_friction: 0.5,
+            dynamic_friction: 0.4,
+            compliance: 0.0,
+        }
+    }
+}
+
+impl SoftContactSettings {
+    /// Checks every field; the first bad one is returned.
+    pub fn validate(&self) -> Result<(), CouplingError> {
+        let fields = [
+            ("thickness (m)", self.thickness, false),
+            ("margin (m)", self.margin, true),
+            ("max_acceleration (m/s²)", self.max_acceleration, true),
+            (
+                "max_separation_speed (m/s)",
+                self.max_separation_speed,
+                false,
+            ),
+            ("static_friction", self.static_friction, true),
+            ("dynamic_friction", self.dynamic_friction, true),
+            ("compliance (m/N)", self.compliance, true),
+        ];
+        for (name, value, zero_ok) in fields {
+            let ok = value.is_finite() && (value > 0.0 || (zero_ok && value == 0.0));
+            if !ok {
+                return Err(CouplingError::BadSetting { name, value });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What [`SoftContacts`] did in the last frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SoftContactStats {
+    /// Soft bodies taking part (with particles, surface and tetrahedra).
+    pub bodies: usize,
+    /// Body pairs whose motion-grown AABBs overlap (the broad phase's output).
+    pub body_pairs: usize,
+    /// Bodies colliding with themselves.
+    pub self_bodies: usize,
+    /// Particle–triangle candidates gathered for the frame.
+    pub candidates: usize,
+    /// Candidates whose constraint was violated and projected at least once.
+    pub contacts: usize,
+    /// Surface particles that started the frame inside another body (deep-overlap
+    /// contacts).
+    pub deep: usize,
+    /// Largest depth of a contact particle below its triangle at the end of the frame, m.
+    pub max_penetration: f32,
+    /// Substep-contacts whose separation was limited to `max_separation_speed`.
+    pub clamps: u64,
+    /// Projections skipped because a triangle was degenerate or a result not finite.
+    pub degenerate: u64,
+    /// Bodies skipped because their mesh refers to missing particles or a position is not
+    /// finite.
+    pub skipped_bodies: usize,
+}
+
+/// Soft–soft and self collision of the `tetpbd` bodies of a world, run inside the soft
+/// solver's substeps (see the module docs of `soft_contact` for the constraint, the
+/// candidates and the deep-overlap bound).
+///
+/// ```
+/// use tetpbd::{generators, Solver, SolverSettings, SoftBodyBuilder};
+/// use tetpbd_rapier::{SoftContactSettings, SoftContacts};
+///
+/// let mut world = hecs::World::new();
+/// let mesh = generators::box_grid(nalgebra::Vector3::repeat(0.5), [2, 2, 2], generators::CellSplit::Six)?;
+/// for y in [0.0, 0.51] {
+///     SoftBodyBuilder::new(mesh.clone())
+///         .edges(0.0)
+///         .volume(0.0)
+///         .translation(nalgebra::Vector3::new(0.0, y, 0.0))
+///         .build()?
+///         .spawn(&mut world);
+/// }
+/// let mut solver = Solver::new(SolverSettings::default())?;
+/// let mut contacts = SoftContacts::new(SoftContactSettings::default())?;
+/// solver.step_with(&mut world, &mut contacts)?;
+/// assert_eq!(contacts.stats().body_pairs, 1);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+///
+/// With the rigid coupling, chain it after the coupling's hook: `(coupling_hook, &mut
+/// contacts)` is itself a [`SubstepHook`].
+pub struct SoftContacts {
+    settings: SoftContactSettings,
+    gather: Gather,
+    frame: ContactFrame,
+    stats: SoftContactStats,
+}
+
+impl SoftContacts {
+    /// Soft contacts with validated settings.
+    pub fn new(settings: SoftContactSettings) -> Result<Self, CouplingError> {
+        settings.validate()?;
+        Ok(SoftContacts {
+            settings,
+            gather: Gather::default(),
+            frame: ContactFrame::default(),
+            stats: SoftContactStats::default(),
+        })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &SoftContactSettings {
+        &self.settings
+    }
+
+    /// Replaces the settings after validating them (from the next frame on).
+    pub fn set_settings(&mut self, settings: SoftContactSettings) -> Result<(), CouplingError> {
+        settings.validate()?;
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// Statistics of the last frame.
+    pub fn stats(&self) -> &SoftContactStats {
+        &self.stats
+    }
+}
+
+impl std::fmt::Debug for SoftContacts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SoftContacts")
+            .field("settings", &self.settings)
+            .field("stats", &self.stats)
+            .finish_non_exhaustive()
+    }
+}
+
+impl SubstepHook for SoftContacts {
+    fn begin_frame(&mut self, world: &mut World, dt: f32) {
+        self.stats = SoftContactStats::default();
+        self.gather
+            .run(world, dt, &self.settings, &mut self.frame, &mut self.stats);
+    }
+
+    fn begin_substep(&mut self, world: &mut World, _h: f32) {
+        self.frame
+            .begin_substep(world, &self.gather, &self.settings);
+    }
+
+    fn project(&mut self, world: &mut World, h: f32) {
+        self.frame
+            .project(world, &self.gather, &self.settings, h, &mut self.stats);
+    }
+
+    fn end_substep(&mut self, world: &mut World, _h: f32) {
+        self.frame.velocity_pass(world, &self.gather);
+    }
+
+    fn end_frame(&mut self, world: &mut World, _dt: f32) {
+        self.frame.finish(world, &self.gather, &mut self.stats);
+    }
+}

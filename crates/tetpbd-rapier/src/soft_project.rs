@@ -1,0 +1,298 @@
+//! Per-substep work of soft–soft contacts: the XPBD vertex–triangle projection with
+//! friction, the velocity pass and the end-of-frame statistics (see
+//! [`crate::SoftContacts`] for the equations).
+
+use hecs::World;
+use nalgebra::Vector3;
+use tetpbd::Particles;
+
+use crate::convert::finite3;
+use crate::soft_bvh::{closest_barycentric, plane_barycentric, triangle_normal};
+use crate::soft_contact::{SoftContactSettings, SoftContactStats};
+use crate::soft_gather::{Candidate, ContactFrame, Gather};
+
+/// How far (in barycentric units) a particle's projection may lie outside a triangle and
+/// still count as inside its prism; closes the gaps between the prisms of a convex edge.
+const PRISM_TOLERANCE: f32 = 0.02;
+
+/// Which per-particle array a load or store touches.
+#[derive(Clone, Copy)]
+enum Field {
+    Position,
+    SubstepStart,
+    Velocity,
+}
+
+impl ContactFrame {
+    /// Copies `field` of every involved body's surface particles into the slots.
+    fn load(&mut self, world: &mut World, g: &Gather, field: Field) {
+        for b in g.bodies.iter().filter(|b| b.involved) {
+            let Ok(p) = world.query_one_mut::<&Particles>(b.entity) else {
+                continue;
+            };
+            let src = match field {
+                Field::Position => p.positions(),
+                Field::SubstepStart => p.prev_positions(),
+                Field::Velocity => p.velocities(),
+            };
+            let dst = match field {
+                Field::Position => &mut self.x,
+                Field::SubstepStart => &mut self.x_prev,
+                Field::Velocity => &mut self.v,
+            };
+            for (k, &i) in g.cache(b).vertices.iter().enumerate() {
+                if let Some(v) = src.get(i as usize) {
+                    dst[b.offset + k] = *v;
+                }
+            }
+        }
+    }
+
+    /// Writes the slots back (finite values only) into positions or velocities.
+    fn store(&self, world: &mut World, g: &Gather, field: Field) -> u64 {
+        let mut rejected = 0;
+        for b in g.bodies.iter().filter(|b| b.involved) {
+            let Ok(p) = world.query_one_mut::<&mut Particles>(b.entity) else {
+                continue;
+            };
+            let (src, dst) = match field {
+                Field::Velocity => (&self.v, p.velocities_mut()),
+                _ => (&self.x, p.positions_mut()),
+            };
+            for (k, &i) in g.cache(b).vertices.iter().enumerate() {
+                let v = src[b.offset + k];
+                match dst.get_mut(i as usize) {
+                    Some(d) if finite3(&v) => *d = v,
+                    Some(_) => rejected += 1,
+                    None => {}
+                }
+            }
+        }
+        rejected
+    }
+
+    /// Substep start: record each candidate's distance to its triangle's plane and reset
+    /// its multipliers.
+    pub fn begin_substep(&mut self, world: &mut World, g: &Gather, s: &SoftContactSettings) {
+        if self.candidates.is_empty() {
+            return;
+        }
+        self.load(world, g, Field::SubstepStart);
+        let x = &self.x_prev;
+        for c in &mut self.candidates {
+            let [a, b, t] = c.tri.map(|i| x[i as usize]);
+            c.d_prev = match triangle_normal(&a, &b, &t) {
+                Some(n) => (x[c.p as usize] - a).dot(&n),
+                None => s.thickness,
+            };
+            c.lambda_n = 0.0;
+            c.lambda_t = 0.0;
+            c.active = false;
+            c.clamped = false;
+        }
+    }
+
+    /// One Gauss–Seidel sweep over the candidates.
+    pub fn project(
+        &mut self,
+        world: &mut World,
+        g: &Gather,
+        s: &SoftContactSettings,
+        h: f32,
+        stats: &mut SoftContactStats,
+    ) {
+        if self.candidates.is_empty() {
+            return;
+        }
+        self.load(world, g, Field::Position);
+        let alpha_tilde = s.compliance / (h * h);
+        let step = s.max_separation_speed * h;
+        let ContactFrame {
+            x,
+            x_prev,
+            w,
+            candidates,
+            ..
+        } = self;
+        for c in candidates.iter_mut() {
+            match project_one(c, x, x_prev, w, s, alpha_tilde, step) {
+                Outcome::Degenerate => stats.degenerate += 1,
+                Outcome::Clamped => stats.clamps += 1,
+                Outcome::Done => {}
+            }
+        }
+        stats.degenerate += self.store(world, g, Field::Position);
+    }
+
+    /// After the velocity update: removes the separating normal velocity of every contact
+    /// projected in the substep (restitution 0).
+    pub fn velocity_pass(&mut self, world: &mut World, g: &Gather) {
+        if !self.candidates.iter().any(|c| c.active) {
+            return;
+        }
+        self.load(world, g, Field::Velocity);
+        let ContactFrame {
+            v, w, candidates, ..
+        } = self;
+        for c in candidates.iter().filter(|c| c.active) {
+            let (p, n, bary) = (c.p as usize, c.n, c.bary);
+            let tri = c.tri.map(|i| i as usize);
+            let vq: Vector3<f32> = (0..3).map(|k| v[tri[k]] * bary[k]).sum();
+            let vn = n.dot(&(v[p] - vq));
+            let wsum = w[p] + (0..3).map(|k| bary[k] * bary[k] * w[tri[k]]).sum::<f32>();
+            if !(vn > 0.0 && wsum > 0.0) {
+                continue;
+            }
+            let j = -vn / wsum;
+            v[p] += n * (w[p] * j);
+            for k in 0..3 {
+                v[tri[k]] -= n * (w[tri[k]] * bary[k] * j);
+            }
+        }
+        self.store(world, g, Field::Velocity);
+    }
+
+    /// End of frame: contact count and the largest penetration at the final positions.
+    pub fn finish(&mut self, world: &mut World, g: &Gather, stats: &mut SoftContactStats) {
+        stats.contacts = self.candidates.iter().filter(|c| c.ever).count();
+        if self.candidates.is_empty() {
+            return;
+        }
+        self.load(world, g, Field::Position);
+        let mut pen = 0.0f32;
+        for c in &self.candidates {
+            let p = self.x[c.p as usize];
+            let [a, b, t] = c.tri.map(|i| self.x[i as usize]);
+            let Some(n) = triangle_normal(&a, &b, &t) else {
+                continue;
+            };
+            let d = (p - a).dot(&n);
+            let counted = if c.recovery {
+                true
+            } else {
+                let bw = plane_barycentric(&p, &a, &b, &t, &n);
+                d > -c.depth_limit && bw.iter().all(|&v| v >= -PRISM_TOLERANCE)
+            };
+            if counted && d.is_finite() {
+                pen = pen.max(-d);
+            }
+        }
+        stats.max_penetration = pen.max(0.0);
+    }
+}
+
+enum Outcome {
+    Done,
+    Clamped,
+    Degenerate,
+}
+
+/// Projects one candidate (see the module docs of `soft_contact`).
+fn project_one(
+    c: &mut Candidate,
+    x: &mut [Vector3<f32>],
+    x_prev: &[Vector3<f32>],
+    w: &[f32],
+    s: &SoftContactSettings,
+    alpha_tilde: f32,
+    step: f32,
+) -> Outcome {
+    let p = c.p as usize;
+    let tri = c.tri.map(|i| i as usize);
+    let [a, b, t] = tri.map(|i| x[i]);
+    let xp = x[p];
+    let Some(n) = triangle_normal(&a, &b, &t) else {
+        return Outcome::Degenerate;
+    };
+    let d = (xp - a).dot(&n);
+    let bary = if c.recovery {
+        closest_barycentric(&xp, &a, &b, &t)
+    } else {
+        if d < -c.depth_limit {
+            return Outcome::Done;
+        }
+        let bw = plane_barycentric(&xp, &a, &b, &t, &n);
+        if bw.iter().any(|&v| v < -PRISM_TOLERANCE) {
+            return Outcome::Done;
+        }
+        let bw = bw.map(|v| v.max(0.0));
+        let sum: f32 = bw.iter().sum();
+        if sum.is_nan() || sum <= 0.0 {
+            return Outcome::Degenerate;
+        }
+        bw.map(|v| v / sum)
+    };
+    let q = a * bary[0] + b * bary[1] + t * bary[2];
+    let dist = (xp - q).dot(&n);
+    let target = s.thickness.min(c.d_prev + step);
+    let cval = dist - target;
+    if cval.is_nan() || cval >= 0.0 {
+        return Outcome::Done;
+    }
+    let wp = w[p];
+    let wsum = wp + (0..3).map(|k| bary[k] * bary[k] * w[tri[k]]).sum::<f32>();
+    let denom = wsum + alpha_tilde;
+    if !(wsum > 0.0 && denom.is_finite()) {
+        return Outcome::Done;
+    }
+    let mut dl = (-cval - alpha_tilde * c.lambda_n) / denom;
+    if c.lambda_n + dl < 0.0 {
+        dl = -c.lambda_n;
+    }
+    if !dl.is_finite() {
+        return Outcome::Degenerate;
+    }
+    x[p] += n * (wp * dl);
+    for k in 0..3 {
+        x[tri[k]] -= n * (w[tri[k]] * bary[k] * dl);
+    }
+    c.lambda_n += dl;
+    c.active = true;
+    c.ever = true;
+    c.n = n;
+    c.bary = bary;
+    friction(c, x, x_prev, w, s, wsum);
+    let clamped = target < s.thickness && !c.clamped;
+    if clamped {
+        c.clamped = true;
+        Outcome::Clamped
+    } else {
+        Outcome::Done
+    }
+}
+
+/// Positional Coulomb friction of one projected contact (Müller et al. 2020).
+fn friction(
+    c: &mut Candidate,
+    x: &mut [Vector3<f32>],
+    x_prev: &[Vector3<f32>],
+    w: &[f32],
+    s: &SoftContactSettings,
+    wsum: f32,
+) {
+    let p = c.p as usize;
+    let tri = c.tri.map(|i| i as usize);
+    let (n, bary) = (c.n, c.bary);
+    let dq: Vector3<f32> = (0..3).map(|k| (x[tri[k]] - x_prev[tri[k]]) * bary[k]).sum();
+    let dp = (x[p] - x_prev[p]) - dq;
+    let dpt = dp - n * n.dot(&dp);
+    let len = dpt.norm();
+    if len.is_nan() || len <= 1e-9 || !len.is_finite() {
+        return;
+    }
+    let dir = dpt / len;
+    let full = len / wsum;
+    let applied = if c.lambda_t + full <= s.static_friction * c.lambda_n {
+        full
+    } else {
+        full.min((s.dynamic_friction * c.lambda_n - c.lambda_t).max(0.0))
+    };
+    if applied.is_nan() || applied <= 0.0 {
+        return;
+    }
+    x[p] -= dir * (w[p] * applied);
+    for k in 0..3 {
+        x[tri[k]] += dir * (w[tri[k]] * bary[k] * applied);
+    }
+    c.lambda_t += applied;
+}
