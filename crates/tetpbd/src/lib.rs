@@ -30,6 +30,7 @@ pub mod constraint;
 mod error;
 mod families;
 pub mod generators;
+mod lanes;
 mod mesh;
 pub mod ordering;
 #[cfg(feature = "parallel")]

@@ -9,13 +9,13 @@ use rayon::prelude::*;
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::mesh::Tetrahedra;
 use crate::particles::Particles;
-use crate::projection::{self, ParticleAccess};
-use crate::systems::ProjectionCount;
+use crate::projection::ParticleAccess;
+use crate::systems::{edge_run, vertex_face_run, volume_run, Kernel, ProjectionCount};
 
 /// Bodies with fewer constraints in a family than this take the serial path.
 pub(crate) const MIN_PARALLEL: usize = 4096;
 
-/// Items per rayon task.
+/// Items per rayon task (a multiple of the SIMD lanes).
 const CHUNK: usize = 256;
 
 /// Shared access for the projections of one colour class.
@@ -76,13 +76,14 @@ impl ParticleAccess for SharedAccess {
     }
 }
 
-/// Runs `f` over the items of every class: independent classes in parallel chunks,
-/// the overflow class serially.
+/// Runs `f` over every class: independent classes split into chunks of [`CHUNK`] items
+/// run in parallel, the overflow class serially. `f` gets the access, the run's first item
+/// index, the run's multipliers and whether the run is independent.
 fn sweep<T: Send>(
     classes: &crate::ordering::ColourClasses,
     items: &mut [T],
     acc: SharedAccess,
-    f: impl Fn(&mut SharedAccess, usize, &mut T) -> ProjectionCount + Sync,
+    f: impl Fn(&mut SharedAccess, usize, &mut [T], bool) -> ProjectionCount + Sync,
 ) -> ProjectionCount {
     let mut total = ProjectionCount::default();
     for (range, independent) in classes.ranges() {
@@ -92,43 +93,37 @@ fn sweep<T: Send>(
             total += class
                 .par_chunks_mut(CHUNK)
                 .enumerate()
-                .map(|(c, chunk)| {
-                    let mut a = acc;
-                    let mut n = ProjectionCount::default();
-                    for (k, item) in chunk.iter_mut().enumerate() {
-                        n += f(&mut a, start + c * CHUNK + k, item);
-                    }
-                    n
-                })
+                .map(|(c, chunk)| f(&mut { acc }, start + c * CHUNK, chunk, true))
                 .reduce(ProjectionCount::default, |mut a, b| {
                     a += b;
                     a
                 });
         } else {
-            let mut a = acc;
-            for (k, item) in class.iter_mut().enumerate() {
-                total += f(&mut a, start + k, item);
-            }
+            total += f(&mut { acc }, start, class, false);
         }
     }
     total
-}
-
-fn one(o: projection::Outcome) -> ProjectionCount {
-    let mut c = ProjectionCount::default();
-    c.add(o);
-    c
 }
 
 pub(crate) fn edges(
     p: &mut Particles,
     e: &mut EdgeConstraints,
     alpha_tilde: f32,
+    kernel: Kernel,
 ) -> ProjectionCount {
     let acc = SharedAccess::new(p);
     let (edges, rest) = (&e.edges, &e.rest_lengths);
-    sweep(&e.classes, &mut e.lambdas, acc, |a, k, lambda| {
-        one(projection::edge(a, edges[k], rest[k], lambda, alpha_tilde))
+    sweep(&e.classes, &mut e.lambdas, acc, |a, s, lam, ind| {
+        let r = s..s + lam.len();
+        edge_run(
+            a,
+            &edges[r.clone()],
+            &rest[r],
+            lam,
+            alpha_tilde,
+            kernel,
+            ind,
+        )
     })
 }
 
@@ -137,16 +132,13 @@ pub(crate) fn volume(
     tets: &Tetrahedra,
     vol: &mut VolumeConstraints,
     alpha_tilde: f32,
+    kernel: Kernel,
 ) -> ProjectionCount {
     let acc = SharedAccess::new(p);
-    sweep(&tets.classes, &mut vol.lambdas, acc, |a, t, lambda| {
-        one(projection::volume(
-            a,
-            tets.indices[t],
-            tets.rest_volumes[t],
-            lambda,
-            alpha_tilde,
-        ))
+    sweep(&tets.classes, &mut vol.lambdas, acc, |a, s, lam, ind| {
+        let r = s..s + lam.len();
+        let (t, rest) = (&tets.indices[r.clone()], &tets.rest_volumes[r]);
+        volume_run(a, t, rest, lam, alpha_tilde, kernel, ind)
     })
 }
 
@@ -155,15 +147,20 @@ pub(crate) fn vertex_face(
     tets: &Tetrahedra,
     vf: &mut VertexFaceConstraints,
     alpha_tilde: f32,
+    kernel: Kernel,
 ) -> ProjectionCount {
     let acc = SharedAccess::new(p);
     let heights = &vf.rest_heights;
-    sweep(&tets.classes, &mut vf.lambdas, acc, |a, t, lambdas| {
-        let (applied, degenerate) =
-            projection::vertex_face(a, tets.indices[t], &heights[t], lambdas, alpha_tilde);
-        ProjectionCount {
-            applied: u64::from(applied),
-            degenerate: u64::from(degenerate),
-        }
+    sweep(&tets.classes, &mut vf.lambdas, acc, |a, s, lam, ind| {
+        let r = s..s + lam.len();
+        vertex_face_run(
+            a,
+            &tets.indices[r.clone()],
+            &heights[r],
+            lam,
+            alpha_tilde,
+            kernel,
+            ind,
+        )
     })
 }

@@ -34,6 +34,8 @@ pub struct SolverSettings {
     /// [`systems::update_velocities`]; clamps are counted in
     /// [`StepStats::velocity_clamps`].
     pub max_correction_speed: Option<f32>,
+    /// Scalar or SIMD projection kernels (default SIMD; they agree to rounding).
+    pub kernel: systems::Kernel,
     /// Evaluate every constraint after the step to fill [`crate::FamilyStats::after`] and
     /// [`StepStats::inverted`]. Costs about one extra sweep; off by default.
     pub measure_error: bool,
@@ -51,6 +53,7 @@ impl Default for SolverSettings {
             damping: 0.0,
             order: Family::ALL,
             max_correction_speed: None,
+            kernel: systems::Kernel::Simd,
             measure_error: false,
             measure_before: false,
         }
@@ -226,9 +229,9 @@ impl Solver {
                 for family in s.order {
                     let t = Instant::now();
                     let c = match family {
-                        Family::Edge => systems::project_edges(world, h),
-                        Family::VertexFace => systems::project_vertex_face(world, h),
-                        Family::Volume => systems::project_volume(world, h),
+                        Family::Edge => systems::project_edges_with(world, h, s.kernel),
+                        Family::VertexFace => systems::project_vertex_face_with(world, h, s.kernel),
+                        Family::Volume => systems::project_volume_with(world, h, s.kernel),
                     };
                     let f = stats.family_mut(family);
                     f.time += t.elapsed();

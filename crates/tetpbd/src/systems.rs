@@ -10,9 +10,10 @@ use nalgebra::Vector3;
 
 use crate::constraint::{self, VERTEX_FACE_ORDER};
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::lanes;
 use crate::mesh::Tetrahedra;
 use crate::particles::{ExternalAcceleration, Particles};
-use crate::projection::{self, SliceAccess};
+use crate::projection::{self, ParticleAccess, SliceAccess};
 use crate::stats::{ErrorAccumulator, ErrorStats};
 
 /// Projections done and skipped by one call of a family system.
@@ -99,28 +100,183 @@ pub fn reset_lambdas(world: &mut World) {
     }
 }
 
+/// Which kernels the projections run on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Kernel {
+    /// One constraint at a time: the reference.
+    Scalar,
+    /// Eight independent constraints of a colour class at once (`wide::f32x8`), the rest
+    /// and the overflow class on the scalar kernel. Agrees with [`Kernel::Scalar`] to
+    /// rounding.
+    #[default]
+    Simd,
+}
+
+/// Projects a run of constraints of one colour class: in chunks of eight lanes when the
+/// class is independent and the kernel is SIMD, the rest one by one.
+macro_rules! run_class {
+    ($kernel:expr, $independent:expr, $len:expr, |$s:ident, $e:ident| $lanes:expr, |$k:ident| $scalar:expr) => {{
+        let mut count = ProjectionCount::default();
+        let mut start = 0;
+        if $kernel == Kernel::Simd && $independent {
+            while start + lanes::LANES <= $len {
+                let ($s, $e) = (start, start + lanes::LANES);
+                count += $lanes;
+                start += lanes::LANES;
+            }
+        }
+        for $k in start..$len {
+            count += $scalar;
+        }
+        count
+    }};
+}
+
+/// Edges `edges[i]` with their rest lengths and multipliers, all of one colour class.
+pub(crate) fn edge_run<A: ParticleAccess>(
+    acc: &mut A,
+    edges: &[[u32; 2]],
+    rest: &[f32],
+    lambdas: &mut [f32],
+    alpha_tilde: f32,
+    kernel: Kernel,
+    independent: bool,
+) -> ProjectionCount {
+    run_class!(
+        kernel,
+        independent,
+        edges.len(),
+        |s, e| lanes::edges(
+            acc,
+            &edges[s..e],
+            &rest[s..e],
+            &mut lambdas[s..e],
+            alpha_tilde
+        ),
+        |k| one(projection::edge(
+            acc,
+            edges[k],
+            rest[k],
+            &mut lambdas[k],
+            alpha_tilde
+        ))
+    )
+}
+
+/// Volume constraints of a run of tetrahedra of one colour class.
+pub(crate) fn volume_run<A: ParticleAccess>(
+    acc: &mut A,
+    tets: &[[u32; 4]],
+    rest: &[f32],
+    lambdas: &mut [f32],
+    alpha_tilde: f32,
+    kernel: Kernel,
+    independent: bool,
+) -> ProjectionCount {
+    run_class!(
+        kernel,
+        independent,
+        tets.len(),
+        |s, e| lanes::volumes(
+            acc,
+            &tets[s..e],
+            &rest[s..e],
+            &mut lambdas[s..e],
+            alpha_tilde
+        ),
+        |k| one(projection::volume(
+            acc,
+            tets[k],
+            rest[k],
+            &mut lambdas[k],
+            alpha_tilde
+        ))
+    )
+}
+
+/// Vertex–face constraints of a run of tetrahedra of one colour class.
+pub(crate) fn vertex_face_run<A: ParticleAccess>(
+    acc: &mut A,
+    tets: &[[u32; 4]],
+    heights: &[[f32; 4]],
+    lambdas: &mut [[f32; 4]],
+    alpha_tilde: f32,
+    kernel: Kernel,
+    independent: bool,
+) -> ProjectionCount {
+    run_class!(
+        kernel,
+        independent,
+        tets.len(),
+        |s, e| lanes::vertex_faces(
+            acc,
+            &tets[s..e],
+            &heights[s..e],
+            &mut lambdas[s..e],
+            alpha_tilde
+        ),
+        |k| {
+            let (a, d) =
+                projection::vertex_face(acc, tets[k], &heights[k], &mut lambdas[k], alpha_tilde);
+            ProjectionCount {
+                applied: u64::from(a),
+                degenerate: u64::from(d),
+            }
+        }
+    )
+}
+
+fn one(o: projection::Outcome) -> ProjectionCount {
+    let mut c = ProjectionCount::default();
+    c.add(o);
+    c
+}
+
+/// One Gauss–Seidel sweep over every body's [`EdgeConstraints`] with the default kernel.
+pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
+    project_edges_with(world, h, Kernel::default())
+}
+
 /// One Gauss–Seidel sweep over every body's [`EdgeConstraints`], in solver (colour) order.
 ///
 /// A zero-length edge (`|p0 − p1| < 1e-6 d`) is pushed apart along its rest-pose direction
 /// and counted as degenerate. With the `parallel` feature, the edges of one colour class
 /// (which share no particle) are projected concurrently; the result is bit-identical to the
 /// serial sweep.
-pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
+pub fn project_edges_with(world: &mut World, h: f32, kernel: Kernel) -> ProjectionCount {
     let mut count = ProjectionCount::default();
     for (p, e) in world.query_mut::<(&mut Particles, &mut EdgeConstraints)>() {
         let alpha_tilde = e.compliance / (h * h);
         #[cfg(feature = "parallel")]
         if e.edges.len() >= crate::parallel::MIN_PARALLEL {
-            count += crate::parallel::edges(p, e, alpha_tilde);
+            count += crate::parallel::edges(p, e, alpha_tilde, kernel);
             continue;
         }
         let mut acc = access(p);
-        let edges = e.edges.iter().zip(&e.rest_lengths).zip(&mut e.lambdas);
-        for ((&edge, &d), lambda) in edges {
-            count.add(projection::edge(&mut acc, edge, d, lambda, alpha_tilde));
+        for (r, independent) in e.classes.ranges() {
+            let (edges, rest, lambdas) = (
+                &e.edges[r.clone()],
+                &e.rest_lengths[r.clone()],
+                &mut e.lambdas[r],
+            );
+            count += edge_run(
+                &mut acc,
+                edges,
+                rest,
+                lambdas,
+                alpha_tilde,
+                kernel,
+                independent,
+            );
         }
     }
     count
+}
+
+/// One sweep over every body's [`VertexFaceConstraints`] with the default kernel.
+pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
+    project_vertex_face_with(world, h, Kernel::default())
 }
 
 /// One Gauss–Seidel sweep over every body's [`VertexFaceConstraints`]: the four constraints
@@ -130,7 +286,7 @@ pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
 /// fallback: `p1` is held at its rest height above `p0` along the face's rest-pose normal.
 /// That constraint is linear in `p0` and `p1`, always defined, and re-expands a tetrahedron
 /// collapsed to a point or a line.
-pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
+pub fn project_vertex_face_with(world: &mut World, h: f32, kernel: Kernel) -> ProjectionCount {
     let mut count = ProjectionCount::default();
     for (p, tets, vf) in
         world.query_mut::<(&mut Particles, &Tetrahedra, &mut VertexFaceConstraints)>()
@@ -138,45 +294,48 @@ pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
         let alpha_tilde = vf.compliance / (h * h);
         #[cfg(feature = "parallel")]
         if tets.len() >= crate::parallel::MIN_PARALLEL {
-            count += crate::parallel::vertex_face(p, tets, vf, alpha_tilde);
+            count += crate::parallel::vertex_face(p, tets, vf, alpha_tilde, kernel);
             continue;
         }
         let mut acc = access(p);
-        let items = tets
-            .indices
-            .iter()
-            .zip(&vf.rest_heights)
-            .zip(&mut vf.lambdas);
-        for ((&tet, heights), lambdas) in items {
-            let (a, d) = projection::vertex_face(&mut acc, tet, heights, lambdas, alpha_tilde);
-            count.applied += u64::from(a);
-            count.degenerate += u64::from(d);
+        for (r, independent) in tets.classes.ranges() {
+            let (t, hgt, lam) = (
+                &tets.indices[r.clone()],
+                &vf.rest_heights[r.clone()],
+                &mut vf.lambdas[r],
+            );
+            count += vertex_face_run(&mut acc, t, hgt, lam, alpha_tilde, kernel, independent);
         }
     }
     count
 }
 
+/// One sweep over every body's [`VolumeConstraints`] with the default kernel.
+pub fn project_volume(world: &mut World, h: f32) -> ProjectionCount {
+    project_volume_with(world, h, Kernel::default())
+}
+
 /// One Gauss–Seidel sweep over every body's [`VolumeConstraints`], in solver (colour)
 /// order. A tetrahedron whose gradients vanish (all four points collinear) is skipped and
 /// counted.
-pub fn project_volume(world: &mut World, h: f32) -> ProjectionCount {
+pub fn project_volume_with(world: &mut World, h: f32, kernel: Kernel) -> ProjectionCount {
     let mut count = ProjectionCount::default();
     for (p, tets, vol) in world.query_mut::<(&mut Particles, &Tetrahedra, &mut VolumeConstraints)>()
     {
         let alpha_tilde = vol.compliance / (h * h);
         #[cfg(feature = "parallel")]
         if tets.len() >= crate::parallel::MIN_PARALLEL {
-            count += crate::parallel::volume(p, tets, vol, alpha_tilde);
+            count += crate::parallel::volume(p, tets, vol, alpha_tilde, kernel);
             continue;
         }
         let mut acc = access(p);
-        let items = tets
-            .indices
-            .iter()
-            .zip(&tets.rest_volumes)
-            .zip(&mut vol.lambdas);
-        for ((&tet, &v), lambda) in items {
-            count.add(projection::volume(&mut acc, tet, v, lambda, alpha_tilde));
+        for (r, independent) in tets.classes.ranges() {
+            let (t, rest, lam) = (
+                &tets.indices[r.clone()],
+                &tets.rest_volumes[r.clone()],
+                &mut vol.lambdas[r],
+            );
+            count += volume_run(&mut acc, t, rest, lam, alpha_tilde, kernel, independent);
         }
     }
     count

@@ -12,7 +12,8 @@ use std::time::Instant;
 
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
-use tetpbd::{systems, Particles, SoftBodyBuilder};
+use tetpbd::systems::{self, Kernel};
+use tetpbd::{Particles, SoftBodyBuilder};
 
 fn arg(name: &str, default: usize) -> usize {
     let args: Vec<String> = std::env::args().collect();
@@ -39,8 +40,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         mesh.tets.len(),
         mesh.vertices.len()
     );
-    println!("family        projections/sweep   median ns/projection   min      max");
-    for family in ["edge", "volume", "vertex-face"] {
+    println!("family        kernel  projections/sweep   median ns/projection   min      max");
+    for (family, kernel) in ["edge", "volume", "vertex-face"]
+        .into_iter()
+        .flat_map(|f| [(f, Kernel::Scalar), (f, Kernel::Simd)])
+    {
         let mut world = hecs::World::new();
         let b = SoftBodyBuilder::new(mesh.clone()).density(1000.0);
         let b = match family {
@@ -78,9 +82,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mut n = 0;
             for _ in 0..sweeps {
                 let c = match family {
-                    "edge" => systems::project_edges(&mut world, h),
-                    "volume" => systems::project_volume(&mut world, h),
-                    _ => systems::project_vertex_face(&mut world, h),
+                    "edge" => systems::project_edges_with(&mut world, h, kernel),
+                    "volume" => systems::project_volume_with(&mut world, h, kernel),
+                    _ => systems::project_vertex_face_with(&mut world, h, kernel),
                 };
                 n += c.applied + c.degenerate;
             }
@@ -92,7 +96,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let lo = samples.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = samples.iter().copied().fold(0.0, f64::max);
         println!(
-            "{family:12}  {per_sweep:17}   {:20.1}   {lo:6.1}   {hi:6.1}",
+            "{family:12}  {:6}  {per_sweep:17}   {:20.1}   {lo:6.1}   {hi:6.1}",
+            format!("{kernel:?}"),
             median(&mut samples)
         );
     }

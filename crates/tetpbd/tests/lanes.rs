@@ -1,0 +1,93 @@
+//! The SIMD kernels agree with the scalar reference kernels.
+
+use nalgebra::Vector3;
+use tetpbd::generators::{box_grid, CellSplit};
+use tetpbd::systems::Kernel;
+use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats};
+
+fn run(kernel: Kernel, set: &str, deformed: bool, frames: usize) -> (Vec<Vector3<f32>>, StepStats) {
+    let mut world = hecs::World::new();
+    let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [5, 5, 5], CellSplit::Six).unwrap();
+    let top: Vec<u32> = (0..mesh.vertices.len() as u32)
+        .filter(|&i| mesh.vertices[i as usize].y > 0.49)
+        .collect();
+    let b = SoftBodyBuilder::new(mesh).pinned(top);
+    let b = match set {
+        "edges+volume" => b.edges(1e-6).volume(0.0),
+        _ => b.vertex_face(1e-6).edges(0.0),
+    };
+    let e = b.build().unwrap().spawn(&mut world);
+    if deformed {
+        let mut p = world.get::<&mut Particles>(e).unwrap();
+        for i in 0..p.len() {
+            let x = p.positions()[i];
+            // Sheared and squashed to 60 %: large corrections, no inversion.
+            p.set_position(
+                i,
+                Vector3::new(x.x + 0.1 * x.y, 0.6 * x.y, x.z - 0.05 * x.x),
+            )
+            .unwrap();
+        }
+    }
+    let mut solver = Solver::new(SolverSettings {
+        kernel,
+        measure_error: true,
+        ..Default::default()
+    })
+    .unwrap();
+    let mut stats = StepStats::default();
+    for _ in 0..frames {
+        stats = solver.step(&mut world).unwrap();
+    }
+    let p = world.get::<&Particles>(e).unwrap();
+    (p.positions().to_vec(), stats)
+}
+
+fn compare(set: &str, deformed: bool, frames: usize, tol: f32) {
+    let (a, sa) = run(Kernel::Scalar, set, deformed, frames);
+    let (b, sb) = run(Kernel::Simd, set, deformed, frames);
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).norm())
+        .fold(0.0, f32::max);
+    assert!(
+        worst < tol,
+        "{set}, deformed {deformed}: positions differ by {worst} m"
+    );
+    assert_eq!(sa.inverted, sb.inverted);
+    for (fa, fb) in [
+        (sa.edge, sb.edge),
+        (sa.volume, sb.volume),
+        (sa.vertex_face, sb.vertex_face),
+    ] {
+        assert_eq!(fa.count, fb.count);
+        let d = fa.projections.abs_diff(fb.projections);
+        assert!(
+            d <= fa.projections / 1000,
+            "{set}: projections {} vs {}",
+            fa.projections,
+            fb.projections
+        );
+    }
+}
+
+#[test]
+fn simd_matches_scalar_edges_and_volume() {
+    compare("edges+volume", false, 10, 1e-5);
+}
+
+#[test]
+fn simd_matches_scalar_vertex_face_and_edges() {
+    compare("vertex-face+edges", false, 10, 1e-5);
+}
+
+/// Large corrections (a body sheared and squashed to 60 %). An inverted start is not
+/// compared: a vertex–face flip passes near degenerate faces, where `1/|b × c|` amplifies
+/// rounding differences (measured: 1.6 cm apart after one sweep of a mirrored 5³ grid,
+/// 2.4e-7 m for this deformation); edges and volume are bit-identical even there.
+#[test]
+fn simd_matches_scalar_under_large_corrections() {
+    compare("edges+volume", true, 10, 1e-4);
+    compare("vertex-face+edges", true, 10, 1e-4);
+}
