@@ -243,10 +243,10 @@ impl BodyProxy {
         self.touched = true;
     }
 
-    /// Writes the final pose and velocity back to rapier (the velocity is that of the last
-    /// substep, as in PBD). Returns `false` (and writes nothing) when the result is not
+    /// Writes the final velocity (that of the last substep, as in PBD) and, `with_pose`, the
+    /// final pose back to rapier. Returns `false` (and writes nothing) when the result is not
     /// finite.
-    pub fn write_back(&self, body: &mut RigidBody) -> bool {
+    pub fn write_back(&self, body: &mut RigidBody, with_pose: bool) -> bool {
         if self.kind != BodyKind::Dynamic || !self.touched {
             return true;
         }
@@ -259,7 +259,9 @@ impl BodyProxy {
         if !finite {
             return false;
         }
-        body.set_position(pose_to_glam(&self.pose), true);
+        if with_pose {
+            body.set_position(pose_to_glam(&self.pose), true);
+        }
         body.set_linvel(to_glam(&v), true);
         body.set_angvel(to_glam(&w), true);
         true

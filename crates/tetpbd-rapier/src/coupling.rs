@@ -121,17 +121,21 @@ impl<'a> RapierContext<'a> {
 ///    interpolation of `P₀ → P₁` plus the offset the soft body pushed it by; contacts and
 ///    attachments are XPBD constraints projected after the soft body's own constraints, with
 ///    dynamic bodies taking part through their generalized inverse mass.
-/// 3. The dynamic bodies the soft bodies touched get their final pose and velocity written
-///    back (`P₁` plus offset, rapier's velocity plus the offset's velocity).
+/// 3. The dynamic bodies the soft bodies touched get their final velocity written back
+///    (rapier's plus the offset's). A body touching only soft bodies also gets its final
+///    pose (`P₁` plus offset). A body that rapier's narrow phase reports in contact with
+///    other rigid colliders keeps `P₁`: its soft load arrives as velocity, which rapier's
+///    solver carries through the rigid contacts in the next step. Writing the offset there
+///    would push it into its rigid neighbours, which rapier only pushes out again over
+///    several frames (a soft body on a stack of boxes would slowly squash the stack).
 ///
 /// Who integrates what: rapier integrates rigid bodies under gravity, rigid contacts and
 /// joints; the coupling integrates the soft bodies and the *reaction* of soft contacts and
 /// attachments on rigid bodies, which rapier sees at its next step as an already-moved pose
-/// and changed velocity. Rapier steps first so that the soft bodies see where the rigid
+/// and/or changed velocity. Rapier steps first so that the soft bodies see where the rigid
 /// bodies really are this frame (kinematic platforms carry soft bodies without a frame of
-/// lag); the price is that a soft push on a rigid body is resolved against rigid–rigid
-/// contacts one frame later (a box pressed into the ground by a soft body is pushed out by
-/// rapier at the next step).
+/// lag); the price is that a soft push on a rigid body reaches rigid–rigid contacts one
+/// frame later.
 #[derive(Clone, Debug)]
 pub struct Coupling {
     solver: Solver,
@@ -241,7 +245,12 @@ impl Coupling {
         let mut stats = std::mem::take(&mut self.frame.stats);
         for b in &self.frame.bodies {
             if let Some(rb) = ctx.bodies.get_mut(b.handle) {
-                if !b.write_back(rb) {
+                let rigid_contact = rb.colliders().iter().any(|&c| {
+                    ctx.narrow_phase
+                        .contact_pairs_with(c)
+                        .any(|pair| pair.has_any_active_contact())
+                });
+                if !b.write_back(rb, !rigid_contact) {
                     stats.non_finite_bodies += 1;
                 } else if b.is_dynamic() && b.touched {
                     stats.bodies_written += 1;
