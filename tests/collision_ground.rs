@@ -5,8 +5,8 @@ mod coupling_common;
 use coupling_common::{inverted, particles, run, scene, soft_box};
 use nalgebra::Vector3;
 use rapier3d::geometry::Array2;
-use rapier3d::math::Vector;
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, TriMeshFlags};
+use rapier3d::math::{Pose, Vector};
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, SharedShape, TriMeshFlags};
 use tetpbd_rapier::SoftCollider;
 
 const CELL: f32 = 0.2;
@@ -104,4 +104,37 @@ fn rests_on_heightfield() {
         0.0,
         "heightfield",
     );
+}
+
+#[test]
+fn rests_on_cylinder() {
+    drop_and_rest(
+        ColliderBuilder::cylinder(0.5, 1.0).translation(Vector::new(0.0, -0.5, 0.0)),
+        0.0,
+        "cylinder",
+    );
+}
+
+#[test]
+fn rests_on_round_cuboid() {
+    drop_and_rest(
+        ColliderBuilder::round_cuboid(1.0, 0.4, 1.0, 0.1).translation(Vector::new(0.0, -0.5, 0.0)),
+        0.0,
+        "round cuboid",
+    );
+}
+
+#[test]
+fn rests_on_compound() {
+    let parts = vec![
+        (
+            Pose::translation(-0.6, -0.5, 0.0),
+            SharedShape::cuboid(0.6, 0.5, 1.0),
+        ),
+        (
+            Pose::translation(0.6, -0.5, 0.0),
+            SharedShape::cuboid(0.6, 0.5, 1.0),
+        ),
+    ];
+    drop_and_rest(ColliderBuilder::compound(parts), 0.0, "compound");
 }

@@ -25,7 +25,11 @@ use crate::convert::{inertia_to_na, pose_to_glam, to_glam, to_na};
 pub(crate) enum BodyKind {
     Fixed,
     Kinematic,
+    /// Dynamic, touched only by soft bodies: takes part with its generalized inverse mass.
     Dynamic,
+    /// Dynamic and in contact with other rigid colliders: infinitely heavy inside the soft
+    /// substeps; the soft reaction is summed as an impulse and handed to rapier.
+    Supported,
 }
 
 /// One rigid body during the soft substeps of a frame.
@@ -59,6 +63,10 @@ pub(crate) struct BodyProxy {
     pub prev: Isometry3<f32>,
     /// Whether a soft correction moved the body this frame.
     pub touched: bool,
+    sub_impulse: Vector3<f32>,
+    sub_angular: Vector3<f32>,
+    impulse: Vector3<f32>,
+    angular: Vector3<f32>,
 }
 
 impl BodyProxy {
@@ -68,8 +76,11 @@ impl BodyProxy {
         body: &RigidBody,
         (start, v_start): (Isometry3<f32>, Vector3<f32>),
         dt: f32,
+        supported: bool,
     ) -> Self {
-        let kind = if body.is_dynamic() {
+        let kind = if body.is_dynamic() && supported {
+            BodyKind::Supported
+        } else if body.is_dynamic() {
             BodyKind::Dynamic
         } else if body.is_kinematic() {
             BodyKind::Kinematic
@@ -92,13 +103,13 @@ impl BodyProxy {
                     (end.rotation * start.rotation.inverse()).scaled_axis() / dt,
                 )
             }
-            BodyKind::Dynamic => (
+            BodyKind::Dynamic | BodyKind::Supported => (
                 v_start,
                 v_end,
                 (end.rotation * start.rotation.inverse()).scaled_axis() / dt,
             ),
         };
-        let (inv_mass, inv_inertia) = if kind == BodyKind::Dynamic {
+        let (inv_mass, inv_inertia) = if body.is_dynamic() {
             let mp = body.mass_properties();
             (
                 to_na(mp.effective_inv_mass),
@@ -133,12 +144,16 @@ impl BodyProxy {
             pose: start,
             prev: start,
             touched: false,
+            sub_impulse: Vector3::zeros(),
+            sub_angular: Vector3::zeros(),
+            impulse: Vector3::zeros(),
+            angular: Vector3::zeros(),
         }
     }
 
-    /// `true` for a dynamic body (finite mass).
+    /// `true` for a dynamic body (finite mass in rapier).
     pub fn is_dynamic(&self) -> bool {
-        self.kind == BodyKind::Dynamic
+        matches!(self.kind, BodyKind::Dynamic | BodyKind::Supported)
     }
 
     /// Moves to the end of the next substep; `frac` is its end time as a fraction of the frame.
@@ -199,6 +214,12 @@ impl BodyProxy {
 
     /// Applies a positional impulse `p` (kg·m: direction × Δλ) at the world point `q`.
     pub fn apply_position_impulse(&mut self, p: &Vector3<f32>, q: &Vector3<f32>) {
+        if self.kind == BodyKind::Supported {
+            self.sub_impulse += p;
+            self.sub_angular += (q - self.com()).cross(p);
+            self.touched = true;
+            return;
+        }
         if self.kind != BodyKind::Dynamic {
             return;
         }
@@ -213,6 +234,12 @@ impl BodyProxy {
 
     /// Ends a substep: the offset velocities follow from the offset motion.
     pub fn end_substep(&mut self, h: f32) {
+        if self.kind == BodyKind::Supported {
+            self.impulse += self.sub_impulse / h;
+            self.angular += self.sub_angular / h;
+            self.sub_impulse = Vector3::zeros();
+            self.sub_angular = Vector3::zeros();
+        }
         if self.kind != BodyKind::Dynamic {
             return;
         }
@@ -235,6 +262,12 @@ impl BodyProxy {
 
     /// Applies a velocity impulse `j` (N·s) at the world point `q`.
     pub fn apply_velocity_impulse(&mut self, j: &Vector3<f32>, q: &Vector3<f32>) {
+        if self.kind == BodyKind::Supported {
+            self.impulse += j;
+            self.angular += (q - self.com()).cross(j);
+            self.touched = true;
+            return;
+        }
         if self.kind != BodyKind::Dynamic {
             return;
         }
@@ -243,24 +276,37 @@ impl BodyProxy {
         self.touched = true;
     }
 
-    /// Writes the final velocity (that of the last substep, as in PBD) and, `with_pose`, the
-    /// final pose back to rapier. Returns `false` (and writes nothing) when the result is not
-    /// finite.
-    pub fn write_back(&self, body: &mut RigidBody, with_pose: bool) -> bool {
-        if self.kind != BodyKind::Dynamic || !self.touched {
+    /// Writes the result back to rapier: for a body touched only by soft bodies its final
+    /// pose and velocity (that of the last substep, as in PBD); for a supported body the
+    /// summed soft impulse as a velocity change. Returns `false` (and writes nothing) when the
+    /// result is not finite.
+    pub fn write_back(&self, body: &mut RigidBody) -> bool {
+        if !self.touched {
             return true;
         }
-        // PBD velocity of the last substep: the base's mean velocity over it plus the offset's.
-        let v = self.v_end - (self.v_end - self.v_start) * (0.5 * self.h / self.dt) + self.dv;
-        let w = self.w_end + self.dw;
-        let t = self.pose.translation.vector;
-        let finite = [v, w, t].iter().all(|x| x.iter().all(|c| c.is_finite()))
-            && self.pose.rotation.coords.iter().all(|c| c.is_finite());
+        let (v, w, pose) = match self.kind {
+            BodyKind::Dynamic => (
+                self.v_end - (self.v_end - self.v_start) * (0.5 * self.h / self.dt) + self.dv,
+                self.w_end + self.dw,
+                Some(self.pose),
+            ),
+            BodyKind::Supported => (
+                self.v_end + self.inv_mass.component_mul(&self.impulse),
+                self.w_end + self.inv_inertia * self.angular,
+                None,
+            ),
+            BodyKind::Fixed | BodyKind::Kinematic => return true,
+        };
+        let finite = [v, w].iter().all(|x| x.iter().all(|c| c.is_finite()))
+            && pose.is_none_or(|p| {
+                p.translation.vector.iter().all(|c| c.is_finite())
+                    && p.rotation.coords.iter().all(|c| c.is_finite())
+            });
         if !finite {
             return false;
         }
-        if with_pose {
-            body.set_position(pose_to_glam(&self.pose), true);
+        if let Some(p) = pose {
+            body.set_position(pose_to_glam(&p), true);
         }
         body.set_linvel(to_glam(&v), true);
         body.set_angvel(to_glam(&w), true);

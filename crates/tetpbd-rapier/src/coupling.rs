@@ -121,13 +121,16 @@ impl<'a> RapierContext<'a> {
 ///    interpolation of `P₀ → P₁` plus the offset the soft body pushed it by; contacts and
 ///    attachments are XPBD constraints projected after the soft body's own constraints, with
 ///    dynamic bodies taking part through their generalized inverse mass.
-/// 3. The dynamic bodies the soft bodies touched get their final velocity written back
-///    (rapier's plus the offset's). A body touching only soft bodies also gets its final
-///    pose (`P₁` plus offset). A body that rapier's narrow phase reports in contact with
-///    other rigid colliders keeps `P₁`: its soft load arrives as velocity, which rapier's
-///    solver carries through the rigid contacts in the next step. Writing the offset there
-///    would push it into its rigid neighbours, which rapier only pushes out again over
-///    several frames (a soft body on a stack of boxes would slowly squash the stack).
+/// 3. The dynamic bodies the soft bodies touched get the soft reaction written back. A body
+///    touching only soft bodies took part in the substeps with its generalized inverse mass
+///    and gets its final pose and velocity (`P₁` plus offset; the velocity of the last
+///    substep). A body that rapier's narrow phase reports in contact with other rigid
+///    colliders is *supported*: inside the substeps it is infinitely heavy (it stays on its
+///    `P₀ → P₁` path), and the summed soft impulse and its moment become a velocity change
+///    that rapier's solver carries through the rigid contacts at the next step. Moving such
+///    a body by the offset would push it into its rigid neighbours, which rapier only pushes
+///    out again over several frames (a soft body on a stack of boxes would squash the
+///    stack).
 ///
 /// Who integrates what: rapier integrates rigid bodies under gravity, rigid contacts and
 /// joints; the coupling integrates the soft bodies and the *reaction* of soft contacts and
@@ -236,6 +239,7 @@ impl Coupling {
             let mut hook = CouplingHook {
                 frame: &mut self.frame,
                 qp,
+                narrow_phase: &*ctx.narrow_phase,
                 default_collider: self.settings.default_collider,
                 margin: self.settings.margin,
                 reports: &mut self.reports,
@@ -245,12 +249,7 @@ impl Coupling {
         let mut stats = std::mem::take(&mut self.frame.stats);
         for b in &self.frame.bodies {
             if let Some(rb) = ctx.bodies.get_mut(b.handle) {
-                let rigid_contact = rb.colliders().iter().any(|&c| {
-                    ctx.narrow_phase
-                        .contact_pairs_with(c)
-                        .any(|pair| pair.has_any_active_contact())
-                });
-                if !b.write_back(rb, !rigid_contact) {
+                if !b.write_back(rb) {
                     stats.non_finite_bodies += 1;
                 } else if b.is_dynamic() && b.touched {
                     stats.bodies_written += 1;

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use hecs::{Entity, World};
 use nalgebra::{Isometry3, Vector3};
 use rapier3d::dynamics::{CoefficientCombineRule, RigidBodyHandle, RigidBodySet};
-use rapier3d::geometry::{Aabb, ColliderHandle, ColliderSet};
+use rapier3d::geometry::{Aabb, ColliderHandle, ColliderSet, NarrowPhase};
 use rapier3d::parry::bounding_volume::BoundingVolume;
 use rapier3d::pipeline::QueryPipeline;
 use tetpbd::{Particles, Surface};
@@ -115,6 +115,7 @@ pub(crate) struct Frame {
 /// What candidate gathering needs besides the frame.
 pub(crate) struct GatherInput<'q, 'a> {
     pub qp: &'q QueryPipeline<'a>,
+    pub narrow_phase: &'q NarrowPhase,
     pub default_collider: &'q SoftCollider,
     pub margin: f32,
 }
@@ -142,7 +143,12 @@ impl Frame {
     }
 
     /// The proxy of `handle`, created on first use; `None` when the body does not exist.
-    pub fn body_proxy(&mut self, handle: RigidBodyHandle, bodies: &RigidBodySet) -> Option<usize> {
+    pub fn body_proxy(
+        &mut self,
+        handle: RigidBodyHandle,
+        bodies: &RigidBodySet,
+        narrow_phase: &NarrowPhase,
+    ) -> Option<usize> {
         let key = handle.into_raw_parts();
         if let Some(&i) = self.body_index.get(&key) {
             return Some(i);
@@ -154,7 +160,14 @@ impl Frame {
                 crate::convert::to_na(rb.linvel()),
             )
         });
-        self.bodies.push(BodyProxy::new(handle, rb, start, self.dt));
+        let supported = rb.is_dynamic()
+            && rb.colliders().iter().any(|&c| {
+                narrow_phase
+                    .contact_pairs_with(c)
+                    .any(|pair| pair.has_any_active_contact())
+            });
+        self.bodies
+            .push(BodyProxy::new(handle, rb, start, self.dt, supported));
         self.body_index.insert(key, self.bodies.len() - 1);
         Some(self.bodies.len() - 1)
     }
@@ -164,6 +177,7 @@ impl Frame {
         handle: ColliderHandle,
         bodies: &RigidBodySet,
         colliders: &ColliderSet,
+        narrow_phase: &NarrowPhase,
     ) -> Option<usize> {
         let key = handle.into_raw_parts();
         if let Some(&i) = self.collider_index.get(&key) {
@@ -172,7 +186,7 @@ impl Frame {
         let co = colliders.get(handle)?;
         let (body, local) = match co.parent() {
             Some(parent) => {
-                let b = self.body_proxy(parent, bodies)?;
+                let b = self.body_proxy(parent, bodies, narrow_phase)?;
                 let local = co
                     .position_wrt_parent()
                     .map(pose_to_na)
@@ -248,7 +262,9 @@ impl Frame {
                     .map(|(h, _)| h)
                     .collect();
                 for handle in near {
-                    let Some(ci) = self.collider_proxy(handle, qp.bodies, qp.colliders) else {
+                    let Some(ci) =
+                        self.collider_proxy(handle, qp.bodies, qp.colliders, input.narrow_phase)
+                    else {
                         continue;
                     };
                     let Some(caabb) = self.swept_aabb(ci, qp.colliders) else {
@@ -319,7 +335,7 @@ impl Frame {
                         AttachTarget::Body {
                             handle,
                             local_point,
-                        } => match self.body_proxy(handle, qp.bodies) {
+                        } => match self.body_proxy(handle, qp.bodies, input.narrow_phase) {
                             Some(b) => AttachRun {
                                 particle: a.particle,
                                 body: Some(b),

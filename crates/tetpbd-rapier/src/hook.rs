@@ -1,6 +1,7 @@
 //! The [`tetpbd::SubstepHook`] that runs the coupling inside the soft solver's substeps.
 
 use hecs::World;
+use rapier3d::geometry::NarrowPhase;
 use rapier3d::pipeline::QueryPipeline;
 use tetpbd::{Particles, SubstepHook, Surface};
 
@@ -18,6 +19,7 @@ use crate::shape_query::surface_point;
 pub(crate) struct CouplingHook<'q, 'a> {
     pub frame: &'q mut Frame,
     pub qp: QueryPipeline<'a>,
+    pub narrow_phase: &'a NarrowPhase,
     pub default_collider: SoftCollider,
     pub margin: f32,
     pub reports: &'q mut Vec<ContactReport>,
@@ -33,6 +35,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
     fn begin_frame(&mut self, world: &mut World, _dt: f32) {
         let input = GatherInput {
             qp: &self.qp,
+            narrow_phase: self.narrow_phase,
             default_collider: &self.default_collider,
             margin: self.margin,
         };
