@@ -40,6 +40,7 @@ mod soft_bvh;
 mod soft_contact;
 mod soft_gather;
 mod soft_project;
+mod soft_separation;
 
 pub use attachment::{AttachTarget, Attachment, Attachments};
 pub use coupling::{Coupling, CouplingSettings, RapierContext};

@@ -9,7 +9,7 @@
 use nalgebra::Vector3;
 use rapier3d::parry::bounding_volume::Aabb;
 use rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
-use rapier3d::parry::query::PointProjection;
+use rapier3d::parry::query::{PointProjection, Ray};
 use tetpbd::{Surface, Tetrahedra};
 
 use crate::convert::to_glam;
@@ -181,6 +181,60 @@ impl BodyCache {
     }
 }
 
+impl BodyCache {
+    /// Distance (m) from `x` along the unit direction `dir` to the first surface triangle
+    /// the ray leaves the body through (outward normal · `dir` > 0), triangles at the
+    /// surface-local positions `xs`; `None` when the ray leaves through none.
+    pub fn exit_distance(
+        &self,
+        x: &Vector3<f32>,
+        dir: &Vector3<f32>,
+        xs: &[Vector3<f32>],
+    ) -> Option<f32> {
+        let ray = Ray::new(to_glam(x), to_glam(dir));
+        let tris = &self.triangles;
+        let hit = self.tri_bvh.cast_ray(&ray, f32::MAX, |t, _| {
+            let [a, b, c] = tris.get(t as usize)?.map(|k| xs[k as usize]);
+            let n = triangle_normal(&a, &b, &c)?;
+            if n.dot(dir) <= 0.0 {
+                return None;
+            }
+            ray_triangle(x, dir, &a, &b, &c)
+        })?;
+        Some(hit.1)
+    }
+}
+
+/// Möller–Trumbore: distance along `dir` from `o` to triangle `(a, b, c)`, if hit ahead.
+fn ray_triangle(
+    o: &Vector3<f32>,
+    dir: &Vector3<f32>,
+    a: &Vector3<f32>,
+    b: &Vector3<f32>,
+    c: &Vector3<f32>,
+) -> Option<f32> {
+    let e1 = b - a;
+    let e2 = c - a;
+    let pv = dir.cross(&e2);
+    let det = e1.dot(&pv);
+    if det.abs() <= 1e-12 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let tv = o - a;
+    let u = tv.dot(&pv) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let qv = tv.cross(&e1);
+    let v = dir.dot(&qv) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = e2.dot(&qv) * inv;
+    (t >= 0.0 && t.is_finite()).then_some(t)
+}
+
 /// `true` when `x` lies strictly inside the tetrahedron `t` (either orientation).
 pub(crate) fn in_tet(x: &Vector3<f32>, t: &[Vector3<f32>; 4]) -> bool {
     let vol = |a: &Vector3<f32>, b: &Vector3<f32>, c: &Vector3<f32>, d: &Vector3<f32>| {
@@ -309,6 +363,18 @@ mod tests {
         let p = plane_barycentric(&Vector3::new(2.0, 0.0, 1.0), &a, &b, &c, &n);
         assert!((p[1] - 2.0).abs() < 1e-6 && (p[0] + 1.0).abs() < 1e-6);
         assert!(triangle_normal(&a, &b, &(b * 2.0)).is_none());
+    }
+
+    #[test]
+    fn ray_hits_triangle() {
+        let a = Vector3::new(0.0, 0.0, 1.0);
+        let b = Vector3::new(1.0, 0.0, 1.0);
+        let c = Vector3::new(0.0, 1.0, 1.0);
+        let z = Vector3::z();
+        let t = ray_triangle(&Vector3::new(0.2, 0.2, 0.0), &z, &a, &b, &c);
+        assert!((t.expect("hit") - 1.0).abs() < 1e-6);
+        assert!(ray_triangle(&Vector3::new(0.8, 0.8, 0.0), &z, &a, &b, &c).is_none());
+        assert!(ray_triangle(&Vector3::new(0.2, 0.2, 2.0), &z, &a, &b, &c).is_none());
     }
 
     #[test]

@@ -37,30 +37,37 @@
 //!
 //! # Deep overlap and the speed bound
 //!
-//! A surface particle that starts the frame *inside* another body (strictly inside one of
-//! its tetrahedra) gets one contact with that body's closest surface triangle, active at any
-//! depth. For every contact the separation a substep may produce is bounded: with `d_prev`
-//! the particle's signed distance to the triangle's plane at the start of the substep, the
-//! target is `min(δ, d_prev + S h)`, `S` = [`SoftContactSettings::max_separation_speed`].
+//! Every contact's target is `min(δ, d_prev + S h)`, with `d_prev` the particle's signed
+//! distance to the triangle's plane at the substep start and `S` =
+//! [`SoftContactSettings::max_separation_speed`]: a contact never separates its particle
+//! from its triangle faster than `S`.
 //!
-//! **Bound:** a contact never pushes its particle away from its triangle faster than `S`
-//! (m/s, relative normal speed over a substep), whatever the depth; and the velocity pass
-//! removes the separating velocity afterwards, so overlapping bodies walk apart by at most
-//! `S·dt` per frame instead of being shot apart. Every substep in which a violated contact's
-//! target was limited this way counts as one clamp in [`SoftContactStats::clamps`].
+//! A surface particle that starts the frame strictly inside a tetrahedron of another body
+//! is *deep*: it is not projected (pushing only the surface particles of the overlap region
+//! deforms both bodies, and their elasticity turns that into an explosion). Instead the two
+//! bodies are walked apart **rigidly** along the direction of least separation, by at most
+//! `S h` per substep, with no velocity added and the approaching relative velocity along that
+//! direction removed (see `soft_separation`).
+//!
+//! **Bound:** bodies created inside each other separate at a relative speed of at most `S`
+//! (m/s; default 2), i.e. by `S·dt` per frame, and the separation itself adds no particle
+//! velocity. Each substep in which a pair's separation (or a contact's target) was limited
+//! by `S` counts as one clamp in [`SoftContactStats::clamps`].
 //!
 //! # Limits
 //!
 //! Vertex–triangle only: two edges crossing without a vertex passing a face are not
 //! detected. A sheet must be thicker than `δ`. Self collision excludes the triangles of the
 //! particle's tetrahedron neighbours, and has no deep-overlap recovery (a body already
-//! folded through itself stays so).
+//! folded through itself stays so). Deep-overlap separation is rigid: a body pair with a
+//! pinned body on each side is not separated.
 
 use hecs::World;
 use tetpbd::SubstepHook;
 
 use crate::error::CouplingError;
 use crate::soft_gather::{ContactFrame, Gather};
+use crate::soft_separation::Separation;
 
 /// Opt-in marker component: this soft body also collides with itself (surface particles
 /// against its own surface triangles, excluding those of their tetrahedron neighbours).
@@ -189,6 +196,7 @@ pub struct SoftContacts {
     settings: SoftContactSettings,
     gather: Gather,
     frame: ContactFrame,
+    separation: Separation,
     stats: SoftContactStats,
 }
 
@@ -200,6 +208,7 @@ impl SoftContacts {
             settings,
             gather: Gather::default(),
             frame: ContactFrame::default(),
+            separation: Separation::default(),
             stats: SoftContactStats::default(),
         })
     }
@@ -234,13 +243,26 @@ impl std::fmt::Debug for SoftContacts {
 impl SubstepHook for SoftContacts {
     fn begin_frame(&mut self, world: &mut World, dt: f32) {
         self.stats = SoftContactStats::default();
-        self.gather
-            .run(world, dt, &self.settings, &mut self.frame, &mut self.stats);
+        self.gather.run(
+            world,
+            dt,
+            &self.settings,
+            &mut self.frame,
+            &mut self.separation,
+            &mut self.stats,
+        );
     }
 
-    fn begin_substep(&mut self, world: &mut World, _h: f32) {
+    fn begin_substep(&mut self, world: &mut World, h: f32) {
         self.frame
             .begin_substep(world, &self.gather, &self.settings);
+        self.separation.apply(
+            world,
+            &self.gather.bodies,
+            &self.settings,
+            h,
+            &mut self.stats,
+        );
     }
 
     fn project(&mut self, world: &mut World, h: f32) {
@@ -248,7 +270,9 @@ impl SubstepHook for SoftContacts {
             .project(world, &self.gather, &self.settings, h, &mut self.stats);
     }
 
-    fn end_substep(&mut self, world: &mut World, _h: f32) {
+    fn end_substep(&mut self, world: &mut World, h: f32) {
+        self.separation
+            .remove_velocity(world, &self.gather.bodies, h);
         self.frame.velocity_pass(world, &self.gather);
     }
 

@@ -10,6 +10,7 @@ use tetpbd::{Particles, Surface, Tetrahedra};
 use crate::convert::{finite3, to_glam};
 use crate::soft_bvh::{triangle_normal, BodyCache};
 use crate::soft_contact::{SelfCollision, SoftContactSettings, SoftContactStats};
+use crate::soft_separation::{Separation, Side};
 
 /// A soft body taking part in the frame; its surface particles occupy the slots
 /// `offset..offset + len` of the [`ContactFrame`] arrays.
@@ -23,6 +24,9 @@ pub(crate) struct FrameBody {
     pub lo: Vector3<f32>,
     pub hi: Vector3<f32>,
     pub self_collide: bool,
+    /// Inverse of the body's mass, 1/kg; 0 when a particle is pinned (the body is not
+    /// shifted by deep-overlap separation).
+    pub inv_mass: f32,
     /// `true` when some candidate refers to the body's slots.
     pub involved: bool,
 }
@@ -32,7 +36,8 @@ pub(crate) struct FrameBody {
 pub(crate) struct Candidate {
     pub p: u32,
     pub tri: [u32; 3],
-    /// Deep-overlap contact: active at any depth, closest-point barycentrics.
+    /// Deep particle (inside the other body at the frame start): not projected, resolved by
+    /// [`crate::soft_separation`].
     pub recovery: bool,
     /// Largest depth behind the triangle at which a regular candidate is active, m.
     pub depth_limit: f32,
@@ -85,6 +90,8 @@ pub(crate) struct Gather {
     list: Vec<(u64, Entity, bool)>,
     order: Vec<usize>,
     pairs: Vec<(usize, usize)>,
+    deep_a: Vec<Vector3<f32>>,
+    deep_b: Vec<Vector3<f32>>,
     pub bodies: Vec<FrameBody>,
 }
 
@@ -101,9 +108,11 @@ impl Gather {
         dt: f32,
         s: &SoftContactSettings,
         frame: &mut ContactFrame,
+        sep: &mut Separation,
         stats: &mut SoftContactStats,
     ) {
         frame.clear();
+        sep.clear();
         self.bodies.clear();
         self.pairs.clear();
         self.list.clear();
@@ -183,6 +192,13 @@ impl Gather {
             if self_collide {
                 cache.ensure_rings();
             }
+            let pinned = p.inv_masses().iter().any(|w| *w <= 0.0);
+            let mass = p.total_mass();
+            let inv_mass = if pinned || mass.is_nan() || mass <= 0.0 {
+                0.0
+            } else {
+                1.0 / mass
+            };
             self.bodies.push(FrameBody {
                 entity: e,
                 cache: ci,
@@ -191,6 +207,7 @@ impl Gather {
                 lo,
                 hi,
                 self_collide,
+                inv_mass,
                 involved: false,
             });
         }
@@ -200,8 +217,20 @@ impl Gather {
         self.refit(world, frame);
         for k in 0..self.pairs.len() {
             let (a, b) = self.pairs[k];
+            let c0 = frame.candidates.len();
             self.candidates(world, frame, s, a, b, stats);
+            let c1 = frame.candidates.len();
             self.candidates(world, frame, s, b, a, stats);
+            let deep = |c: &Candidate| c.recovery.then(|| frame.x[c.p as usize]);
+            self.deep_a.clear();
+            self.deep_a
+                .extend(frame.candidates[c0..c1].iter().filter_map(deep));
+            self.deep_b.clear();
+            self.deep_b
+                .extend(frame.candidates[c1..].iter().filter_map(deep));
+            let side_a = self.side(a, &self.deep_a, frame);
+            let side_b = self.side(b, &self.deep_b, frame);
+            sep.add_pair(a, b, &side_a, &side_b, s.thickness);
         }
         for a in 0..self.bodies.len() {
             if self.bodies[a].self_collide {
@@ -216,6 +245,16 @@ impl Gather {
             }
         }
         stats.candidates = frame.candidates.len();
+    }
+
+    fn side<'s>(&'s self, k: usize, deep: &'s [Vector3<f32>], frame: &'s ContactFrame) -> Side<'s> {
+        let body = &self.bodies[k];
+        Side {
+            cache: &self.caches[body.cache].cache,
+            xs: &frame.x[body.offset..body.offset + body.len],
+            deep,
+            centre: (body.lo + body.hi) / 2.0,
+        }
     }
 
     fn body_of_slot(&self, slot: usize) -> usize {

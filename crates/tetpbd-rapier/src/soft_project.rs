@@ -7,7 +7,7 @@ use nalgebra::Vector3;
 use tetpbd::Particles;
 
 use crate::convert::finite3;
-use crate::soft_bvh::{closest_barycentric, plane_barycentric, triangle_normal};
+use crate::soft_bvh::{plane_barycentric, triangle_normal};
 use crate::soft_contact::{SoftContactSettings, SoftContactStats};
 use crate::soft_gather::{Candidate, ContactFrame, Gather};
 
@@ -104,6 +104,9 @@ impl ContactFrame {
         if self.candidates.is_empty() {
             return;
         }
+        if std::env::var("DBG_NOPROJ").is_ok() {
+            return;
+        }
         self.load(world, g, Field::Position);
         let alpha_tilde = s.compliance / (h * h);
         let step = s.max_separation_speed * h;
@@ -114,7 +117,7 @@ impl ContactFrame {
             candidates,
             ..
         } = self;
-        for c in candidates.iter_mut() {
+        for c in candidates.iter_mut().filter(|c| !c.recovery) {
             match project_one(c, x, x_prev, w, s, alpha_tilde, step) {
                 Outcome::Degenerate => stats.degenerate += 1,
                 Outcome::Clamped => stats.clamps += 1,
@@ -205,23 +208,19 @@ fn project_one(
         return Outcome::Degenerate;
     };
     let d = (xp - a).dot(&n);
-    let bary = if c.recovery {
-        closest_barycentric(&xp, &a, &b, &t)
-    } else {
-        if d < -c.depth_limit {
-            return Outcome::Done;
-        }
-        let bw = plane_barycentric(&xp, &a, &b, &t, &n);
-        if bw.iter().any(|&v| v < -PRISM_TOLERANCE) {
-            return Outcome::Done;
-        }
-        let bw = bw.map(|v| v.max(0.0));
-        let sum: f32 = bw.iter().sum();
-        if sum.is_nan() || sum <= 0.0 {
-            return Outcome::Degenerate;
-        }
-        bw.map(|v| v / sum)
-    };
+    if d < -c.depth_limit {
+        return Outcome::Done;
+    }
+    let bw = plane_barycentric(&xp, &a, &b, &t, &n);
+    if bw.iter().any(|&v| v < -PRISM_TOLERANCE) {
+        return Outcome::Done;
+    }
+    let bw = bw.map(|v| v.max(0.0));
+    let sum: f32 = bw.iter().sum();
+    if sum.is_nan() || sum <= 0.0 {
+        return Outcome::Degenerate;
+    }
+    let bary = bw.map(|v| v / sum);
     let q = a * bary[0] + b * bary[1] + t * bary[2];
     let dist = (xp - q).dot(&n);
     let target = s.thickness.min(c.d_prev + step);
