@@ -10,7 +10,7 @@ use rapier3d::math::{Rotation, Vector};
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyType};
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::SoftBodyBuilder;
-use tetpbd_rapier::{CoupledWorld, DeformationDamping, SoftColliderBuilder};
+use tetpbd_rapier::{CoupledWorld, DeformationDamping, SoftColliderBuilder, SoftFeature};
 
 /// A slab lying on the ground; with `glued` its bottom particles are pinned where they are.
 fn slab(
@@ -134,13 +134,46 @@ fn corner_drop(triangles: bool) -> f32 {
     );
     let h = 0.05;
     let corner_down = Rotation::from_rotation_arc(Vector::ONE.normalize(), -Vector::Y);
-    let (cube, _) = s.physics.insert(
+    let (cube, cube_collider) = s.physics.insert(
         RigidBodyBuilder::dynamic()
             .translation(Vector::new(0.2, top + 0.3, 0.05))
             .rotation(corner_down.to_scaled_axis()),
         ColliderBuilder::cuboid(h, h, h).density(1000.0),
     );
-    run(&mut s, 90, 1);
+    run(&mut s, 150, 1);
+    if triangles {
+        // The slab holds the cube up through triangle contacts, reported as such; all the
+        // cube's contacts together carry its weight.
+        let on_triangles: Vec<_> = s
+            .coupling
+            .contacts()
+            .iter()
+            .filter(|c| {
+                c.collider == cube_collider && matches!(c.feature, SoftFeature::Triangle(_))
+            })
+            .collect();
+        let push: f32 = s
+            .coupling
+            .contacts()
+            .iter()
+            .filter(|c| c.collider == cube_collider)
+            .map(|c| c.impulse.y)
+            .sum();
+        let weight_dt = s.physics.bodies[cube].mass() * 9.81 * s.physics.integration_parameters.dt;
+        println!(
+            "{} triangle contacts, impulse of the cube on the slab {push:.5} N·s, cube weight × \
+             dt {weight_dt:.5} N·s",
+            on_triangles.len()
+        );
+        assert!(!on_triangles.is_empty(), "no triangle contact reported");
+        assert!(on_triangles
+            .iter()
+            .all(|c| c.normal.y < -0.9 && c.entity == e));
+        assert!(
+            (push + weight_dt).abs() < 0.01 * weight_dt,
+            "impulse {push} N·s"
+        );
+    }
     let b = &s.physics.bodies[cube];
     let lowest = (0..8)
         .map(|k| {

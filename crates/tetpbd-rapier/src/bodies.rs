@@ -8,12 +8,14 @@
 //! et al. 2020). Fixed and kinematic bodies never get an offset (infinite mass).
 //!
 //! The base of a kinematic body is the linear interpolation `P₀ → P₁`. The base of a
-//! dynamic body spreads rapier's velocity change `v₁ − v₀` (gravity, rigid contacts,
-//! joints) evenly over the frame: `c(t) = c₀ + v₀t + ½(v₁ − v₀)t²/dt`, rotation
-//! interpolated. A heavy body resting on a soft one is then pushed by its weight a little
-//! every substep instead of hitting the soft body with a frame's worth of gravity at once.
-//! Its end position is `c₀ + ½(v₀ + v₁)dt` (plus offset) instead of rapier's `c₀ + v₁dt`;
-//! only bodies a soft body actually touched are written back.
+//! dynamic body spreads rapier's velocity change `a·dt = v₁ − v₀` (gravity, rigid contacts,
+//! joints) evenly over the substeps, integrated like the soft particles (symplectic Euler):
+//! in the substep ending at `t` its velocity is `v₀ + a·t` and `c(t) = c₀ + v₀t + ½a·t(t + h)`;
+//! the rotation is interpolated. A heavy body resting on a soft one is then pushed by its
+//! weight a little every substep instead of hitting the soft body with a frame's worth of
+//! gravity at once, and the soft impulse balances exactly `m·g·dt` per frame at rest. The end
+//! position differs from rapier's `c₀ + v₁dt` by `½a·dt(dt − h)`; only bodies a soft body
+//! actually touched are written back.
 
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
@@ -158,6 +160,7 @@ impl BodyProxy {
 
     /// Moves to the end of the next substep; `frac` is its end time as a fraction of the frame.
     pub fn begin_substep(&mut self, frac: f32, h: f32) {
+        self.h = h;
         self.prev = self.pose;
         if self.kind == BodyKind::Dynamic {
             self.dx_sub = self.dx;
@@ -180,7 +183,7 @@ impl BodyProxy {
         let t = frac * self.dt;
         let com = self.com_start
             + self.v_start * t
-            + (self.v_end - self.v_start) * (0.5 * t * frac)
+            + (self.v_end - self.v_start) * (0.5 * t * (t + self.h) / self.dt)
             + self.dx;
         let rot = self.dq * self.rot_start.nlerp(&self.rot_end, frac);
         self.pose = Isometry3::from_parts(Translation3::from(com - rot * self.com_local), rot);
@@ -277,7 +280,7 @@ impl BodyProxy {
     }
 
     /// Writes the result back to rapier: for a body touched only by soft bodies its final
-    /// pose and velocity (that of the last substep, as in PBD); for a supported body the
+    /// pose and velocity (`v₁` plus the offset's); for a supported body the
     /// summed soft impulse as a velocity change. Returns `false` (and writes nothing) when the
     /// result is not finite.
     pub fn write_back(&self, body: &mut RigidBody) -> bool {
@@ -285,11 +288,7 @@ impl BodyProxy {
             return true;
         }
         let (v, w, pose) = match self.kind {
-            BodyKind::Dynamic => (
-                self.v_end - (self.v_end - self.v_start) * (0.5 * self.h / self.dt) + self.dv,
-                self.w_end + self.dw,
-                Some(self.pose),
-            ),
+            BodyKind::Dynamic => (self.v_end + self.dv, self.w_end + self.dw, Some(self.pose)),
             BodyKind::Supported => (
                 self.v_end + self.inv_mass.component_mul(&self.impulse),
                 self.w_end + self.inv_inertia * self.angular,

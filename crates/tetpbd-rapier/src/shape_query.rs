@@ -103,3 +103,67 @@ pub(crate) fn surface_point(
         distance,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rapier3d::geometry::{Array2, SharedShape, TriMeshFlags};
+    use rapier3d::math::Vector;
+
+    fn query(shape: &SharedShape, p: Vector3<f32>) -> SurfacePoint {
+        let rule = InsideRule::of(shape.as_ref());
+        surface_point(shape.as_ref(), rule, &Isometry3::identity(), &p, None).unwrap()
+    }
+
+    #[test]
+    fn solid_shapes_report_inside_with_negative_distance() {
+        let ball = SharedShape::ball(1.0);
+        let out = query(&ball, Vector3::new(0.0, 1.5, 0.0));
+        assert!((out.distance - 0.5).abs() < 1e-5);
+        assert!((out.normal - Vector3::y()).norm() < 1e-5);
+        let inside = query(&ball, Vector3::new(0.0, 0.75, 0.0));
+        assert!((inside.distance + 0.25).abs() < 1e-5);
+        assert!((inside.normal - Vector3::y()).norm() < 1e-5);
+        assert!((inside.point - Vector3::y()).norm() < 1e-5);
+    }
+
+    #[test]
+    fn heightfield_is_solid_below_its_surface() {
+        let hf = SharedShape::heightfield(Array2::repeat(3, 3, 0.0), Vector::new(2.0, 1.0, 2.0));
+        assert_eq!(InsideRule::of(hf.as_ref()), InsideRule::HeightField);
+        let above = query(&hf, Vector3::new(0.1, 0.2, 0.1));
+        let below = query(&hf, Vector3::new(0.1, -0.2, 0.1));
+        assert!((above.distance - 0.2).abs() < 1e-5 && above.normal.y > 0.99);
+        assert!((below.distance + 0.2).abs() < 1e-5 && below.normal.y > 0.99);
+    }
+
+    #[test]
+    fn unoriented_trimesh_is_one_sided() {
+        let v = vec![
+            Vector::new(-1.0, 0.0, -1.0),
+            Vector::new(1.0, 0.0, -1.0),
+            Vector::new(1.0, 0.0, 1.0),
+            Vector::new(-1.0, 0.0, 1.0),
+        ];
+        let mesh =
+            SharedShape::trimesh_with_flags(v, vec![[0, 2, 1], [0, 3, 2]], TriMeshFlags::empty())
+                .unwrap();
+        assert_eq!(InsideRule::of(mesh.as_ref()), InsideRule::OneSidedMesh);
+        let above = query(&mesh, Vector3::new(0.2, 0.1, 0.3));
+        let below = query(&mesh, Vector3::new(0.2, -0.1, 0.3));
+        assert!((above.distance - 0.1).abs() < 1e-5 && above.normal.y > 0.99);
+        assert!((below.distance + 0.1).abs() < 1e-5 && below.normal.y > 0.99);
+    }
+
+    #[test]
+    fn a_point_on_the_surface_needs_a_fallback_normal() {
+        let cuboid = SharedShape::cuboid(1.0, 1.0, 1.0);
+        let rule = InsideRule::of(cuboid.as_ref());
+        let p = Vector3::new(0.0, 1.0, 0.0);
+        let id = Isometry3::identity();
+        assert!(surface_point(cuboid.as_ref(), rule, &id, &p, None).is_none());
+        let sp = surface_point(cuboid.as_ref(), rule, &id, &p, Some(Vector3::y())).unwrap();
+        assert_eq!(sp.distance, 0.0);
+        assert_eq!(sp.normal, Vector3::y());
+    }
+}
