@@ -9,7 +9,12 @@ use rapier3d::prelude::{
     PhysicsWorld, SoftBodyBuilder as RapierBuilder, SoftBodyCellModel, SoftBodyHandle,
     SoftBodyMaterial, SoftBodySolver, SpringCoefficients,
 };
-use tetpbd::{hecs, Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats};
+use tetpbd::systems::{self, Measured};
+use tetpbd::{
+    hecs, ErrorStats, Family, Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats,
+};
+
+use crate::clock::thread_cpu_ms;
 
 use crate::scenes::{Scene, DT};
 
@@ -142,8 +147,10 @@ impl Model {
 /// One frame's cost.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FrameCost {
-    /// Wall time of the step, ms (tetpbd: without the error measurement).
+    /// Wall time of the step, ms.
     pub ms: f64,
+    /// CPU time of the calling thread during the step, ms.
+    pub cpu_ms: f64,
     /// Constraint projections done (0 when the engine does not say).
     pub projections: u64,
 }
@@ -154,8 +161,16 @@ pub trait Sim {
     fn step(&mut self) -> FrameCost;
     /// Current particle positions, in mesh vertex order.
     fn positions(&self) -> Vec<Vector3<f32>>;
-    /// tetpbd's own statistics of the last step (None for rapier).
-    fn stats(&self) -> Option<&StepStats>;
+    /// tetpbd's own per-family `|C|` after the last step, in [`Family::ALL`] order (None for
+    /// rapier; a family the body does not have is None).
+    fn family_errors(&self) -> Option<[Option<ErrorStats>; 3]>;
+}
+
+/// Times `f` in wall and thread CPU ms.
+fn timed(f: impl FnOnce()) -> (f64, f64) {
+    let (t, c) = (Instant::now(), thread_cpu_ms());
+    f();
+    (t.elapsed().as_secs_f64() * 1e3, thread_cpu_ms() - c)
 }
 
 /// Builds the simulation of `model` on `scene` with `substeps × iterations` (rapier: its
@@ -173,6 +188,7 @@ struct Ours {
     world: hecs::World,
     solver: Solver,
     last: StepStats,
+    measured: Measured,
 }
 
 impl Ours {
@@ -204,7 +220,6 @@ impl Ours {
             iterations,
             gravity: Vector3::new(0.0, scene.gravity, 0.0),
             damping: scene.damping,
-            measure_error: true,
             ..Default::default()
         })
         .expect("valid settings");
@@ -212,19 +227,23 @@ impl Ours {
             world,
             solver,
             last: StepStats::default(),
+            measured: Measured::default(),
         }
     }
 }
 
 impl Sim for Ours {
     fn step(&mut self) -> FrameCost {
-        self.last = self
-            .solver
-            .step(&mut self.world)
-            .expect("settings validated");
+        let (solver, world) = (&mut self.solver, &mut self.world);
+        let mut stats = StepStats::default();
+        let (ms, cpu_ms) = timed(|| stats = solver.step(world).expect("settings validated"));
+        // The same evaluation `SolverSettings::measure_error` runs, outside the timed step.
+        self.measured = systems::measure(&mut self.world);
+        self.last = stats;
         let s = &self.last;
         FrameCost {
-            ms: (s.total_time - s.measure_time).as_secs_f64() * 1e3,
+            ms,
+            cpu_ms,
             projections: s.edge.projections + s.vertex_face.projections + s.volume.projections,
         }
     }
@@ -237,8 +256,16 @@ impl Sim for Ours {
             .unwrap_or_default()
     }
 
-    fn stats(&self) -> Option<&StepStats> {
-        Some(&self.last)
+    fn family_errors(&self) -> Option<[Option<ErrorStats>; 3]> {
+        let m = &self.measured;
+        Some(Family::ALL.map(|f| {
+            let e = match f {
+                Family::Edge => m.edge,
+                Family::VertexFace => m.vertex_face,
+                Family::Volume => m.volume,
+            };
+            (self.last.family(f).count > 0).then_some(e)
+        }))
     }
 }
 
@@ -301,10 +328,11 @@ impl Rapier {
 
 impl Sim for Rapier {
     fn step(&mut self) -> FrameCost {
-        let t = Instant::now();
-        self.world.step();
+        let world = &mut self.world;
+        let (ms, cpu_ms) = timed(|| world.step());
         FrameCost {
-            ms: t.elapsed().as_secs_f64() * 1e3,
+            ms,
+            cpu_ms,
             projections: 0,
         }
     }
@@ -316,7 +344,7 @@ impl Sim for Rapier {
             .collect()
     }
 
-    fn stats(&self) -> Option<&StepStats> {
+    fn family_errors(&self) -> Option<[Option<ErrorStats>; 3]> {
         None
     }
 }

@@ -6,6 +6,7 @@
 //! squash_volume.csv, plot.png, plot.svg, squash_volume.png, squash_volume.svg,
 //! summary.md); `--quick` (a smoke run of about 10 s) writes `target/error-vs-time-quick/`.
 
+mod clock;
 mod engines;
 mod metrics;
 mod pareto;

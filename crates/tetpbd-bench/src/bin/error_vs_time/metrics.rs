@@ -3,7 +3,6 @@
 //! from a converged reference run.
 
 use nalgebra::{Matrix3, Vector3};
-use tetpbd::Family;
 
 use crate::engines::{build, Model, Sim};
 use crate::scenes::{tet_volume, Scene, SceneKind, DT};
@@ -64,13 +63,17 @@ pub struct RunResult {
     pub ns_per_projection: Option<f64>,
     /// Wall ms of every measured frame (after the warm-up), sorted.
     pub frame_ms: Vec<f64>,
+    /// Median thread CPU ms per frame over the same frames.
+    pub cpu_ms_median: f64,
+    /// Thread CPU ms of every measured frame, sorted.
+    pub frame_cpu_ms: Vec<f64>,
     /// Projections and their wall ms over the measured frames.
     pub projections: (u64, f64),
     /// Observables after the last frame.
     pub last: Observables,
     /// Largest number of inverted tetrahedra over all frames.
     pub max_inverted: usize,
-    /// tetpbd's per-family |C| after the last frame, in [`Family::ALL`] order (None: rapier,
+    /// tetpbd's per-family |C| after the last frame, in [`tetpbd::Family::ALL`] order (None: rapier,
     /// or the family is not in the set).
     pub families: [Option<FamilyError>; 3],
     /// Squash: first time after which volume and edge lengths stay within 1 % of rest, s.
@@ -88,6 +91,7 @@ pub struct RunResult {
 /// Runs `sim` through `scene.frames` frames.
 pub fn run(sim: &mut dyn Sim, scene: &Scene) -> RunResult {
     let mut times = Vec::with_capacity(scene.frames);
+    let mut cpu = Vec::with_capacity(scene.frames);
     let (mut proj, mut proj_ms) = (0u64, 0.0f64);
     let mut trajectory = Vec::with_capacity(scene.frames);
     let mut obs = Vec::with_capacity(scene.frames);
@@ -97,6 +101,7 @@ pub fn run(sim: &mut dyn Sim, scene: &Scene) -> RunResult {
         let cost = sim.step();
         if f >= scene.warmup {
             times.push(cost.ms);
+            cpu.push(cost.cpu_ms);
             proj += cost.projections;
             proj_ms += cost.ms;
         }
@@ -106,20 +111,17 @@ pub fn run(sim: &mut dyn Sim, scene: &Scene) -> RunResult {
         }
         obs.push(observe(scene, &x));
         trajectory.push(x);
-        if let Some(s) = sim.stats() {
-            for (k, fam) in Family::ALL.iter().enumerate() {
-                let st = s.family(*fam);
-                families[k] = match st.after {
-                    Some(e) if st.count > 0 => Some(FamilyError {
-                        rms: e.rms,
-                        max: e.max,
-                    }),
-                    _ => None,
-                };
-            }
+        if let Some(errors) = sim.family_errors() {
+            families = errors.map(|e| {
+                e.map(|e| FamilyError {
+                    rms: e.rms,
+                    max: e.max,
+                })
+            });
         }
     }
     times.sort_by(f64::total_cmp);
+    cpu.sort_by(f64::total_cmp);
     let final_speed = match trajectory.len() {
         n if n >= 2 => trajectory[n - 1]
             .iter()
@@ -136,6 +138,8 @@ pub fn run(sim: &mut dyn Sim, scene: &Scene) -> RunResult {
         ms_median: times.get(times.len() / 2).copied().unwrap_or(f64::NAN),
         ns_per_projection: (proj > 0).then(|| proj_ms * 1e6 / proj as f64),
         frame_ms: times,
+        cpu_ms_median: cpu.get(cpu.len() / 2).copied().unwrap_or(f64::NAN),
+        frame_cpu_ms: cpu,
         projections: (proj, proj_ms),
         last: obs.last().copied().unwrap_or_default(),
         max_inverted: obs.iter().map(|o| o.inverted).max().unwrap_or(0),
@@ -157,6 +161,13 @@ impl RunResult {
         self.ms_median = self
             .frame_ms
             .get(self.frame_ms.len() / 2)
+            .copied()
+            .unwrap_or(f64::NAN);
+        self.frame_cpu_ms.extend_from_slice(&other.frame_cpu_ms);
+        self.frame_cpu_ms.sort_by(f64::total_cmp);
+        self.cpu_ms_median = self
+            .frame_cpu_ms
+            .get(self.frame_cpu_ms.len() / 2)
             .copied()
             .unwrap_or(f64::NAN);
         self.projections.0 += other.projections.0;

@@ -27,6 +27,8 @@ pub struct Row {
     pub iterations: u32,
     /// Median wall ms per frame after the warm-up.
     pub ms: f64,
+    /// Median thread CPU ms per frame over the same frames.
+    pub cpu_ms: f64,
     /// ns per constraint projection (tetpbd).
     pub ns_per_projection: Option<f64>,
     /// Deviation from the model's converged reference.
@@ -83,6 +85,7 @@ impl Row {
             substeps,
             iterations,
             ms: res.ms_median,
+            cpu_ms: res.cpu_ms_median,
             ns_per_projection: res.ns_per_projection,
             dev,
             volume_err_pct: res.last.volume_err_pct,
@@ -134,7 +137,8 @@ fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
 /// The CSV of every run.
 pub fn results_csv(rows: &[Row]) -> String {
     let mut s = String::from(
-        "scene,engine,model,hard,substeps,iterations,ms_per_frame_median,ns_per_projection,\
+        "scene,engine,model,hard,substeps,iterations,ms_per_frame_median,cpu_ms_per_frame_median,\
+         ns_per_projection,\
          dev_max_rel,dev_rms_rel,volume_err_pct,late_volume_err_pct_max,edge_strain_rms,\
          edge_strain_max,inverted,inverted_max,edge_c_rms_m,edge_c_max_m,vertex_face_c_rms_m,\
          vertex_face_c_max_m,volume_c_rms_m3,volume_c_max_m3,recover_s,final_speed_m_s,finite,\
@@ -148,7 +152,7 @@ pub fn results_csv(rows: &[Row]) -> String {
         };
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{:.6},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{},{},{:e}",
+            "{},{},{},{},{},{},{:.6},{:.6},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{},{},{:e}",
             r.scene,
             r.model.engine(),
             r.model.label(),
@@ -156,6 +160,7 @@ pub fn results_csv(rows: &[Row]) -> String {
             r.substeps,
             r.iterations,
             r.ms,
+            r.cpu_ms,
             opt(r.ns_per_projection.map(|n| format!("{n:.2}"))),
             r.dev.max,
             r.dev.rms,

@@ -85,10 +85,11 @@ const LATE_VOLUME: Metric = Metric {
     needs_reference: false,
 };
 
-fn points(rows: &[Row], idx: &[usize], m: &Metric) -> Vec<Point> {
+/// Cost by wall time (`cpu == false`) or by thread CPU time.
+fn points(rows: &[Row], idx: &[usize], m: &Metric, cpu: bool) -> Vec<Point> {
     idx.iter()
         .map(|&i| Point {
-            ms: rows[i].ms,
+            ms: if cpu { rows[i].cpu_ms } else { rows[i].ms },
             err: (m.f)(&rows[i]),
             row: i,
         })
@@ -120,7 +121,14 @@ struct Brief {
     points: usize,
 }
 
-fn headline(s: &mut String, rows: &[Row], scene: &str, m: &Metric, hard_only: bool) -> Brief {
+fn headline(
+    s: &mut String,
+    rows: &[Row],
+    scene: &str,
+    m: &Metric,
+    hard_only: bool,
+    cpu: bool,
+) -> Brief {
     let sel = |engine: &str| -> Vec<usize> {
         (0..rows.len())
             .filter(|&i| {
@@ -134,8 +142,8 @@ fn headline(s: &mut String, rows: &[Row], scene: &str, m: &Metric, hard_only: bo
             .collect()
     };
     let matches = compare(
-        &points(rows, &sel("tetpbd"), m),
-        &points(rows, &sel("rapier"), m),
+        &points(rows, &sel("tetpbd"), m, cpu),
+        &points(rows, &sel("rapier"), m, cpu),
     );
     let speed: Vec<f64> = matches.iter().filter_map(|x| x.speedup()).collect();
     let gain: Vec<f64> = matches.iter().filter_map(|x| x.accuracy_gain()).collect();
@@ -279,23 +287,27 @@ pub fn markdown(
             ],
         };
         for (m, hard) in cases {
-            let b = headline(&mut details, rows, scene.name, m, *hard);
+            let b = headline(&mut details, rows, scene.name, m, *hard, false);
+            let c = headline(&mut String::new(), rows, scene.name, m, *hard, true);
             let f = |x: Option<f64>| x.map(sig).unwrap_or_else(|| "n/a".to_string());
             briefs.push(format!(
-                "| {} | {} | {} | **{}** | **{}** | {} |",
+                "| {} | {} | {} | **{}** | **{}** | {} | {} | {} |",
                 scene.name,
                 if *hard { "hard" } else { "all" },
                 m.name,
                 f(b.speed),
                 f(b.gain),
-                b.points
+                b.points,
+                f(c.speed),
+                f(c.gain)
             ));
         }
     }
-    let _ = writeln!(s, "| scene | models | error | speed at equal error | accuracy at equal time | rapier front points |\n|---|---|---|---:|---:|---:|");
+    let _ = writeln!(s, "| scene | models | error | speed at equal error | accuracy at equal time | rapier front points | speed, by CPU time | accuracy, by CPU time |\n|---|---|---|---:|---:|---:|---:|---:|");
     for b in &briefs {
         let _ = writeln!(s, "{b}");
     }
+    let _ = writeln!(s, "\nThe last two columns repeat the comparison with each run's median thread CPU time per frame instead of its wall time (both engines run on the calling thread): on a loaded machine they show how much of the wall-time figure is contention.");
     let _ = writeln!(s, "\n### Details\n\n{details}");
     crate::summary_setup::setup(&mut s, scenes, rows, references);
     s
