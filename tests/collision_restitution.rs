@@ -4,6 +4,8 @@ mod coupling_common;
 
 use coupling_common::{ground, min_y, scene, soft_ball};
 use nalgebra::Vector3;
+use rapier3d::math::Vector;
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 use tetpbd_rapier::{SoftCollider, SoftColliderBuilder};
 
 const DROP: f32 = 1.0;
@@ -62,4 +64,68 @@ fn rebound_height_follows_restitution() {
             "e = {e}: rebound {h} m vs {ideal} m"
         );
     }
+}
+
+/// A rigid ball (restitution `e` on ball and slab) dropped from `DROP_RIGID` m onto a soft
+/// slab whose bottom is glued to the ground. Returns the ball's highest rebound above its
+/// resting height.
+fn rigid_rebound(e: f32) -> f32 {
+    let mut s = scene(10);
+    ground(&mut s);
+    let mesh = tetpbd::generators::box_grid(
+        Vector3::new(1.0, 0.2, 1.0),
+        [4, 2, 4],
+        tetpbd::generators::CellSplit::Six,
+    )
+    .expect("mesh");
+    let bottom: Vec<u32> = (0..mesh.vertices.len() as u32)
+        .filter(|&i| mesh.vertices[i as usize].y < -0.1 + 1e-6)
+        .collect();
+    let slab = tetpbd::SoftBodyBuilder::new(mesh)
+        .density(1000.0)
+        .edges(0.0)
+        .volume(0.0)
+        .pinned(bottom)
+        .translation(Vector3::new(0.0, 0.1, 0.0))
+        .build()
+        .expect("slab")
+        .spawn(&mut s.soft);
+    let collider = SoftColliderBuilder::new()
+        .restitution(e)
+        .build()
+        .expect("collider");
+    s.soft.insert_one(slab, collider).expect("entity");
+    let r = 0.15;
+    let rest = 0.2 + r + SoftCollider::DEFAULT_THICKNESS;
+    let (ball, _) = s.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vector::new(0.125, rest + DROP_RIGID, 0.125)),
+        ColliderBuilder::ball(r).density(1000.0).restitution(e),
+    );
+    let mut hit = false;
+    let mut best = f32::NEG_INFINITY;
+    for _ in 0..120 {
+        let stats = s.step().expect("step");
+        hit |= stats.contacts > 0;
+        if hit {
+            best = best.max(s.physics.bodies[ball].translation().y - rest);
+        }
+    }
+    assert!(hit, "the ball never reached the slab");
+    best
+}
+
+const DROP_RIGID: f32 = 0.5;
+
+#[test]
+fn rigid_ball_on_soft_slab_follows_restitution() {
+    let dead = rigid_rebound(0.0);
+    let e = 0.8;
+    let live = rigid_rebound(e);
+    let ideal = e * e * DROP_RIGID;
+    println!("rigid ball on a soft slab: rebound {dead:.4} m with e = 0, {live:.4} m with e = {e} (ideal {ideal:.4} m)");
+    assert!(dead < 0.02 * DROP_RIGID, "bounced {dead} m with e = 0");
+    assert!(
+        (live - ideal).abs() < 0.1 * ideal,
+        "rebound {live} m vs {ideal} m"
+    );
 }

@@ -69,6 +69,9 @@ pub(crate) struct BodyProxy {
     sub_angular: Vector3<f32>,
     impulse: Vector3<f32>,
     angular: Vector3<f32>,
+    /// Linear and angular velocity at the start of the current substep (before any soft
+    /// correction), and the centre of mass they refer to.
+    pre: (Vector3<f32>, Vector3<f32>, Vector3<f32>),
 }
 
 impl BodyProxy {
@@ -150,6 +153,7 @@ impl BodyProxy {
             sub_angular: Vector3::zeros(),
             impulse: Vector3::zeros(),
             angular: Vector3::zeros(),
+            pre: (Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
         }
     }
 
@@ -169,6 +173,20 @@ impl BodyProxy {
             self.dq = UnitQuaternion::from_scaled_axis(self.dw * h) * self.dq;
         }
         self.set_pose(frac);
+        if self.kind != BodyKind::Fixed {
+            self.pre = (
+                self.v_start.lerp(&self.v_end, self.frac) + self.dv,
+                self.w_base + self.dw,
+                self.com(),
+            );
+        }
+    }
+
+    /// Velocity of the material point at `q` at the start of the current substep, before
+    /// any soft correction of the substep, m/s.
+    pub fn velocity_at_pre(&self, q: &Vector3<f32>) -> Vector3<f32> {
+        let (v, w, com) = self.pre;
+        v + w.cross(&(q - com))
     }
 
     fn set_pose(&mut self, frac: f32) {

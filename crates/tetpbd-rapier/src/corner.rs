@@ -52,6 +52,8 @@ pub(crate) struct CornerContact {
     /// into the soft body's contacts).
     pub vertex_contacts: [Option<usize>; 3],
     pub thickness: f32,
+    pub restitution: f32,
+    pub active: bool,
     pub mu_d: f32,
     pub mu_s: f32,
     pub lambda_n: f32,
@@ -109,7 +111,7 @@ pub(crate) fn gather_corners(
     surface: &Surface,
     dt: f32,
     thickness: f32,
-    (mu_d, mu_s): (f32, f32),
+    (mu_d, mu_s, restitution): (f32, f32, f32),
     vertex_contacts: &[(u32, usize)],
 ) {
     let (corners, extra) = corners_of(shape);
@@ -147,6 +149,8 @@ pub(crate) fn gather_corners(
                 triangle: t as u32,
                 vertex_contacts: vc,
                 thickness: reach,
+                restitution,
+                active: false,
                 mu_d,
                 mu_s,
                 lambda_n: 0.0,
@@ -247,6 +251,7 @@ pub(crate) fn project_corners(
             bodies[bi].apply_position_impulse(&(n * dl), &v);
         }
         k.ever_active = true;
+        k.active = true;
         k.depth = k.depth.max(-c_val);
         k.normal = -n;
         k.point = v;

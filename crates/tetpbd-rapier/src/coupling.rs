@@ -139,6 +139,25 @@ impl<'a> RapierContext<'a> {
 /// bodies really are this frame (kinematic platforms carry soft bodies without a frame of
 /// lag); the price is that a soft push on a rigid body reaches rigid–rigid contacts one
 /// frame later.
+///
+/// # Constraints in the substeps
+///
+/// Each iteration, after the soft body's own families: particle–collider contacts
+/// (`contact` module docs: XPBD inequality, positional Coulomb friction with static and
+/// dynamic coefficients), rigid points against soft surface triangles (`corner` module
+/// docs), then attachments ([`crate::Attachments`]). After each substep's velocity update:
+/// the per-particle separating velocity is removed, then restitution acts per (soft body,
+/// collider) impact episode on the body's centre of mass (`restitution` module docs), and
+/// [`crate::DeformationDamping`] damps deformation of bodies that carry it.
+///
+/// # Known limits
+///
+/// * Gauss–Seidel with one iteration per substep carries large mass ratios poorly: a rigid
+///   body 1000× heavier than the soft body under it needs a few iterations per substep.
+/// * A heavy soft body on a stack of supported rigid bodies keeps a small rocking motion
+///   (a few cm/s), the one-frame lag between the soft load and rapier's answer.
+/// * Joints are only enforced by rapier: inside the substeps a jointed dynamic body moves
+///   freely under soft reactions, and rapier pulls it back at the next step.
 #[derive(Clone, Debug)]
 pub struct Coupling {
     solver: Solver,

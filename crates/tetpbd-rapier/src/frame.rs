@@ -319,7 +319,7 @@ impl Frame {
                             surface,
                             dt,
                             sc.thickness,
-                            (mu_d, mu_s),
+                            (mu_d, mu_s, e),
                             &vertex_contacts,
                         );
                     }

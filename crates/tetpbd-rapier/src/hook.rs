@@ -124,6 +124,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 episodes,
                 s.entity,
                 &mut contacts[range.clone()],
+                &mut corners[s.corners.clone()],
                 p,
                 &s.v_cm_pre,
                 bodies,
@@ -134,6 +135,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
         }
         end_episodes(episodes);
         for k in corners.iter_mut() {
+            k.active = false;
             k.impulse += k.sub_impulse / h;
             k.sub_impulse = nalgebra::Vector3::zeros();
             k.lambda_n = 0.0;

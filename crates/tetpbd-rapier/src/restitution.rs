@@ -7,16 +7,19 @@
 //! body makes it bounce off a contact with `e = 0`. Instead each (soft body, collider) pair
 //! in contact runs an *impact episode*:
 //!
-//! 1. it begins at the first substep with an active contact; `v⁻ = n·(v_cm − v_rigid(q))` is
+//! 1. it begins at the first substep with an active contact (particle or rigid point on a
+//!    surface triangle); `v⁻ = n·(v_cm − v_rigid(q))` is
 //!    the approach speed of the body's centre of mass before that substep (`n`, `q` the mean
 //!    normal and point of the active contacts). Only an approach faster than `2|g|h` is an
 //!    impact (resting contacts never bounce);
 //! 2. compression ends at the first substep where the relative normal velocity `v_n` of the
 //!    centre of mass is ≥ 0; the body then receives the uniform velocity change that makes
 //!    `v_n = −e·v⁻` (with the opposite impulse on a dynamic rigid body, generalized inverse
-//!    mass at `q`);
+//!    mass at `q`; a soft body with pinned particles is anchored and takes no share);
 //! 3. while the contact lasts, `v_n` is capped at `−e·v⁻`, so the body's elastic recoil does
-//!    not add bounce; the episode ends with the last active contact (kept across frames).
+//!    not add bounce; the episode ends with the last active contact (kept across frames). A
+//!    soft body squeezed under a load after an impact therefore does not spring back while
+//!    the load rests on it (it does once the load is lifted).
 //!
 //! `e` is the largest combined restitution among the pair's contacts.
 
@@ -26,6 +29,7 @@ use rapier3d::geometry::ColliderHandle;
 use tetpbd::Particles;
 
 use crate::bodies::BodyProxy;
+use crate::corner::CornerContact;
 use crate::frame::{ColliderProxy, ParticleContact};
 
 /// One impact episode of a (soft body, collider) pair.
@@ -62,6 +66,7 @@ pub(crate) fn restitution_pass(
     episodes: &mut Vec<Episode>,
     entity: Entity,
     contacts: &mut [ParticleContact],
+    corners: &mut [CornerContact],
     p: &mut Particles,
     v_cm_pre: &Vector3<f32>,
     bodies: &mut [BodyProxy],
@@ -72,24 +77,36 @@ pub(crate) fn restitution_pass(
     if mass <= 0.0 {
         return;
     }
-    let mut start = 0;
-    while start < contacts.len() {
-        let ci = contacts[start].collider;
-        let mut end = start;
-        while end < contacts.len() && contacts[end].collider == ci {
-            end += 1;
-        }
-        let group = &mut contacts[start..end];
-        start = end;
+    // A body with pinned particles is anchored to the world: its centre of mass takes no
+    // share of the restitution impulse.
+    let anchored = p.inv_masses().contains(&0.0);
+    let mut active: Vec<usize> = contacts
+        .iter()
+        .filter(|c| c.active && c.solve)
+        .map(|c| c.collider)
+        .chain(corners.iter().filter(|k| k.active).map(|k| k.collider))
+        .collect();
+    active.sort_unstable();
+    active.dedup();
+    for ci in active {
         let mut n = Vector3::zeros();
         let mut q = Vector3::zeros();
         let mut count = 0usize;
         let mut e = 0.0f32;
-        for c in group.iter().filter(|c| c.active && c.solve) {
+        for c in contacts
+            .iter()
+            .filter(|c| c.collider == ci && c.active && c.solve)
+        {
             n += c.normal;
             q += c.point;
             count += 1;
             e = e.max(c.restitution);
+        }
+        for k in corners.iter().filter(|k| k.collider == ci && k.active) {
+            n += k.normal;
+            q += k.point;
+            count += 1;
+            e = e.max(k.restitution);
         }
         let len = n.norm();
         if count == 0 || len.is_nan() || len <= 1e-6 {
@@ -105,7 +122,10 @@ pub(crate) fn restitution_pass(
         let k = match episodes.binary_search_by(|ep| ep.key.cmp(&key)) {
             Ok(k) => k,
             Err(k) => {
-                let approach = n.dot(&(v_cm_pre - vb));
+                let vb_pre = cp
+                    .body
+                    .map_or(Vector3::zeros(), |b| bodies[b].velocity_at_pre(&q));
+                let approach = n.dot(&(v_cm_pre - vb_pre));
                 episodes.insert(
                     k,
                     Episode {
@@ -137,11 +157,12 @@ pub(crate) fn restitution_pass(
             continue;
         };
         let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_at(&q, &n));
-        let j = dv / (1.0 / mass + w_b);
+        let w_soft = if anchored { 0.0 } else { 1.0 / mass };
+        let j = dv / (w_soft + w_b);
         if !j.is_finite() {
             continue;
         }
-        let dv_soft = n * (j / mass);
+        let dv_soft = n * (j * w_soft);
         for i in 0..p.len() {
             if p.inv_masses()[i] > 0.0 {
                 p.velocities_mut()[i] += dv_soft;
@@ -151,8 +172,14 @@ pub(crate) fn restitution_pass(
             bodies[b].apply_velocity_impulse(&(-n * j), &q);
         }
         let share = n * (j / count as f32);
-        for c in group.iter_mut().filter(|c| c.active && c.solve) {
+        for c in contacts
+            .iter_mut()
+            .filter(|c| c.collider == ci && c.active && c.solve)
+        {
             c.impulse += share;
+        }
+        for k in corners.iter_mut().filter(|k| k.collider == ci && k.active) {
+            k.impulse += share;
         }
     }
 }
