@@ -11,7 +11,7 @@ use rapier3d::dynamics::{
 use rapier3d::geometry::{BroadPhaseBvh, ColliderSet, NarrowPhase};
 use rapier3d::math::Vector;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline, PhysicsWorld, QueryFilter};
-use tetpbd::{Solver, SolverSettings};
+use tetpbd::{Solver, SolverSettings, SubstepHook};
 
 use crate::convert::to_na;
 use crate::error::CouplingError;
@@ -211,6 +211,18 @@ impl Coupling {
         world: &mut World,
         ctx: RapierContext<'_>,
     ) -> Result<CouplingStats, CouplingError> {
+        self.step_with(world, ctx, &mut ())
+    }
+
+    /// [`Coupling::step`] with another [`SubstepHook`] run inside the same substeps, after
+    /// the coupling's constraints at every point (e.g. [`crate::SoftContacts`] for soft–soft
+    /// contacts).
+    pub fn step_with(
+        &mut self,
+        world: &mut World,
+        ctx: RapierContext<'_>,
+        extra: &mut dyn SubstepHook,
+    ) -> Result<CouplingStats, CouplingError> {
         let start = Instant::now();
         self.settings.validate()?;
         let dt = ctx.integration_parameters.dt;
@@ -255,7 +267,7 @@ impl Coupling {
                 ctx.colliders,
                 QueryFilter::default(),
             );
-            let mut hook = CouplingHook {
+            let hook = CouplingHook {
                 frame: &mut self.frame,
                 qp,
                 narrow_phase: &*ctx.narrow_phase,
@@ -263,7 +275,7 @@ impl Coupling {
                 margin: self.settings.margin,
                 reports: &mut self.reports,
             };
-            self.solver.step_with(world, &mut hook)?
+            self.solver.step_with(world, &mut (hook, extra))?
         };
         let mut stats = std::mem::take(&mut self.frame.stats);
         for b in &self.frame.bodies {

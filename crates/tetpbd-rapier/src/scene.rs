@@ -3,7 +3,7 @@
 
 use hecs::World;
 use rapier3d::pipeline::PhysicsWorld;
-use tetpbd::SolverSettings;
+use tetpbd::{SolverSettings, SubstepHook};
 
 use crate::coupling::{Coupling, CouplingSettings, RapierContext};
 use crate::error::CouplingError;
@@ -40,7 +40,16 @@ impl CoupledWorld {
 
     /// Advances everything by one frame ([`Coupling::step`]).
     pub fn step(&mut self) -> Result<CouplingStats, CouplingError> {
+        self.step_with(&mut ())
+    }
+
+    /// Advances everything by one frame with another hook in the substeps
+    /// ([`Coupling::step_with`]).
+    pub fn step_with(
+        &mut self,
+        extra: &mut dyn SubstepHook,
+    ) -> Result<CouplingStats, CouplingError> {
         let ctx = RapierContext::from_physics_world(&mut self.physics);
-        self.coupling.step(&mut self.soft, ctx)
+        self.coupling.step_with(&mut self.soft, ctx, extra)
     }
 }
