@@ -9,7 +9,7 @@ use nalgebra::Vector3;
 use rapier3d::math::{Rotation, Vector};
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyType};
 use tetpbd::generators::{self, CellSplit};
-use tetpbd::SoftBodyBuilder;
+use tetpbd::{SoftBodyBuilder, Surface};
 use tetpbd_rapier::{CoupledWorld, DeformationDamping, SoftColliderBuilder, SoftFeature};
 
 /// A slab lying on the ground; with `glued` its bottom particles are pinned where they are.
@@ -200,5 +200,62 @@ fn rigid_corner_does_not_slip_between_particles() {
     assert!(
         missed < 0.4 - 0.05,
         "control: without triangle tests the corner should sink"
+    );
+}
+
+/// A soft cube (0.2 m cells) dropped onto the apex of a fixed cone, the apex under the
+/// middle of a bottom triangle. Returns how deep the apex got inside the cube.
+fn cone_drop(triangles: bool) -> f32 {
+    let mut s = scene(10);
+    let apex = 0.5;
+    s.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vector::new(0.0, apex - 0.25, 0.0)),
+        ColliderBuilder::cone(0.25, 0.1),
+    );
+    let mesh = generators::box_grid(Vector3::repeat(0.4), [2, 2, 2], CellSplit::Six).expect("mesh");
+    let body = SoftBodyBuilder::new(mesh)
+        .density(200.0)
+        .edges(0.0)
+        .volume(0.0)
+        .translation(Vector3::new(0.07, apex + 0.2 + 0.02, 0.13))
+        .build()
+        .expect("body");
+    let e = body.spawn(&mut s.soft);
+    let c = SoftColliderBuilder::new()
+        .triangle_collisions(triangles)
+        .build()
+        .expect("collider");
+    s.soft.insert_one(e, c).expect("entity");
+    // How deep the apex gets inside the (still convex) cube during 0.5 s: its distance
+    // behind the nearest boundary face plane, negative when outside.
+    let tip = Vector3::new(0.0, apex, 0.0);
+    let mut deepest = f32::NEG_INFINITY;
+    for _ in 0..30 {
+        s.step().expect("step");
+        let p = particles(&s, e);
+        let surface = s.soft.get::<&Surface>(e).expect("surface");
+        let depth = surface
+            .triangles()
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| p.positions()[i as usize]);
+                let n = (b - a).cross(&(c - a)).normalize();
+                (a - tip).dot(&n)
+            })
+            .fold(f32::INFINITY, f32::min);
+        deepest = deepest.max(depth);
+    }
+    println!("triangle collisions {triangles}: apex at most {deepest:.4} m inside the cube");
+    deepest
+}
+
+#[test]
+fn cone_apex_does_not_pierce_a_coarse_soft_body() {
+    let missed = cone_drop(false);
+    let caught = cone_drop(true);
+    assert!(caught < 0.005, "pierced by {caught} m");
+    assert!(
+        missed > 0.05,
+        "control: without triangle tests the apex should pierce"
     );
 }
