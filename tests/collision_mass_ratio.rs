@@ -15,6 +15,9 @@ use tetpbd_rapier::SoftCollider;
 #[test]
 fn heavy_box_on_light_slab() {
     let mut s = scene_with(20, 5);
+    // Particles squeezed between the box and the ground get large position corrections;
+    // the core's safety net keeps those from turning into velocity spikes.
+    s.coupling.solver_mut().settings.max_correction_speed = Some(1.0);
     ground(&mut s);
     let size = Vector3::new(0.6, 0.1, 0.6);
     // 1 kg slab: density 1 kg / 0.036 m³.
@@ -57,8 +60,7 @@ fn heavy_box_on_light_slab() {
         p.positions().iter().all(|x| x.norm() < 2.0),
         "slab exploded"
     );
-    // Squeezed particles get short velocity spikes from their position corrections (printed
-    // above); what must hold is that the slab stays in place and keeps its shape.
+    assert!(violent < 1.0, "slab violent: {violent} m/s");
     let (lo, hi) = p.aabb();
     assert!(
         lo.x > -0.35 && lo.z > -0.35 && hi.x < 0.35 && hi.z < 0.35 && lo.y > -0.005 && hi.y < 0.11,
