@@ -12,9 +12,37 @@
 //!   all pairs), contacts re-evaluated as XPBD inequality constraints every iteration of
 //!   every substep (particle vs collider by parry point projection; rigid corners vs soft
 //!   surface triangles).
-//! * Per-body collision properties and groups: the [`SoftCollider`] component.
+//! * Rigid points against soft surface triangles: rigid corners and small shapes do not slip
+//!   between the particles of a coarse soft body.
+//! * Per-body collision properties and groups: the [`SoftCollider`] component; deformation
+//!   damping: the [`DeformationDamping`] component.
 //! * Attachments: the [`Attachments`] component.
 //! * Contact reports: [`Coupling::contacts`]; statistics: [`CouplingStats`].
+//! * Other hooks (e.g. soft–soft contacts) run in the same substeps through
+//!   [`Coupling::step_with`].
+//!
+//! ```
+//! use nalgebra::Vector3;
+//! use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
+//! use tetpbd::{generators, SoftBodyBuilder};
+//! use tetpbd_rapier::{CoupledWorld, SoftColliderBuilder};
+//!
+//! let mut scene = CoupledWorld::new(Default::default(), Default::default())?;
+//! scene.physics.insert(RigidBodyBuilder::fixed(), ColliderBuilder::cuboid(2.0, 0.1, 2.0));
+//! let mesh = generators::box_grid(Vector3::repeat(0.2), [2, 2, 2], generators::CellSplit::Six)?;
+//! let cube = SoftBodyBuilder::new(mesh)
+//!     .edges(0.0)
+//!     .volume(0.0)
+//!     .translation(Vector3::new(0.0, 0.3, 0.0))
+//!     .build()?
+//!     .spawn(&mut scene.soft);
+//! scene.soft.insert_one(cube, SoftColliderBuilder::new().friction(0.8).build()?)?;
+//! for _ in 0..30 {
+//!     scene.step()?;
+//! }
+//! assert!(!scene.coupling.contacts().is_empty());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 //!
 //! Bad input is rejected with a [`CouplingError`] naming what is wrong; conditions that can
 //! only be seen during a step (an attachment whose body was removed, a point parry gives no
