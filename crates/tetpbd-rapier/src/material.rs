@@ -202,3 +202,34 @@ impl SoftColliderBuilder {
         Ok(c)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coefficients_combine_like_rapier() {
+        let soft = SoftColliderBuilder::new()
+            .friction(0.8)
+            .static_friction(1.0)
+            .restitution(0.5)
+            .build()
+            .unwrap();
+        // Average with the collider's rule Average.
+        let (d, s) = soft.combined_friction(0.2, CoefficientCombineRule::Average);
+        assert!((d - 0.5).abs() < 1e-6 && (s - 0.6).abs() < 1e-6);
+        // The stricter rule wins: Min on the collider.
+        let (d, s) = soft.combined_friction(0.2, CoefficientCombineRule::Min);
+        assert!((d - 0.2).abs() < 1e-6 && (s - 0.2).abs() < 1e-6);
+        // Static friction is never below the dynamic one.
+        let low_static = SoftColliderBuilder::new()
+            .friction(0.8)
+            .static_friction(0.1)
+            .build()
+            .unwrap();
+        let (d, s) = low_static.combined_friction(0.8, CoefficientCombineRule::Average);
+        assert!(s >= d);
+        let e = soft.combined_restitution(1.0, CoefficientCombineRule::Max);
+        assert!((e - 1.0).abs() < 1e-6);
+    }
+}
