@@ -6,8 +6,8 @@ mod coupling_common;
 
 use coupling_common::{ground, min_y, particles, run, scene, volume_ratio};
 use nalgebra::Vector3;
-use rapier3d::math::{Rotation, Vector};
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyType};
+use rapier3d::math::{Pose, Rotation, Vector};
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyType, SharedShape};
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::{SoftBodyBuilder, Surface};
 use tetpbd_rapier::{CoupledWorld, DeformationDamping, SoftColliderBuilder, SoftFeature};
@@ -120,7 +120,7 @@ fn ball_rests_on_slab_and_slab_recovers() {
 /// A 1 kg, 0.1 m rigid cube falls corner-first onto the middle of a surface triangle of a
 /// 2-cell-thick slab with 0.4 m cells: no slab particle is anywhere near the corner.
 /// Returns the height of the cube's lowest corner after 1.5 s.
-fn corner_drop(triangles: bool) -> f32 {
+fn corner_drop(triangles: bool, compound: bool) -> f32 {
     let mut s = scene(10);
     ground(&mut s);
     let top = 0.4;
@@ -138,7 +138,12 @@ fn corner_drop(triangles: bool) -> f32 {
         RigidBodyBuilder::dynamic()
             .translation(Vector::new(0.2, top + 0.3, 0.05))
             .rotation(corner_down.to_scaled_axis()),
-        ColliderBuilder::cuboid(h, h, h).density(1000.0),
+        if compound {
+            let part = (Pose::IDENTITY, SharedShape::cuboid(h, h, h));
+            ColliderBuilder::compound(vec![part]).density(1000.0)
+        } else {
+            ColliderBuilder::cuboid(h, h, h).density(1000.0)
+        },
     );
     run(&mut s, 150, 1);
     if triangles {
@@ -193,10 +198,16 @@ fn corner_drop(triangles: bool) -> f32 {
 }
 
 #[test]
+fn compound_corner_does_not_slip_between_particles() {
+    let caught = corner_drop(true, true);
+    assert!(caught > 0.4 - 0.01, "compound corner sank to {caught} m");
+}
+
+#[test]
 fn rigid_corner_does_not_slip_between_particles() {
-    let caught = corner_drop(true);
+    let caught = corner_drop(true, false);
     assert!(caught > 0.4 - 0.01, "corner sank to {caught} m");
-    let missed = corner_drop(false);
+    let missed = corner_drop(false, false);
     assert!(
         missed < 0.4 - 0.05,
         "control: without triangle tests the corner should sink"

@@ -25,11 +25,12 @@
 //!
 //! A triangle whose vertex is itself in contact with the collider (in the same iteration)
 //! is skipped: there the particle contacts hold the surface, and two sets of constraints on
-//! the same spot only fight. Triangle meshes, heightfields and compounds take no part (their contacts with the soft
-//! particles still act). `v` is only caught while its projection falls inside the triangle
-//! (within 0.1 % of its barycentric range, so a point on a shared edge is not lost between
-//! two triangles) and it is less than half the triangle's shortest edge behind it, so
-//! triangles on the far side of the body never grab it.
+//! the same spot only fight. A compound contributes the vertices of its polyhedral parts;
+//! triangle meshes, heightfields and the smooth parts of compounds take no part (their
+//! contacts with the soft particles still act). `v` is only caught while its projection
+//! falls inside the triangle (within 0.1 % of its barycentric range, so a point on a shared
+//! edge is not lost between two triangles) and it is less than half the triangle's shortest
+//! edge behind it, so triangles on the far side of the body never grab it.
 
 use nalgebra::{Point3, Vector3};
 use rapier3d::geometry::{Aabb, ColliderSet};
@@ -95,6 +96,19 @@ pub(crate) fn corners_of(shape: &dyn Shape) -> (Vec<Vector3<f32>>, f32) {
         )
     } else if let Some(t) = shape.as_triangle() {
         (vec![to_na(t.a), to_na(t.b), to_na(t.c)], 0.0)
+    } else if let Some(compound) = shape.as_compound() {
+        // The corners of the polyhedral parts, in the compound's frame (a rounded part's
+        // border radius is not added: parts may differ).
+        let mut all = Vec::new();
+        for (pose, part) in compound.shapes() {
+            let (corners, _) = corners_of(part.as_ref());
+            all.extend(
+                corners
+                    .into_iter()
+                    .map(|c| to_na(pose.transform_point(to_glam(&c)))),
+            );
+        }
+        (all, 0.0)
     } else {
         (Vec::new(), 0.0)
     }
@@ -192,12 +206,6 @@ pub(crate) fn project_corners(
         let idx = tri.map(|i| i as usize);
         let [a, b, c] = idx.map(|i| p.positions()[i]);
         let cp = &colliders[k.collider];
-        let Some(support) = set
-            .get(cp.handle)
-            .and_then(|co| co.shape().as_support_map())
-        else {
-            continue;
-        };
         let m = (b - a).cross(&(c - a));
         let area2 = m.norm();
         let shortest = (b - a).norm().min((c - b).norm()).min((a - c).norm());
@@ -209,6 +217,12 @@ pub(crate) fn project_corners(
         let local = match k.corner {
             Some(c) => c,
             None => {
+                let Some(support) = set
+                    .get(cp.handle)
+                    .and_then(|co| co.shape().as_support_map())
+                else {
+                    continue;
+                };
                 let dir = pose.rotation.inverse() * (-n);
                 to_na(support.local_support_point(to_glam(&dir)))
             }
