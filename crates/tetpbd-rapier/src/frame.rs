@@ -103,6 +103,8 @@ pub(crate) struct Frame {
     pub contacts: Vec<ParticleContact>,
     pub corners: Vec<CornerContact>,
     pub attachments: Vec<AttachRun>,
+    near: Vec<ColliderHandle>,
+    vertex_contacts: Vec<(u32, usize)>,
     /// Impact episodes in progress (kept across frames).
     pub episodes: Vec<crate::restitution::Episode>,
     pub substep: u32,
@@ -252,16 +254,18 @@ impl Frame {
                 let reach = input.margin + sc.thickness + p.max_speed() * dt + fall;
                 let (lo, hi) = surface_bounds(p, surface);
                 let aabb = Aabb::new(to_glam(&lo), to_glam(&hi)).loosened(reach);
-                let near: Vec<ColliderHandle> = qp
-                    .intersect_aabb_conservative(aabb)
-                    .filter(|(_, co)| {
-                        co.is_enabled()
-                            && !co.is_sensor()
-                            && sc.collision_groups.test(co.collision_groups())
-                    })
-                    .map(|(h, _)| h)
-                    .collect();
-                for handle in near {
+                let mut near = std::mem::take(&mut self.near);
+                near.clear();
+                near.extend(
+                    qp.intersect_aabb_conservative(aabb)
+                        .filter(|(_, co)| {
+                            co.is_enabled()
+                                && !co.is_sensor()
+                                && sc.collision_groups.test(co.collision_groups())
+                        })
+                        .map(|(h, _)| h),
+                );
+                for &handle in &near {
                     let Some(ci) =
                         self.collider_proxy(handle, qp.bodies, qp.colliders, input.narrow_phase)
                     else {
@@ -307,9 +311,12 @@ impl Frame {
                         });
                     }
                     if sc.triangles && solve {
-                        let vertex_contacts: Vec<(u32, usize)> = (first..self.contacts.len())
-                            .map(|k| (self.contacts[k].particle, k - c0))
-                            .collect();
+                        let mut vertex_contacts = std::mem::take(&mut self.vertex_contacts);
+                        vertex_contacts.clear();
+                        vertex_contacts.extend(
+                            (first..self.contacts.len())
+                                .map(|k| (self.contacts[k].particle, k - c0)),
+                        );
                         gather_corners(
                             &mut self.corners,
                             co.shape(),
@@ -322,8 +329,10 @@ impl Frame {
                             (mu_d, mu_s, e),
                             &vertex_contacts,
                         );
+                        self.vertex_contacts = vertex_contacts;
                     }
                 }
+                self.near = near;
             }
             if let Some(att) = att {
                 for a in &att.items {
