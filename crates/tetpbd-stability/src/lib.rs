@@ -9,10 +9,12 @@
 
 mod cases;
 mod config;
+mod coupled;
 mod report;
 mod run;
 
 pub use cases::{all_cases, Case, CaseKind};
 pub use config::{Config, ConstraintSet};
+pub use coupled::{coupled_cases, CoupledCase, CoupledOutcome};
 pub use report::markdown;
 pub use run::{run_scene, Outcome, Scene, Start};

@@ -114,3 +114,48 @@ fn long_cases_pass_with_hard_edges_and_volume() {
         );
     }
 }
+
+mod coupled {
+    use tetpbd_stability::{coupled_cases, CaseKind, Config, ConstraintSet};
+
+    fn case(name: &str) -> tetpbd_stability::CoupledCase {
+        coupled_cases()
+            .into_iter()
+            .find(|c| c.name == name)
+            .expect("case exists")
+    }
+
+    #[test]
+    fn light_soft_body_rests_on_a_heavy_free_plank_under_every_configuration() {
+        let c = case("soft 1 kg on rigid 1000 kg");
+        for config in Config::all() {
+            let o = (c.run)(&config);
+            assert!(o.pass(), "{}: {o:?}", config.label());
+        }
+    }
+
+    #[test]
+    fn heavy_rigid_box_on_light_soft_slab_holds_with_20_substeps_of_5_iterations() {
+        let c = case("rigid 1000 kg on soft 1 kg, 20 × 5");
+        for set in [ConstraintSet::EdgesVolume, ConstraintSet::VertexFaceEdges] {
+            let config = Config { set, soft: false };
+            let o = (c.run)(&config);
+            assert!(o.pass(), "{}: {o:?}", config.label());
+        }
+    }
+
+    #[test]
+    #[ignore = "long: run in release by .ci/run"]
+    fn soft_cube_rests_100k_frames_on_rigid_ground() {
+        let c = coupled_cases()
+            .into_iter()
+            .find(|c| c.kind == CaseKind::Long)
+            .expect("long case");
+        let config = Config {
+            set: ConstraintSet::EdgesVolume,
+            soft: false,
+        };
+        let o = (c.run)(&config);
+        assert!(o.pass(), "{o:?}");
+    }
+}

@@ -11,7 +11,9 @@ use std::fmt::Write as _;
 use std::process::Command;
 use std::time::Instant;
 
-use tetpbd_stability::{all_cases, markdown, run_scene, CaseKind, Config, Outcome};
+use tetpbd_stability::{
+    all_cases, coupled_cases, markdown, run_scene, CaseKind, Config, CoupledOutcome, Outcome,
+};
 
 const SAFETY_NET: f32 = 10.0;
 
@@ -120,10 +122,85 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         writeln!(doc)?;
     }
+    writeln!(doc, "## Coupled with rapier rigid bodies\n")?;
+    writeln!(
+        doc,
+        "Through `tetpbd-rapier` (10 substeps, default coupling settings). A cell reads pass/FAIL (finite, no \
+         inverted tetrahedron at the end, and the case's own criterion), the criterion's figures, the peak \
+         particle speed and the largest penetration over the last second. The long case runs under the hard \
+         configurations only.\n"
+    )?;
+    write!(doc, "| case |")?;
+    for c in &configs {
+        write!(doc, " {} |", c.label())?;
+    }
+    writeln!(doc)?;
+    write!(doc, "|---|")?;
+    for _ in &configs {
+        write!(doc, "---|")?;
+    }
+    writeln!(doc)?;
+    let mut coupled_pass = (0, 0);
+    for case in coupled_cases() {
+        if fast && case.kind == CaseKind::Long {
+            continue;
+        }
+        let t = Instant::now();
+        write!(doc, "| {} |", case.name)?;
+        for c in &configs {
+            if case.kind == CaseKind::Long && c.soft {
+                write!(doc, " — |")?;
+                continue;
+            }
+            let o: CoupledOutcome = (case.run)(c);
+            coupled_pass.1 += 1;
+            if o.pass() {
+                coupled_pass.0 += 1;
+            }
+            let verdict = if o.pass() { "**pass**" } else { "**FAIL**" };
+            match &o.error {
+                Some(e) => write!(doc, " rejected: {e} |")?,
+                None => write!(
+                    doc,
+                    " {verdict} {}, peak {:.1} m/s, pen {:.1e} m{} |",
+                    o.criterion.1,
+                    o.peak_speed,
+                    o.penetration,
+                    if o.inverted > 0 {
+                        format!(", inv {}", o.inverted)
+                    } else {
+                        String::new()
+                    }
+                )?,
+            }
+        }
+        writeln!(doc)?;
+        println!(
+            "[{:6.1} s] coupled: {} ({:.1} s)",
+            started.elapsed().as_secs_f64(),
+            case.name,
+            t.elapsed().as_secs_f64()
+        );
+    }
+    writeln!(
+        doc,
+        "\n{} of {} coupled cells pass.\n",
+        coupled_pass.0, coupled_pass.1
+    )?;
+    for case in coupled_cases() {
+        writeln!(doc, "- *{}*: {}.", case.name, case.description)?;
+    }
+    writeln!(doc)?;
+    doc.push_str(include_str!("findings.md"));
     std::fs::write(&out, &doc)?;
     for (title, passed, total) in totals {
         println!("{title}: {passed} passed, {} failed", total - passed);
     }
+    println!(
+        "coupled: {} passed, {} failed",
+        coupled_pass.0,
+        coupled_pass.1 - coupled_pass.0
+    );
     println!("wrote {out} in {:.1} s", started.elapsed().as_secs_f64());
     Ok(())
 }
