@@ -65,6 +65,8 @@ pub struct RunResult {
     pub frame_ms: Vec<f64>,
     /// Median thread CPU ms per frame over the same frames.
     pub cpu_ms_median: f64,
+    /// The wall-time median of each run pooled into this one (this run's first).
+    pub repeat_medians: Vec<f64>,
     /// Thread CPU ms of every measured frame, sorted.
     pub frame_cpu_ms: Vec<f64>,
     /// Projections and their wall ms over the measured frames.
@@ -137,6 +139,7 @@ pub fn run(sim: &mut dyn Sim, scene: &Scene) -> RunResult {
     RunResult {
         ms_median: times.get(times.len() / 2).copied().unwrap_or(f64::NAN),
         ns_per_projection: (proj > 0).then(|| proj_ms * 1e6 / proj as f64),
+        repeat_medians: vec![times.get(times.len() / 2).copied().unwrap_or(f64::NAN)],
         frame_ms: times,
         cpu_ms_median: cpu.get(cpu.len() / 2).copied().unwrap_or(f64::NAN),
         frame_cpu_ms: cpu,
@@ -153,9 +156,29 @@ pub fn run(sim: &mut dyn Sim, scene: &Scene) -> RunResult {
 }
 
 impl RunResult {
+    /// Relative spread of the pooled runs' wall-time medians, `max / min − 1` (NaN for a
+    /// single run).
+    pub fn timing_spread(&self) -> f64 {
+        if self.repeat_medians.len() < 2 {
+            return f64::NAN;
+        }
+        let lo = self
+            .repeat_medians
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let hi = self.repeat_medians.iter().copied().fold(0.0, f64::max);
+        if lo > 0.0 && lo.is_finite() {
+            hi / lo - 1.0
+        } else {
+            f64::NAN
+        }
+    }
+
     /// Pools the frame times of another run of the same configuration into this one's timing
     /// (the median is then over both runs' measured frames).
     pub fn pool_timing(&mut self, other: &RunResult) {
+        self.repeat_medians.push(other.ms_median);
         self.frame_ms.extend_from_slice(&other.frame_ms);
         self.frame_ms.sort_by(f64::total_cmp);
         self.ms_median = self

@@ -29,6 +29,8 @@ pub struct Row {
     pub ms: f64,
     /// Median thread CPU ms per frame over the same frames.
     pub cpu_ms: f64,
+    /// Spread of the wall-time medians of the pooled runs, `max / min − 1`.
+    pub timing_spread: f64,
     /// ns per constraint projection (tetpbd).
     pub ns_per_projection: Option<f64>,
     /// Deviation from the model's converged reference.
@@ -86,6 +88,7 @@ impl Row {
             iterations,
             ms: res.ms_median,
             cpu_ms: res.cpu_ms_median,
+            timing_spread: res.timing_spread(),
             ns_per_projection: res.ns_per_projection,
             dev,
             volume_err_pct: res.last.volume_err_pct,
@@ -138,6 +141,7 @@ fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
 pub fn results_csv(rows: &[Row]) -> String {
     let mut s = String::from(
         "scene,engine,model,hard,substeps,iterations,ms_per_frame_median,cpu_ms_per_frame_median,\
+         timing_spread,\
          ns_per_projection,\
          dev_max_rel,dev_rms_rel,volume_err_pct,late_volume_err_pct_max,edge_strain_rms,\
          edge_strain_max,inverted,inverted_max,edge_c_rms_m,edge_c_max_m,vertex_face_c_rms_m,\
@@ -152,7 +156,7 @@ pub fn results_csv(rows: &[Row]) -> String {
         };
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{:.6},{:.6},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{},{},{:e}",
+            "{},{},{},{},{},{},{:.6},{:.6},{:.4},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{},{},{:e}",
             r.scene,
             r.model.engine(),
             r.model.label(),
@@ -161,6 +165,7 @@ pub fn results_csv(rows: &[Row]) -> String {
             r.iterations,
             r.ms,
             r.cpu_ms,
+            r.timing_spread,
             opt(r.ns_per_projection.map(|n| format!("{n:.2}"))),
             r.dev.max,
             r.dev.rms,

@@ -307,6 +307,15 @@ pub fn markdown(
     for b in &briefs {
         let _ = writeln!(s, "{b}");
     }
+    let mut spread: Vec<f64> = rows
+        .iter()
+        .map(|r| r.timing_spread)
+        .filter(|x| x.is_finite())
+        .collect();
+    spread.sort_by(f64::total_cmp);
+    if let (Some(m), Some(p90)) = (median(spread.clone()), spread.get(spread.len() * 9 / 10)) {
+        let _ = writeln!(s, "\nTiming noise: the wall-time medians of the two runs of each configuration differ by {:.1} % (median over all configurations; 90th percentile {:.1} %). Ratios near 1 in the table are within that noise.", m * 100.0, p90 * 100.0);
+    }
     let _ = writeln!(s, "\nThe last two columns repeat the comparison with each run's median thread CPU time per frame instead of its wall time (both engines run on the calling thread): on a loaded machine they show how much of the wall-time figure is contention.");
     let _ = writeln!(s, "\n### Details\n\n{details}");
     crate::summary_setup::setup(&mut s, scenes, rows, references);
