@@ -13,9 +13,16 @@
 //! Friction (positional, Müller et al. 2020): the relative tangential displacement `Δp_t` of
 //! the particle against the body's material point over the substep is removed completely
 //! while the accumulated tangential multiplier stays under `μ_s λ_n` (sticking), otherwise
-//! only up to `μ_d λ_n` (sliding). The velocity pass then removes the separating normal
-//! velocity the projection gave each contact particle; restitution is applied to the whole
-//! body by [`crate::restitution`].
+//! only up to `μ_d λ_n` (sliding).
+//!
+//! Overlap a contact starts with (a particle created inside a collider, not touching it in
+//! the previous frame) is not resolved at once: the contact tolerates an allowance, the
+//! starting depth less `max_depenetration_speed · h`, which shrinks by that much every
+//! substep, so the overlap is pushed out at a bounded speed instead of turning into an
+//! explosion. Ongoing contacts and fresh impacts have no allowance.
+//!
+//! The velocity pass then removes the separating normal velocity the projection gave each
+//! contact particle; restitution is applied to the whole body by [`crate::restitution`].
 
 use nalgebra::{Point3, Vector3};
 use rapier3d::geometry::ColliderSet;
@@ -33,6 +40,7 @@ pub(crate) fn project_contacts(
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
     set: &ColliderSet,
+    max_push: f32,
 ) -> u64 {
     let mut degenerate = 0;
     for c in contacts {
@@ -49,8 +57,22 @@ pub(crate) fn project_contacts(
             continue;
         };
         let (q, n) = (sp.point, sp.normal);
-        let c_val = sp.distance - c.thickness;
-        if c_val >= 0.0 {
+        let depth = c.thickness - sp.distance;
+        if !c.allowance_fresh {
+            // First evaluation of this contact in the frame. If it is deeper than one substep
+            // may push out and was already this deep at the substep start (an overlap, not an
+            // impact), resolve only `max_push` of that pre-existing overlap per substep: the
+            // allowance decays by `max_push` each substep (`finish_substep`).
+            c.allowance_fresh = true;
+            if depth > max_push {
+                let x0 = p.prev_positions()[i];
+                if let Some(s0) = surface_point(shape, cp.rule, &pose, &x0, Some(n)) {
+                    c.allowance = (c.thickness - s0.distance - max_push).max(0.0);
+                }
+            }
+        }
+        let c_val = -depth + c.allowance;
+        if depth <= 0.0 {
             continue;
         }
         c.active = true;
@@ -58,8 +80,8 @@ pub(crate) fn project_contacts(
         c.has_normal = true;
         c.normal = n;
         c.point = q;
-        c.depth = c.depth.max(-c_val);
-        if !c.solve {
+        c.depth = c.depth.max(depth);
+        if !c.solve || c_val >= 0.0 {
             continue;
         }
         let w_p = p.inv_masses()[i];
@@ -160,12 +182,13 @@ pub(crate) fn velocity_pass(
 }
 
 /// Resets the per-substep state of the contacts; the substep's impulses join the frame's.
-pub(crate) fn finish_substep(contacts: &mut [ParticleContact], h: f32) {
+pub(crate) fn finish_substep(contacts: &mut [ParticleContact], h: f32, max_push: f32) {
     for c in contacts {
         c.impulse += c.sub_impulse / h;
         c.sub_impulse = Vector3::zeros();
         c.lambda_n = 0.0;
         c.lambda_t = 0.0;
         c.active = false;
+        c.allowance = (c.allowance - max_push).max(0.0);
     }
 }

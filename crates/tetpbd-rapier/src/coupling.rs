@@ -29,6 +29,12 @@ pub struct CouplingSettings {
     pub margin: f32,
     /// Collision properties of soft bodies without a [`SoftCollider`] component.
     pub default_collider: SoftCollider,
+    /// Largest speed at which an overlap a contact starts with (a soft body created inside
+    /// a rigid one, a pair not touching in the previous frame) is pushed out, m/s (> 0). Such
+    /// an overlap is resolved over several substeps and frames instead of in one substep, so
+    /// separation does not turn into an explosion. Ongoing contacts and impacts (no overlap at
+    /// the substep start) are resolved fully, whatever their depth.
+    pub max_depenetration_speed: f32,
 }
 
 impl Default for CouplingSettings {
@@ -36,6 +42,7 @@ impl Default for CouplingSettings {
         CouplingSettings {
             margin: 0.02,
             default_collider: SoftCollider::default(),
+            max_depenetration_speed: 2.0,
         }
     }
 }
@@ -47,6 +54,12 @@ impl CouplingSettings {
             return Err(CouplingError::BadSetting {
                 name: "margin (m)",
                 value: self.margin,
+            });
+        }
+        if !(self.max_depenetration_speed.is_finite() && self.max_depenetration_speed > 0.0) {
+            return Err(CouplingError::BadSetting {
+                name: "max depenetration speed (m/s)",
+                value: self.max_depenetration_speed,
             });
         }
         Ok(())
@@ -273,6 +286,7 @@ impl Coupling {
                 narrow_phase: &*ctx.narrow_phase,
                 default_collider: self.settings.default_collider,
                 margin: self.settings.margin,
+                max_depenetration_speed: self.settings.max_depenetration_speed,
                 reports: &mut self.reports,
             };
             self.solver.step_with(world, &mut (hook, extra))?

@@ -75,9 +75,18 @@ pub(crate) struct ParticleContact {
     pub normal: Vector3<f32>,
     pub point: Vector3<f32>,
     pub depth: f32,
+    /// Penetration tolerated in this substep (pre-existing overlap beyond one substep's
+    /// allowed push-out), m; see `CouplingSettings::max_depenetration_speed`.
+    pub allowance: f32,
+    /// Whether `allowance` was decided: at the contact's first evaluation in the frame, or
+    /// at gathering for a pair already touching in the previous frame (no allowance).
+    pub allowance_fresh: bool,
     pub sub_impulse: Vector3<f32>,
     pub impulse: Vector3<f32>,
 }
+
+/// A particle–collider pair: `(entity bits, collider handle (index, generation), particle)`.
+pub(crate) type PairKey = (u64, (u32, u32), u32);
 
 /// An attachment in the frame.
 #[derive(Clone, Debug)]
@@ -94,6 +103,12 @@ pub(crate) struct AttachRun {
 /// Everything the coupling keeps for one frame (allocations reused across frames).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Frame {
+    /// Particle–collider pairs in contact during the previous frame, sorted by
+    /// `(entity bits, collider handle (index, generation), particle)`, with the overlap
+    /// allowance they still had (m). A contact found in this frame whose pair is not here is
+    /// new: an overlap it starts with is pushed out at the bounded depenetration speed (see
+    /// `contact::project_contacts`); one that is here continues with its allowance.
+    pub touching: Vec<(PairKey, f32)>,
     pub start_poses: Vec<((u32, u32), StartState)>,
     pub soft: Vec<SoftEntry>,
     pub bodies: Vec<BodyProxy>,
@@ -290,6 +305,8 @@ impl Frame {
                         if !pa.intersects(&caabb) {
                             continue;
                         }
+                        let key = (entity.to_bits().get(), handle.into_raw_parts(), i);
+                        let previous = self.touching.binary_search_by_key(&key, |t| t.0).ok();
                         self.contacts.push(ParticleContact {
                             particle: i,
                             collider: ci,
@@ -306,6 +323,10 @@ impl Frame {
                             normal: Vector3::zeros(),
                             point: Vector3::zeros(),
                             depth: 0.0,
+                            // Touching in the previous frame: an ongoing contact, which keeps
+                            // what is left of its overlap allowance (usually nothing).
+                            allowance: previous.map_or(0.0, |k| self.touching[k].1),
+                            allowance_fresh: previous.is_some(),
                             sub_impulse: Vector3::zeros(),
                             impulse: Vector3::zeros(),
                         });
@@ -396,4 +417,22 @@ fn surface_bounds(p: &Particles, surface: &Surface) -> (Vector3<f32>, Vector3<f3
         hi = hi.sup(&x);
     }
     (lo, hi)
+}
+
+impl Frame {
+    /// Remembers which particle–collider pairs touched in this frame (for the next frame's
+    /// new-overlap test). Reuses the allocation.
+    pub fn remember_touching(&mut self) {
+        self.touching.clear();
+        for s in &self.soft {
+            for c in &self.contacts[s.contacts.clone()] {
+                if c.ever_active {
+                    let handle = self.colliders[c.collider].handle.into_raw_parts();
+                    let key = (s.entity.to_bits().get(), handle, c.particle);
+                    self.touching.push((key, c.allowance));
+                }
+            }
+        }
+        self.touching.sort_unstable_by_key(|t| t.0);
+    }
 }

@@ -22,6 +22,7 @@ pub(crate) struct CouplingHook<'q, 'a> {
     pub narrow_phase: &'a NarrowPhase,
     pub default_collider: SoftCollider,
     pub margin: f32,
+    pub max_depenetration_speed: f32,
     pub reports: &'q mut Vec<ContactReport>,
 }
 
@@ -81,6 +82,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 bodies,
                 colliders,
                 self.qp.colliders,
+                self.max_depenetration_speed * h,
             );
             project_corners(
                 &mut corners[s.corners.clone()],
@@ -131,7 +133,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 colliders,
                 threshold,
             );
-            finish_substep(&mut contacts[range], h);
+            finish_substep(&mut contacts[range], h, self.max_depenetration_speed * h);
         }
         end_episodes(episodes);
         for k in corners.iter_mut() {
@@ -144,6 +146,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
     }
 
     fn end_frame(&mut self, world: &mut World, _dt: f32) {
+        self.frame.remember_touching();
         let frame = &mut *self.frame;
         self.reports.clear();
         let mut max_pen = 0.0f32;

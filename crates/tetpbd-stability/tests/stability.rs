@@ -159,3 +159,19 @@ mod coupled {
         assert!(o.pass(), "{o:?}");
     }
 }
+
+mod coupled_overlap {
+    use tetpbd_stability::{coupled_cases, Config};
+
+    #[test]
+    fn soft_cube_created_half_in_the_ground_separates_under_every_configuration() {
+        let c = coupled_cases()
+            .into_iter()
+            .find(|c| c.name == "created half in the ground")
+            .expect("case exists");
+        for config in Config::all() {
+            let o = (c.run)(&config);
+            assert!(o.pass(), "{}: {o:?}", config.label());
+        }
+    }
+}
