@@ -73,12 +73,16 @@ fn ball_at_20_m_per_s_does_not_pass_through() {
     let mut pen = 0.0f32;
     let mut above = f32::INFINITY;
     let mut rebound = 0.0f32;
-    for _ in 0..60 {
+    for _ in 0..30 {
         s.step();
         pen = pen.max(penetration(&s.world, ball, sheet).1);
         pen = pen.max(penetration(&s.world, sheet, ball).1);
         let p = s.particles(ball);
-        above = above.min(p.center_of_mass().y - s.particles(sheet).aabb().0.y);
+        let c = p.center_of_mass();
+        // Over the sheet (the ball may roll off its edge later, which is not passing through).
+        if c.x.abs() < 0.8 && c.z.abs() < 0.8 {
+            above = above.min(c.y - s.particles(sheet).aabb().0.y);
+        }
         rebound = rebound.max(p.linear_momentum().y / p.total_mass());
     }
     println!(

@@ -66,10 +66,14 @@ impl Scene {
     /// Largest interpenetration over all ordered pairs of distinct bodies (see
     /// [`penetration`]), m.
     pub fn max_interpenetration(&self, bodies: &[Entity]) -> f32 {
+        let boxes: Vec<_> = bodies.iter().map(|&e| self.particles(e).aabb()).collect();
         let mut pen = 0.0f32;
-        for &a in bodies {
-            for &b in bodies {
-                if a != b {
+        for (i, &a) in bodies.iter().enumerate() {
+            for (j, &b) in bodies.iter().enumerate() {
+                let (la, ha) = boxes[i];
+                let (lb, hb) = boxes[j];
+                let overlap = (0..3).all(|k| la[k] <= hb[k] && lb[k] <= ha[k]);
+                if a != b && overlap {
                     pen = pen.max(penetration(&self.world, a, b).1);
                 }
             }

@@ -68,6 +68,7 @@ mod soft_bvh;
 mod soft_contact;
 mod soft_gather;
 mod soft_project;
+mod soft_restitution;
 mod soft_separation;
 
 pub use attachment::{AttachTarget, Attachment, Attachments};

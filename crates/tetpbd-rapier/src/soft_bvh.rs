@@ -391,3 +391,58 @@ mod tests {
         assert!(in_tet(&Vector3::new(0.1, 0.1, 0.1), &flipped));
     }
 }
+
+#[cfg(test)]
+mod bvh_tests {
+    use super::*;
+    use tetpbd::generators::{self, CellSplit};
+    use tetpbd::SoftBodyBuilder;
+
+    /// The refitted triangle BVH finds exactly the triangles a brute-force box test finds,
+    /// also after the body moved and deformed.
+    #[test]
+    fn refit_matches_brute_force() {
+        let mesh = generators::box_grid(Vector3::new(2.0, 0.06, 2.0), [8, 1, 8], CellSplit::Six)
+            .expect("mesh");
+        let body = SoftBodyBuilder::new(mesh).build().expect("body");
+        let n = body.particles.len();
+        let mut cache = BodyCache::build(&body.surface, &body.tetrahedra, n).expect("cache");
+        let mut xs: Vec<Vector3<f32>> = cache
+            .vertices
+            .iter()
+            .map(|&i| body.particles.positions()[i as usize])
+            .collect();
+        let motion = vec![0.001; xs.len()];
+        for round in 0..3 {
+            cache.refit_triangles(&xs, &motion);
+            for k in 0..40 {
+                let q = Vector3::new(-1.0 + 0.05 * k as f32, 0.03 + 0.001 * round as f32, 0.013);
+                let r = 0.02;
+                let (lo, hi) = (q - Vector3::repeat(r), q + Vector3::repeat(r));
+                let aabb = Aabb::new(to_glam(&lo), to_glam(&hi));
+                let mut found: Vec<u32> = cache.tri_bvh.intersect_aabb(&aabb).collect();
+                found.sort_unstable();
+                let brute: Vec<u32> = (0..cache.triangles.len() as u32)
+                    .filter(|&t| {
+                        let (mut a, mut b) = (Vector3::repeat(f32::MAX), Vector3::repeat(f32::MIN));
+                        for &v in &cache.triangles[t as usize] {
+                            a = a.inf(&(xs[v as usize] - Vector3::repeat(0.001)));
+                            b = b.sup(&(xs[v as usize] + Vector3::repeat(0.001)));
+                        }
+                        (0..3).all(|i| a[i] <= hi[i] && lo[i] <= b[i])
+                    })
+                    .collect();
+                assert_eq!(found, brute, "round {round}, query {k}");
+            }
+            for k in 0..40 {
+                let q = Vector3::new(-0.9 + 0.045 * k as f32, 0.01 * round as f32, 0.013);
+                let t = cache.closest_triangle(&q, &xs);
+                assert!(t.is_some(), "round {round}, closest query {k}: none");
+            }
+            for (j, x) in xs.iter_mut().enumerate() {
+                x.y += 0.001 * (j % 7) as f32;
+                x.x += 0.01;
+            }
+        }
+    }
+}

@@ -19,8 +19,10 @@
 //! (an inequality), every iteration of every substep. Friction is positional (Müller et al.
 //! 2020): the relative tangential displacement of `p` against `q` over the substep is removed
 //! while the tangential multiplier stays under `μ_s λ`, otherwise only up to `μ_d λ`. After
-//! each substep the separating normal velocity a contact's projection created is removed
-//! (restitution 0), so corrections do not turn into bounces.
+//! each substep the separating normal velocity
+//! a contact's projection created is removed, and, with
+//! [`SoftContactSettings::inelastic`], so is the separating velocity of the two bodies'
+//! centres of mass (see `soft_restitution`), so impacts do not turn into bounces.
 //!
 //! # Candidates (once per frame)
 //!
@@ -29,18 +31,28 @@
 //! `m = |v| dt + ½ a_max dt²` (`a_max` = [`SoftContactSettings::max_acceleration`]); a
 //! particle–triangle pair is a candidate when the particle's box grown by `m + margin + δ`
 //! meets the triangle's box grown by its vertices' bounds. A candidate is kept only when the
-//! particle starts the frame on the outer side of the triangle's plane (`d₀ ≥ −δ`), and it is
-//! active only while the particle is inside the triangle's prism and less than the frame's
-//! relative motion behind it. That is what catches a fast particle: one that crosses a
-//! thin sheet within a substep is still within `m` of the face it came from, and is pushed
-//! back to it, while a particle resting under the sheet is never pulled through it.
+//! particle starts the frame on the outer side of the triangle's plane (`d₀ ≥ −δ`). It is
+//! active when the particle is less than the frame's relative motion behind the plane and
+//! either was over the triangle (inside its prism) at the substep start and still is, or its
+//! path over the substep crossed the plane inside the triangle. That is what catches a fast
+//! particle: one that crosses a thin sheet within a substep is still within `m` of the face
+//! it came from and is pushed back to it, while a particle resting under the sheet is never
+//! pulled through it, and one sliding past a face's edge beside it does not snag on it.
 //!
 //! # Deep overlap and the speed bound
 //!
-//! Every contact's target is `min(δ, d_prev + S h)`, with `d_prev` the particle's signed
-//! distance to the triangle's plane at the substep start and `S` =
-//! [`SoftContactSettings::max_separation_speed`]: a contact never separates its particle
-//! from its triangle faster than `S`.
+//! Every contact's target height is reached at a bounded rate: with `d_prev` the
+//! particle's signed distance to the triangle's plane at the substep start,
+//!
+//! ```text
+//! target = max( min(0, d_prev + S h), min(δ, d_prev + S_skin h) )
+//! ```
+//!
+//! `S` = [`SoftContactSettings::max_separation_speed`], `S_skin` =
+//! [`SoftContactSettings::skin_speed`]. A particle arriving from outside (`d_prev ≥ δ`) goes
+//! straight back to `δ` (that is what stops a fast particle); one found below the surface
+//! comes out at no more than `S`; one inside the skin `[0, δ)` (bodies created touching)
+//! creeps out at `S_skin`, so touching bodies do not pop apart.
 //!
 //! A surface particle that starts the frame strictly inside a tetrahedron of another body
 //! is *deep*: it is not projected (pushing only the surface particles of the overlap region
@@ -51,8 +63,8 @@
 //!
 //! **Bound:** bodies created inside each other separate at a relative speed of at most `S`
 //! (m/s; default 2), i.e. by `S·dt` per frame, and the separation itself adds no particle
-//! velocity. Each substep in which a pair's separation (or a contact's target) was limited
-//! by `S` counts as one clamp in [`SoftContactStats::clamps`].
+//! velocity. Each substep in which a pair's separation, or a contact below the surface, was
+//! limited by `S` counts as one clamp in [`SoftContactStats::clamps`].
 //!
 //! # Limits
 //!
@@ -67,6 +79,7 @@ use tetpbd::SubstepHook;
 
 use crate::error::CouplingError;
 use crate::soft_gather::{ContactFrame, Gather};
+use crate::soft_restitution::body_restitution;
 use crate::soft_separation::Separation;
 
 /// Opt-in marker component: this soft body also collides with itself (surface particles
@@ -90,6 +103,14 @@ pub struct SoftContactSettings {
     /// `S`: the largest relative normal speed at which a contact separates two surfaces,
     /// m/s (> 0). Bounds how fast deep overlaps are resolved (see the module docs).
     pub max_separation_speed: f32,
+    /// `S_skin`: the largest speed at which a particle that starts a substep inside the
+    /// contact skin `[0, δ)` of a surface (e.g. bodies created touching) is pushed to the
+    /// full thickness, m/s (> 0). Small, so touching bodies do not pop apart.
+    pub skin_speed: f32,
+    /// Body-level restitution 0: after every substep, bodies in contact stop separating as
+    /// wholes along their contact normal (see `soft_restitution`). Without it stiff bodies
+    /// spring back off each other at a large part of their impact speed.
+    pub inelastic: bool,
     /// Static friction coefficient between soft bodies (≥ 0, dimensionless).
     pub static_friction: f32,
     /// Dynamic friction coefficient between soft bodies (≥ 0, dimensionless).
@@ -105,6 +126,8 @@ impl Default for SoftContactSettings {
             margin: 0.01,
             max_acceleration: 20.0,
             max_separation_speed: 2.0,
+            skin_speed: 0.1,
+            inelastic: true,
             static_friction: 0.5,
             dynamic_friction: 0.4,
             compliance: 0.0,
@@ -197,6 +220,7 @@ pub struct SoftContacts {
     gather: Gather,
     frame: ContactFrame,
     separation: Separation,
+    pair_normals: Vec<nalgebra::Vector3<f32>>,
     stats: SoftContactStats,
 }
 
@@ -209,6 +233,7 @@ impl SoftContacts {
             gather: Gather::default(),
             frame: ContactFrame::default(),
             separation: Separation::default(),
+            pair_normals: Vec::new(),
             stats: SoftContactStats::default(),
         })
     }
@@ -274,6 +299,9 @@ impl SubstepHook for SoftContacts {
         self.separation
             .remove_velocity(world, &self.gather.bodies, h);
         self.frame.velocity_pass(world, &self.gather);
+        if self.settings.inelastic {
+            body_restitution(world, &self.gather, &self.frame, &mut self.pair_normals);
+        }
     }
 
     fn end_frame(&mut self, world: &mut World, _dt: f32) {

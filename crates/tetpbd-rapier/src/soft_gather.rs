@@ -50,6 +50,10 @@ pub(crate) struct Candidate {
     pub ever: bool,
     /// Limited by the separation speed in the current substep.
     pub clamped: bool,
+    /// The particle projected inside the triangle at the substep start.
+    pub prism_prev: bool,
+    /// `w_p + Σ β² w` of the last projection, 1/kg.
+    pub wsum: f32,
     /// Normal and barycentrics of the last projection.
     pub n: Vector3<f32>,
     pub bary: [f32; 3],
@@ -89,7 +93,7 @@ pub(crate) struct Gather {
     caches: Vec<CacheEntry>,
     list: Vec<(u64, Entity, bool)>,
     order: Vec<usize>,
-    pairs: Vec<(usize, usize)>,
+    pub pairs: Vec<(usize, usize)>,
     deep_a: Vec<Vector3<f32>>,
     deep_b: Vec<Vector3<f32>>,
     pub bodies: Vec<FrameBody>,
@@ -257,7 +261,8 @@ impl Gather {
         }
     }
 
-    fn body_of_slot(&self, slot: usize) -> usize {
+    /// Index of the frame body owning `slot`.
+    pub fn body_of_slot(&self, slot: usize) -> usize {
         self.bodies.partition_point(|b| b.offset + b.len <= slot)
     }
 
@@ -391,6 +396,8 @@ fn candidate(p: u32, tri: [u32; 3], recovery: bool, depth_limit: f32) -> Candida
         active: false,
         ever: false,
         clamped: false,
+        prism_prev: false,
+        wsum: 0.0,
         n: Vector3::zeros(),
         bary: [1.0 / 3.0; 3],
     }

@@ -7,13 +7,14 @@ use nalgebra::Vector3;
 use tetpbd::Particles;
 
 use crate::convert::finite3;
-use crate::soft_bvh::{plane_barycentric, triangle_normal};
+use crate::soft_bvh::{closest_barycentric, plane_barycentric, triangle_normal};
 use crate::soft_contact::{SoftContactSettings, SoftContactStats};
 use crate::soft_gather::{Candidate, ContactFrame, Gather};
 
 /// How far (in barycentric units) a particle's projection may lie outside a triangle and
-/// still count as inside its prism; closes the gaps between the prisms of a convex edge.
-const PRISM_TOLERANCE: f32 = 0.02;
+/// still count as inside its prism: rounding only. A wider band lets a face catch particles
+/// sliding past its edges (they snag and are shot off along the face normal).
+const PRISM_TOLERANCE: f32 = 1e-3;
 
 /// Which per-particle array a load or store touches.
 #[derive(Clone, Copy)]
@@ -81,9 +82,14 @@ impl ContactFrame {
         let x = &self.x_prev;
         for c in &mut self.candidates {
             let [a, b, t] = c.tri.map(|i| x[i as usize]);
-            c.d_prev = match triangle_normal(&a, &b, &t) {
-                Some(n) => (x[c.p as usize] - a).dot(&n),
-                None => s.thickness,
+            let p = x[c.p as usize];
+            (c.d_prev, c.prism_prev) = match triangle_normal(&a, &b, &t) {
+                Some(n) => {
+                    let bw = plane_barycentric(&p, &a, &b, &t, &n);
+                    let inside = bw.iter().all(|&v| v >= -PRISM_TOLERANCE);
+                    ((p - a).dot(&n), inside)
+                }
+                None => (s.thickness, false),
             };
             c.lambda_n = 0.0;
             c.lambda_t = 0.0;
@@ -104,12 +110,9 @@ impl ContactFrame {
         if self.candidates.is_empty() {
             return;
         }
-        if std::env::var("DBG_NOPROJ").is_ok() {
-            return;
-        }
         self.load(world, g, Field::Position);
         let alpha_tilde = s.compliance / (h * h);
-        let step = s.max_separation_speed * h;
+        let steps = (s.max_separation_speed * h, s.skin_speed * h);
         let ContactFrame {
             x,
             x_prev,
@@ -118,7 +121,7 @@ impl ContactFrame {
             ..
         } = self;
         for c in candidates.iter_mut().filter(|c| !c.recovery) {
-            match project_one(c, x, x_prev, w, s, alpha_tilde, step) {
+            match project_one(c, x, x_prev, w, s, alpha_tilde, steps) {
                 Outcome::Degenerate => stats.degenerate += 1,
                 Outcome::Clamped => stats.clamps += 1,
                 Outcome::Done => {}
@@ -198,7 +201,7 @@ fn project_one(
     w: &[f32],
     s: &SoftContactSettings,
     alpha_tilde: f32,
-    step: f32,
+    (step, skin_step): (f32, f32),
 ) -> Outcome {
     let p = c.p as usize;
     let tri = c.tri.map(|i| i as usize);
@@ -212,18 +215,28 @@ fn project_one(
         return Outcome::Done;
     }
     let bw = plane_barycentric(&xp, &a, &b, &t, &n);
-    if bw.iter().any(|&v| v < -PRISM_TOLERANCE) {
+    let inside_now = bw.iter().all(|&v| v >= -PRISM_TOLERANCE);
+    // A particle touches the triangle if it was over it at the substep start and still is,
+    // or if its path over the substep crossed the triangle's plane inside the triangle (a
+    // fast particle entering at a convex edge). One sliding past the triangle's edge beside
+    // it does neither and is left to the neighbouring faces.
+    let touching = c.active || (c.prism_prev && inside_now) || crossed_inside(c, d, x, x_prev);
+    if !touching {
         return Outcome::Done;
     }
-    let bw = bw.map(|v| v.max(0.0));
-    let sum: f32 = bw.iter().sum();
-    if sum.is_nan() || sum <= 0.0 {
-        return Outcome::Degenerate;
-    }
-    let bary = bw.map(|v| v / sum);
+    let bary = if inside_now {
+        let bw = bw.map(|v| v.max(0.0));
+        let sum: f32 = bw.iter().sum();
+        if sum.is_nan() || sum <= 0.0 {
+            return Outcome::Degenerate;
+        }
+        bw.map(|v| v / sum)
+    } else {
+        closest_barycentric(&xp, &a, &b, &t)
+    };
     let q = a * bary[0] + b * bary[1] + t * bary[2];
     let dist = (xp - q).dot(&n);
-    let target = s.thickness.min(c.d_prev + step);
+    let target = contact_target(c.d_prev, s.thickness, step, skin_step);
     let cval = dist - target;
     if cval.is_nan() || cval >= 0.0 {
         return Outcome::Done;
@@ -250,8 +263,9 @@ fn project_one(
     c.ever = true;
     c.n = n;
     c.bary = bary;
-    friction(c, x, x_prev, w, s, wsum);
-    let clamped = target < s.thickness && !c.clamped;
+    c.wsum = wsum;
+    friction(c, x, x_prev, w, s);
+    let clamped = target < 0.0 && !c.clamped;
     if clamped {
         c.clamped = true;
         Outcome::Clamped
@@ -260,14 +274,43 @@ fn project_one(
     }
 }
 
-/// Positional Coulomb friction of one projected contact (Müller et al. 2020).
+/// `true` when the particle, moving from its substep start towards the triangle's plane
+/// (`d_prev` → `d`), crossed the plane inside the triangle (both linearly interpolated).
+fn crossed_inside(c: &Candidate, d: f32, x: &[Vector3<f32>], x_prev: &[Vector3<f32>]) -> bool {
+    if c.d_prev.is_nan() || c.d_prev <= d || c.d_prev < 0.0 {
+        return false;
+    }
+    let s = (c.d_prev / (c.d_prev - d)).clamp(0.0, 1.0);
+    let lerp = |i: u32| x_prev[i as usize] + (x[i as usize] - x_prev[i as usize]) * s;
+    let [a, b, t] = c.tri.map(lerp);
+    let p = lerp(c.p);
+    match triangle_normal(&a, &b, &t) {
+        Some(n) => plane_barycentric(&p, &a, &b, &t, &n)
+            .iter()
+            .all(|&v| v >= -PRISM_TOLERANCE),
+        None => false,
+    }
+}
+
+/// The height a contact pushes its particle to in this substep: the thickness `δ`, reached
+/// from the substep-start distance `d_prev` at no more than `S h` while below the surface
+/// and no more than `S_skin h` inside the skin `[0, δ)`.
+#[inline]
+fn contact_target(d_prev: f32, thickness: f32, step: f32, skin_step: f32) -> f32 {
+    let out_of_depth = (d_prev + step).min(0.0);
+    let through_skin = (d_prev + skin_step).min(thickness);
+    out_of_depth.max(through_skin)
+}
+
+/// Positional Coulomb friction of one contact just projected (Müller et al. 2020): the
+/// relative tangential displacement of the particle against its triangle point over the
+/// substep is removed while `λ_t` stays under `μ_s λ_n`, else by at most `μ_d λ_n − λ_t`.
 fn friction(
     c: &mut Candidate,
     x: &mut [Vector3<f32>],
     x_prev: &[Vector3<f32>],
     w: &[f32],
     s: &SoftContactSettings,
-    wsum: f32,
 ) {
     let p = c.p as usize;
     let tri = c.tri.map(|i| i as usize);
@@ -280,13 +323,13 @@ fn friction(
         return;
     }
     let dir = dpt / len;
-    let full = len / wsum;
+    let full = len / c.wsum;
     let applied = if c.lambda_t + full <= s.static_friction * c.lambda_n {
         full
     } else {
         full.min((s.dynamic_friction * c.lambda_n - c.lambda_t).max(0.0))
     };
-    if applied.is_nan() || applied <= 0.0 {
+    if applied.is_nan() || applied <= 0.0 || !applied.is_finite() {
         return;
     }
     x[p] -= dir * (w[p] * applied);
@@ -294,4 +337,23 @@ fn friction(
         x[tri[k]] += dir * (w[tri[k]] * bary[k] * applied);
     }
     c.lambda_t += applied;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::contact_target;
+
+    #[test]
+    fn target_rates() {
+        let (d, s, k) = (0.005, 0.002, 0.0001);
+        // Resting or arriving from outside: straight to the thickness.
+        assert_eq!(contact_target(0.005, d, s, k), 0.005);
+        assert_eq!(contact_target(0.3, d, s, k), 0.005);
+        // Deep: out at S h per substep.
+        assert!((contact_target(-0.1, d, s, k) - (-0.098)).abs() < 1e-7);
+        // Just below the surface: to the surface, not further than the skin rate.
+        assert!((contact_target(-0.001, d, s, k) - 0.0).abs() < 1e-7);
+        // In the skin: creeps at S_skin h.
+        assert!((contact_target(0.002, d, s, k) - 0.0021).abs() < 1e-7);
+    }
 }
