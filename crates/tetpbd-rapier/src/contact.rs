@@ -15,11 +15,13 @@
 //! while the accumulated tangential multiplier stays under `μ_s λ_n` (sticking), otherwise
 //! only up to `μ_d λ_n` (sliding).
 //!
-//! Overlap a contact starts with (a particle created inside a collider, not touching it in
-//! the previous frame) is not resolved at once: the contact tolerates an allowance, the
-//! starting depth less `max_depenetration_speed · h`, which shrinks by that much every
-//! substep, so the overlap is pushed out at a bounded speed instead of turning into an
-//! explosion. Ongoing contacts and fresh impacts have no allowance.
+//! Overlap a soft body is created with (its first frame in the coupling, a particle already
+//! inside a collider) is not resolved at once: the contact tolerates an allowance, the
+//! starting penetration into the collider itself (the thickness skin is resolved as usual)
+//! less `max_depenetration_speed · h`, which shrinks by that much every
+//! substep (and carries over to the next frames), so the overlap is pushed out at a bounded
+//! speed instead of turning into an explosion. Every other contact, impacts included, has no
+//! allowance.
 //!
 //! The velocity pass then removes the separating normal velocity the projection gave each
 //! contact particle; restitution is applied to the whole body by [`crate::restitution`].
@@ -67,7 +69,7 @@ pub(crate) fn project_contacts(
             if depth > max_push {
                 let x0 = p.prev_positions()[i];
                 if let Some(s0) = surface_point(shape, cp.rule, &pose, &x0, Some(n)) {
-                    c.allowance = (c.thickness - s0.distance - max_push).max(0.0);
+                    c.allowance = (-s0.distance - max_push).max(0.0);
                 }
             }
         }

@@ -29,11 +29,11 @@ pub struct CouplingSettings {
     pub margin: f32,
     /// Collision properties of soft bodies without a [`SoftCollider`] component.
     pub default_collider: SoftCollider,
-    /// Largest speed at which an overlap a contact starts with (a soft body created inside
-    /// a rigid one, a pair not touching in the previous frame) is pushed out, m/s (> 0). Such
-    /// an overlap is resolved over several substeps and frames instead of in one substep, so
-    /// separation does not turn into an explosion. Ongoing contacts and impacts (no overlap at
-    /// the substep start) are resolved fully, whatever their depth.
+    /// Largest speed at which the overlap of a soft body created inside a collider (in its
+    /// first frame in the coupling) is pushed out, m/s (> 0). Such an overlap is resolved
+    /// over several substeps and frames instead of in one substep, so separation does not turn
+    /// into an explosion. Every other contact, impacts included, is resolved fully. A rigid
+    /// body created inside a soft one is not covered.
     pub max_depenetration_speed: f32,
 }
 

@@ -109,6 +109,10 @@ pub(crate) struct Frame {
     /// new: an overlap it starts with is pushed out at the bounded depenetration speed (see
     /// `contact::project_contacts`); one that is here continues with its allowance.
     pub touching: Vec<(PairKey, f32)>,
+    /// Soft bodies (entity bits) stepped in the previous frame, sorted. Only a body not in
+    /// this list (created this frame) gets an overlap allowance: an overlap it was created
+    /// with is pushed out at the bounded speed; any other penetration is resolved fully.
+    pub seen: Vec<u64>,
     pub start_poses: Vec<((u32, u32), StartState)>,
     pub soft: Vec<SoftEntry>,
     pub bodies: Vec<BodyProxy>,
@@ -262,6 +266,7 @@ impl Frame {
             Option<&Attachments>,
         )>() {
             let sc = sc.copied().unwrap_or(*input.default_collider);
+            let newcomer = self.seen.binary_search(&entity.to_bits().get()).is_err();
             let c0 = self.contacts.len();
             let k0 = self.corners.len();
             let a0 = self.attachments.len();
@@ -307,6 +312,8 @@ impl Frame {
                         }
                         let key = (entity.to_bits().get(), handle.into_raw_parts(), i);
                         let previous = self.touching.binary_search_by_key(&key, |t| t.0).ok();
+                        // Allowance decided now unless the body is new (see `seen`).
+                        let decided = previous.is_some() || !newcomer;
                         self.contacts.push(ParticleContact {
                             particle: i,
                             collider: ci,
@@ -326,7 +333,7 @@ impl Frame {
                             // Touching in the previous frame: an ongoing contact, which keeps
                             // what is left of its overlap allowance (usually nothing).
                             allowance: previous.map_or(0.0, |k| self.touching[k].1),
-                            allowance_fresh: previous.is_some(),
+                            allowance_fresh: decided,
                             sub_impulse: Vector3::zeros(),
                             impulse: Vector3::zeros(),
                         });
@@ -420,8 +427,9 @@ fn surface_bounds(p: &Particles, surface: &Surface) -> (Vector3<f32>, Vector3<f3
 }
 
 impl Frame {
-    /// Remembers which particle–collider pairs touched in this frame (for the next frame's
-    /// new-overlap test). Reuses the allocation.
+    /// Remembers which soft bodies were stepped and which particle–collider pairs touched in
+    /// this frame, with their remaining overlap allowance (for the next frame). Reuses the
+    /// allocations.
     pub fn remember_touching(&mut self) {
         self.touching.clear();
         for s in &self.soft {
@@ -434,5 +442,9 @@ impl Frame {
             }
         }
         self.touching.sort_unstable_by_key(|t| t.0);
+        self.seen.clear();
+        self.seen
+            .extend(self.soft.iter().map(|s| s.entity.to_bits().get()));
+        self.seen.sort_unstable();
     }
 }
