@@ -45,8 +45,9 @@ fn nine_cubes_settle_on_a_pinned_slab() {
         if f >= 270 {
             tail_speed = tail_speed.max(v);
         }
-        if f >= 60 {
-            peak_speed = peak_speed.max(v);
+        for &e in &bodies[1..] {
+            let p = s.particles(e);
+            peak_speed = peak_speed.max((p.linear_momentum() / p.total_mass()).norm());
         }
         if f % 60 == 59 {
             println!(
@@ -61,13 +62,13 @@ fn nine_cubes_settle_on_a_pinned_slab() {
     }
     let pen = s.max_interpenetration(&bodies);
     println!(
-        "after 5 s: max|v| over the last 0.5 s {tail_speed:.4} m/s, peak after 1 s {peak_speed:.3} m/s, \
+        "after 5 s: max|v| over the last 0.5 s {tail_speed:.4} m/s, peak centre speed {peak_speed:.3} m/s, \
          interpenetration {pen:.5} m (worst sampled {worst_pen:.5} m), clamps {clamps}"
     );
     // The issue's target: max |v| < 0.05 m/s after 5 s.
     assert!(tail_speed < 0.05, "still moving at {tail_speed} m/s");
-    // Falling from up to 9 m the cubes hit at ~13 m/s; nothing may come out faster.
-    assert!(peak_speed < 13.0, "a cube was flung at {peak_speed} m/s");
+    // The highest cube hits at √(2 g 9 m) ≈ 13.3 m/s; no cube may move faster than that.
+    assert!(peak_speed < 13.5, "a cube was flung at {peak_speed} m/s");
     assert!(pen < 0.002, "interpenetration {pen} m");
     assert!(
         worst_pen < 0.1,
