@@ -49,22 +49,22 @@ pub struct CoupledCase {
     pub run: fn(&Config) -> CoupledOutcome,
 }
 
-fn scene(substeps: u32) -> Option<CoupledWorld> {
+fn scene(substeps: u32) -> Result<CoupledWorld, String> {
     scene_with(substeps, 1)
 }
 
-fn scene_with(substeps: u32, iterations: u32) -> Option<CoupledWorld> {
+fn scene_with(substeps: u32, iterations: u32) -> Result<CoupledWorld, String> {
     scene_net(substeps, iterations, None)
 }
 
-fn scene_net(substeps: u32, iterations: u32, net: Option<f32>) -> Option<CoupledWorld> {
+fn scene_net(substeps: u32, iterations: u32, net: Option<f32>) -> Result<CoupledWorld, String> {
     let solver = SolverSettings {
         substeps,
         iterations,
         max_correction_speed: net,
         ..SolverSettings::default()
     };
-    CoupledWorld::new(solver, CouplingSettings::default()).ok()
+    CoupledWorld::new(solver, CouplingSettings::default()).map_err(|e| e.to_string())
 }
 
 /// A fixed ground slab whose top is at y = 0, `depth` m thick.
@@ -139,40 +139,39 @@ fn run(
     }
 }
 
+/// A case's outcome, or its setup error as a clean outcome.
+fn guarded(r: Result<CoupledOutcome, String>) -> CoupledOutcome {
+    r.unwrap_or_else(|e| CoupledOutcome {
+        error: Some(e),
+        ..CoupledOutcome::default()
+    })
+}
+
 fn heavy_rigid_on_light_soft(config: &Config) -> CoupledOutcome {
-    heavy_rigid_on_light_soft_with(config, 10, 1)
+    guarded(heavy_rigid_on_light_soft_with(config, 10, 1))
 }
 
 fn heavy_rigid_on_light_soft_20x5(config: &Config) -> CoupledOutcome {
-    heavy_rigid_on_light_soft_with(config, 20, 5)
+    guarded(heavy_rigid_on_light_soft_with(config, 20, 5))
 }
 
 fn heavy_rigid_on_light_soft_with(
     config: &Config,
     substeps: u32,
     iterations: u32,
-) -> CoupledOutcome {
+) -> Result<CoupledOutcome, String> {
     let mut out = CoupledOutcome::default();
-    let Some(mut s) = scene_with(substeps, iterations) else {
-        out.error = Some("settings".into());
-        return out;
-    };
+    let mut s = scene_with(substeps, iterations)?;
     ground(&mut s);
     // 1 kg soft slab (2 × 0.2 × 2 m at 1.25 kg/m³) under a 1000 kg rigid box.
-    let e = match soft_box(
+    let e = soft_box(
         &mut s,
         config,
         Vector3::new(2.0, 0.2, 2.0),
         [4, 1, 4],
         Vector3::new(0.0, 0.1, 0.0),
         1.25,
-    ) {
-        Ok(e) => e,
-        Err(err) => {
-            out.error = Some(err);
-            return out;
-        }
-    };
+    )?;
     let (rb, _) = s.physics.insert(
         RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 0.45, 0.0)),
         ColliderBuilder::cuboid(0.25, 0.25, 0.25).mass(1000.0),
@@ -185,35 +184,26 @@ fn heavy_rigid_on_light_soft_with(
         .map_or(f32::NAN, |b| b.translation().y);
     // The box's bottom stays above the ground (it did not sink through the slab).
     out.criterion = (y - 0.25 > -0.01, format!("box bottom {:.3} m", y - 0.25));
-    out
+    Ok(out)
 }
 
-fn light_soft_on_heavy_plank(config: &Config) -> CoupledOutcome {
+fn light_soft_on_heavy_plank(config: &Config) -> Result<CoupledOutcome, String> {
     let mut out = CoupledOutcome::default();
-    let Some(mut s) = scene(10) else {
-        out.error = Some("settings".into());
-        return out;
-    };
+    let mut s = scene(10)?;
     ground(&mut s);
     let (rb, _) = s.physics.insert(
         RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 0.1, 0.0)),
         ColliderBuilder::cuboid(1.5, 0.1, 1.5).mass(1000.0),
     );
     // 1 kg soft cube (0.5 m at 8 kg/m³) on a free 1000 kg plank.
-    let e = match soft_box(
+    let e = soft_box(
         &mut s,
         config,
         Vector3::repeat(0.5),
         [3, 3, 3],
         Vector3::new(0.0, 0.46, 0.0),
         8.0,
-    ) {
-        Ok(e) => e,
-        Err(err) => {
-            out.error = Some(err);
-            return out;
-        }
-    };
+    )?;
     run(&mut s, e, Some(rb), 180, &mut out, |_| {});
     let min_y = s
         .soft
@@ -226,31 +216,22 @@ fn light_soft_on_heavy_plank(config: &Config) -> CoupledOutcome {
             out.final_speed
         ),
     );
-    out
+    Ok(out)
 }
 
-fn ball_at_100_m_s(config: &Config) -> CoupledOutcome {
+fn ball_at_100_m_s(config: &Config) -> Result<CoupledOutcome, String> {
     let mut out = CoupledOutcome::default();
-    let Some(mut s) = scene(10) else {
-        out.error = Some("settings".into());
-        return out;
-    };
+    let mut s = scene(10)?;
     ground(&mut s);
     // A soft slab one cell thick (0.2 m) on the ground; a 0.1 m rigid ball at 100 m/s onto it.
-    let e = match soft_box(
+    let e = soft_box(
         &mut s,
         config,
         Vector3::new(2.0, 0.2, 2.0),
         [8, 1, 8],
         Vector3::new(0.0, 0.1, 0.0),
         1000.0,
-    ) {
-        Ok(e) => e,
-        Err(err) => {
-            out.error = Some(err);
-            return out;
-        }
-    };
+    )?;
     let (rb, _) = s.physics.insert(
         RigidBodyBuilder::dynamic()
             .translation(Vector::new(0.05, 1.0, 0.05))
@@ -266,40 +247,31 @@ fn ball_at_100_m_s(config: &Config) -> CoupledOutcome {
     });
     // No tunnelling: the ball's centre never reaches the slab's lower half.
     out.criterion = (lowest > 0.1, format!("ball centre lowest {lowest:.3} m"));
-    out
+    Ok(out)
 }
 
 fn created_in_the_ground(config: &Config) -> CoupledOutcome {
-    created_in_the_ground_with(config, None)
+    guarded(created_in_the_ground_with(config, None))
 }
 
 fn created_in_the_ground_net(config: &Config) -> CoupledOutcome {
-    created_in_the_ground_with(config, Some(5.0))
+    guarded(created_in_the_ground_with(config, Some(5.0)))
 }
 
-fn created_in_the_ground_with(config: &Config, net: Option<f32>) -> CoupledOutcome {
+fn created_in_the_ground_with(config: &Config, net: Option<f32>) -> Result<CoupledOutcome, String> {
     let mut out = CoupledOutcome::default();
-    let Some(mut s) = scene_net(10, 1, net) else {
-        out.error = Some("settings".into());
-        return out;
-    };
+    let mut s = scene_net(10, 1, net)?;
     // Ground 4 m thick, so the nearest face of every overlapping particle is the top.
     ground_of(&mut s, 4.0);
     // A 1 m cube created half inside the ground.
-    let e = match soft_box(
+    let e = soft_box(
         &mut s,
         config,
         Vector3::repeat(1.0),
         [3, 3, 3],
         Vector3::zeros(),
         1000.0,
-    ) {
-        Ok(e) => e,
-        Err(err) => {
-            out.error = Some(err);
-            return out;
-        }
-    };
+    )?;
     run(&mut s, e, None, 180, &mut out, |_| {});
     let min_y = s
         .soft
@@ -312,30 +284,21 @@ fn created_in_the_ground_with(config: &Config, net: Option<f32>) -> CoupledOutco
             out.peak_speed
         ),
     );
-    out
+    Ok(out)
 }
 
-fn resting_100k_frames(config: &Config) -> CoupledOutcome {
+fn resting_100k_frames(config: &Config) -> Result<CoupledOutcome, String> {
     let mut out = CoupledOutcome::default();
-    let Some(mut s) = scene(10) else {
-        out.error = Some("settings".into());
-        return out;
-    };
+    let mut s = scene(10)?;
     ground(&mut s);
-    let e = match soft_box(
+    let e = soft_box(
         &mut s,
         config,
         Vector3::repeat(0.5),
         [2, 2, 2],
         Vector3::new(0.0, 0.3, 0.0),
         1000.0,
-    ) {
-        Ok(e) => e,
-        Err(err) => {
-            out.error = Some(err);
-            return out;
-        }
-    };
+    )?;
     let mut settled = None;
     let mut ke_settled = 0.0f32;
     let mut ke_max_after = 0.0f32;
@@ -365,7 +328,7 @@ fn resting_100k_frames(config: &Config) -> CoupledOutcome {
             out.final_speed
         ),
     );
-    out
+    Ok(out)
 }
 
 /// Every coupled case, in report order.
@@ -387,13 +350,13 @@ pub fn coupled_cases() -> Vec<CoupledCase> {
             name: "soft 1 kg on rigid 1000 kg",
             description: "a 1 kg soft cube on a free 1000 kg plank on the ground, 3 s: rests on it (lowest particle on the plank, final speed < 0.05 m/s)",
             kind: CaseKind::Fast,
-            run: light_soft_on_heavy_plank,
+            run: |c| guarded(light_soft_on_heavy_plank(c)),
         },
         CoupledCase {
             name: "rigid ball at 100 m/s",
             description: "a 0.1 m rigid ball (CCD on) at 100 m/s onto a soft slab one cell (0.2 m) thick on the ground, 2 s: the ball's centre never reaches the slab's lower half",
             kind: CaseKind::Fast,
-            run: ball_at_100_m_s,
+            run: |c| guarded(ball_at_100_m_s(c)),
         },
         CoupledCase {
             name: "created half in the ground",
@@ -411,7 +374,7 @@ pub fn coupled_cases() -> Vec<CoupledCase> {
             name: "resting, 100,000 frames",
             description: "a 0.5 m soft cube resting on the ground for 100,000 frames (28 min simulated): final speed < 1 mm/s, centre-of-mass drift < 1 mm after settling, kinetic energy never above 10 × its settled value",
             kind: CaseKind::Long,
-            run: resting_100k_frames,
+            run: |c| guarded(resting_100k_frames(c)),
         },
     ]
 }
