@@ -1,0 +1,43 @@
+//! Mesh files in and frames out for [`tetpbd`] soft bodies.
+//!
+//! * In: TetGen `.node`/`.ele` ([`read_tetgen_str`], [`read_tetgen_files`]) and Gmsh `.msh`
+//!   4.1 ASCII ([`read_msh_str`], [`read_msh_file`]) into a [`tetpbd::TetMesh`]. Malformed
+//!   input gives a [`ReadError`] naming the file kind and line; the readers never panic.
+//! * Out: surfaces as Wavefront OBJ ([`surface_obj`], [`triangles_obj`]) and tetrahedra as
+//!   VTK unstructured grids ([`tetrahedra_vtu`]) with per-tetrahedron `volume_ratio` and
+//!   `inverted` cell data; and meshes back as TetGen or Gmsh text ([`write_tetgen`],
+//!   [`write_msh`]).
+//!
+//! ```
+//! use tetpbd::SoftBodyBuilder;
+//! use tetpbd_io::{read_tetgen_str, surface_obj, tetrahedra_vtu};
+//!
+//! let node = "# one tetrahedron, numbered from 1\n4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n";
+//! let ele = "1 4 0\n1 1 2 3 4\n";
+//! let mesh = read_tetgen_str(node, ele)?;
+//! assert_eq!(mesh.tets, vec![[0, 1, 2, 3]]);
+//!
+//! let body = SoftBodyBuilder::new(mesh).density(1000.0).edges(0.0).build()?;
+//! let obj = surface_obj(&body.surface, body.particles.positions())?;
+//! assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), 4);
+//! let vtu = tetrahedra_vtu(&body.particles, &body.tetrahedra)?;
+//! assert!(vtu.contains("NumberOfCells=\"1\""));
+//!
+//! let err = read_tetgen_str(node, "1 4 0\n1 1 2 3 9\n").unwrap_err();
+//! assert_eq!(err.to_string(), ".ele line 2: vertex 9 does not exist (4 vertices)");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+#![warn(missing_docs)]
+
+mod error;
+mod gmsh;
+mod obj;
+mod tetgen;
+mod text;
+mod vtu;
+
+pub use error::{FileKind, ReadError, WriteError};
+pub use gmsh::{read_msh_file, read_msh_str, write_msh};
+pub use obj::{surface_obj, triangles_obj, write_surface_obj};
+pub use tetgen::{read_tetgen_files, read_tetgen_str, write_tetgen};
+pub use vtu::{tetrahedra_vtu, write_tetrahedra_vtu};

@@ -1,0 +1,154 @@
+//! Seeded fuzzing of the three parsers: 20,000 inputs per target (`.node`, `.ele`, `.msh`),
+//! 60,000 in all, half random bytes and half random mutations of valid files. Every input
+//! must give `Ok` or `Err` without panicking, and every `Ok` mesh must be consistent
+//! (finite coordinates, indices in range).
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use tetpbd::generators::{box_grid, CellSplit};
+use tetpbd::nalgebra::Vector3;
+use tetpbd::TetMesh;
+use tetpbd_io::{read_msh_str, read_tetgen_str, write_msh, write_tetgen, ReadError};
+
+/// Inputs tried per target.
+const INPUTS: usize = 20_000;
+
+/// xorshift64* pseudo-random numbers.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+/// Bytes the formats are made of, so random inputs get past the first check often.
+const ALPHABET: &[u8] = b"0123456789 0 1 2 3 4\n\n\n-+.eE#$\t\rMeshFormatNodesElementsEnd";
+
+/// Tokens that hit edge cases when inserted.
+const TOKENS: &[&str] = &[
+    "0",
+    "1",
+    "4",
+    "10",
+    "-1",
+    "4.1",
+    "2.2",
+    "1e999",
+    "nan",
+    "inf",
+    "18446744073709551616",
+    "4294967296",
+    "#",
+    "$Nodes",
+    "$EndNodes",
+    "$Elements",
+    "$EndElements",
+    "$MeshFormat",
+    "$EndMeshFormat",
+    "\n",
+    " ",
+    "é",
+    "\u{0}",
+];
+
+fn random_bytes(rng: &mut Rng) -> String {
+    let len = rng.below(300);
+    let bytes: Vec<u8> = (0..len)
+        .map(|_| {
+            if rng.below(8) == 0 {
+                rng.next() as u8
+            } else {
+                ALPHABET[rng.below(ALPHABET.len())]
+            }
+        })
+        .collect();
+    String::from_utf8_lossy(&bytes).into_owned()
+}
+
+fn mutate(rng: &mut Rng, valid: &str) -> String {
+    let mut bytes = valid.as_bytes().to_vec();
+    for _ in 0..1 + rng.below(4) {
+        let at = rng.below(bytes.len() + 1);
+        match rng.below(6) {
+            0 => {
+                let end = (at + 1 + rng.below(8)).min(bytes.len());
+                bytes.drain(at.min(end)..end);
+            }
+            1 => {
+                let token = TOKENS[rng.below(TOKENS.len())].as_bytes();
+                bytes.splice(at..at, token.iter().copied());
+            }
+            2 if at < bytes.len() => bytes[at] = ALPHABET[rng.below(ALPHABET.len())],
+            3 => bytes.truncate(at),
+            4 => {
+                let lines: Vec<&[u8]> = bytes.split(|&b| b == b'\n').collect();
+                let pick = lines[rng.below(lines.len())].to_vec();
+                let mut line = pick;
+                line.push(b'\n');
+                bytes.splice(at..at, line);
+            }
+            _ if at < bytes.len() => bytes[at] = rng.next() as u8,
+            _ => {}
+        }
+    }
+    String::from_utf8_lossy(&bytes).into_owned()
+}
+
+/// A successful read must be a consistent mesh.
+fn check(result: Result<TetMesh, ReadError>, ok: &mut usize) {
+    if let Ok(mesh) = result {
+        *ok += 1;
+        assert!(mesh
+            .vertices
+            .iter()
+            .all(|v| v.iter().all(|c| c.is_finite())));
+        let n = mesh.vertices.len();
+        assert!(mesh.tets.iter().flatten().all(|&i| (i as usize) < n));
+    } else if let Err(e) = result {
+        assert!(e.to_string().contains("line "), "{e}");
+    }
+}
+
+#[test]
+fn parsers_never_panic() {
+    let grid = box_grid(Vector3::new(1.0, 2.0, 0.5), [2, 1, 2], CellSplit::Five).unwrap();
+    let (node, ele) = write_tetgen(&grid);
+    let node = format!("# header\n{}", node.replacen("\n", " # c\n", 2));
+    let msh = write_msh(&grid);
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut tried = 0;
+    let mut ok = [0usize; 3];
+    for i in 0..INPUTS {
+        let input = |rng: &mut Rng, valid: &str| {
+            if i % 2 == 0 {
+                random_bytes(rng)
+            } else {
+                mutate(rng, valid)
+            }
+        };
+        let inputs = [
+            input(&mut rng, &node),
+            input(&mut rng, &ele),
+            input(&mut rng, &msh),
+        ];
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            check(read_tetgen_str(&inputs[0], &ele), &mut ok[0]);
+            check(read_tetgen_str(&node, &inputs[1]), &mut ok[1]);
+            check(read_msh_str(&inputs[2]), &mut ok[2]);
+        }));
+        assert!(outcome.is_ok(), "input {i} panicked: {inputs:?}");
+        tried += 3;
+    }
+    println!("fuzz: {tried} inputs ({INPUTS} per parser), Ok per parser (node, ele, msh): {ok:?}");
+    assert_eq!(tried, 3 * INPUTS);
+    // The mutations must leave some inputs readable, or they test only the first check.
+    assert!(ok.iter().all(|&k| k > 100), "{ok:?}");
+}
