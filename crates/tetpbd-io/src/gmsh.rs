@@ -1,13 +1,12 @@
-//! Gmsh `.msh` files, format 4.1 ASCII.
+//! Gmsh `.msh` files, format 4.1 ASCII (and 2.2 ASCII through [`crate::gmsh22`]).
 //!
-//! Read: `$MeshFormat` (must say `4.1 0 <data size>`), `$Nodes` (entity blocks of node tags
+//! Read: `$MeshFormat` (must say `4.1 0 <data size>` or `2.2 0 <data size>`), `$Nodes` (entity blocks of node tags
 //! then coordinates, parametric coordinates allowed and dropped) and `$Elements`, of which
 //! only type 4 (4-node tetrahedron) is kept; other element types and all other sections are
 //! skipped. Vertices are the nodes in file order; node tags are mapped to those indices.
 //! Nodes used by no tetrahedron are kept (the soft-body builder rejects them).
 //!
-//! Not read: binary `.msh` and the older 2.2 format (both are reported as
-//! [`ReadError::Unsupported`]).
+//! Not read: binary `.msh` (reported as [`ReadError::Unsupported`]).
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -21,15 +20,22 @@ use crate::tetgen::read_to_string;
 use crate::text::{capacity_hint, Rows};
 
 /// Vertices in file order and the map from node tag to vertex index.
-type NodeTable = (Vec<Vector3<f32>>, HashMap<u64, u32>);
+pub(crate) type NodeTable = (Vec<Vector3<f32>>, HashMap<u64, u32>);
 
 /// Gmsh element type of the 4-node tetrahedron.
-const TETRAHEDRON: i64 = 4;
+pub(crate) const TETRAHEDRON: i64 = 4;
 
-/// Reads a mesh from the text of a `.msh` 4.1 ASCII file.
+/// The format versions read.
+#[derive(Clone, Copy)]
+enum Version {
+    V41,
+    V22,
+}
+
+/// Reads a mesh from the text of a `.msh` file, format 4.1 or 2.2 ASCII.
 pub fn read_msh_str(text: &str) -> Result<TetMesh, ReadError> {
     let mut rows = Rows::new(text, FileKind::Msh, false);
-    let mut format_seen = false;
+    let mut format = None;
     let mut nodes: Option<NodeTable> = None;
     let mut tets: Option<Vec<[u32; 4]>> = None;
     while let Some((line, fields)) = rows.next_row() {
@@ -45,11 +51,9 @@ pub fn read_msh_str(text: &str) -> Result<TetMesh, ReadError> {
             });
         }
         match name {
-            "$MeshFormat" => {
-                read_format(&mut rows)?;
-                format_seen = true;
-            }
-            "$Nodes" | "$Elements" if !format_seen => {
+            "$MeshFormat" if format.is_some() => return Err(repeated(line, "$MeshFormat")),
+            "$MeshFormat" => format = Some(read_format(&mut rows)?),
+            "$Nodes" | "$Elements" if format.is_none() => {
                 return Err(ReadError::MissingSection {
                     kind: FileKind::Msh,
                     line,
@@ -57,7 +61,12 @@ pub fn read_msh_str(text: &str) -> Result<TetMesh, ReadError> {
                 });
             }
             "$Nodes" if nodes.is_some() => return Err(repeated(line, "$Nodes")),
-            "$Nodes" => nodes = Some(read_nodes(&mut rows, text)?),
+            "$Nodes" => {
+                nodes = Some(match format {
+                    Some(Version::V22) => crate::gmsh22::read_nodes(&mut rows, text)?,
+                    _ => read_nodes(&mut rows, text)?,
+                })
+            }
             "$Elements" if tets.is_some() => return Err(repeated(line, "$Elements")),
             "$Elements" => {
                 let Some((vertices, tags)) = &nodes else {
@@ -67,7 +76,12 @@ pub fn read_msh_str(text: &str) -> Result<TetMesh, ReadError> {
                         section: "$Nodes (before $Elements)",
                     });
                 };
-                tets = Some(read_elements(&mut rows, text, tags, vertices.len())?);
+                tets = Some(match format {
+                    Some(Version::V22) => {
+                        crate::gmsh22::read_elements(&mut rows, text, tags, vertices.len())?
+                    }
+                    _ => read_elements(&mut rows, text, tags, vertices.len())?,
+                });
             }
             _ => skip_section(&mut rows, name)?,
         }
@@ -78,7 +92,7 @@ pub fn read_msh_str(text: &str) -> Result<TetMesh, ReadError> {
         line: end,
         section,
     };
-    if !format_seen {
+    if format.is_none() {
         return Err(missing("$MeshFormat"));
     }
     let (vertices, _) = nodes.ok_or_else(|| missing("$Nodes"))?;
@@ -86,7 +100,7 @@ pub fn read_msh_str(text: &str) -> Result<TetMesh, ReadError> {
     Ok(TetMesh { vertices, tets })
 }
 
-/// Reads a mesh from a `.msh` 4.1 ASCII file.
+/// Reads a mesh from a `.msh` file, format 4.1 or 2.2 ASCII.
 pub fn read_msh_file(path: impl AsRef<Path>) -> Result<TetMesh, ReadError> {
     read_msh_str(&read_to_string(path.as_ref(), FileKind::Msh)?)
 }
@@ -130,7 +144,7 @@ fn repeated(line: usize, section: &str) -> ReadError {
 }
 
 /// The next data row of a section; a `$` row or the end of input means rows are missing.
-fn data_row<'a>(
+pub(crate) fn data_row<'a>(
     rows: &mut Rows<'a>,
     what: &'static str,
     expected: u64,
@@ -152,7 +166,7 @@ fn data_row<'a>(
 }
 
 /// Consumes the `$End…` row closing a section.
-fn end_section(rows: &mut Rows<'_>, end: &'static str) -> Result<(), ReadError> {
+pub(crate) fn end_section(rows: &mut Rows<'_>, end: &'static str) -> Result<(), ReadError> {
     match rows.next_row() {
         Some((_, fields)) if fields.len() == 1 && fields[0] == end => Ok(()),
         Some((line, fields)) if !fields[0].starts_with('$') => Err(ReadError::ExtraRows {
@@ -182,21 +196,25 @@ fn skip_section(rows: &mut Rows<'_>, name: &str) -> Result<(), ReadError> {
     })
 }
 
-fn read_format(rows: &mut Rows<'_>) -> Result<(), ReadError> {
+fn read_format(rows: &mut Rows<'_>) -> Result<Version, ReadError> {
     let (line, fields) = data_row(rows, "$MeshFormat rows", 1, 0)?;
     if fields.len() != 3 {
         return Err(rows.field_count(line, "$MeshFormat row", 3, fields.len()));
     }
-    if fields[0] != "4.1" {
-        return Err(ReadError::Unsupported {
-            kind: FileKind::Msh,
-            line,
-            what: format!(
-                "format version `{}` (only 4.1)",
-                fields[0].chars().take(32).collect::<String>()
-            ),
-        });
-    }
+    let version = match fields[0] {
+        "4.1" => Version::V41,
+        "2.2" => Version::V22,
+        _ => {
+            return Err(ReadError::Unsupported {
+                kind: FileKind::Msh,
+                line,
+                what: format!(
+                    "format version `{}` (4.1 or 2.2)",
+                    fields[0].chars().take(32).collect::<String>()
+                ),
+            })
+        }
+    };
     let file_type = rows.uint(line, "file type", fields[1])?;
     rows.uint(line, "data size", fields[2])?;
     if file_type != 0 {
@@ -206,7 +224,8 @@ fn read_format(rows: &mut Rows<'_>) -> Result<(), ReadError> {
             what: "binary file (only ASCII)".to_string(),
         });
     }
-    end_section(rows, "$EndMeshFormat")
+    end_section(rows, "$EndMeshFormat")?;
+    Ok(version)
 }
 
 /// A 4-field section or block header as unsigned integers (`signed` marks fields read as

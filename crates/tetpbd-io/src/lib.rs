@@ -1,8 +1,9 @@
 //! Mesh files in and frames out for [`tetpbd`] soft bodies.
 //!
 //! * In: TetGen `.node`/`.ele` ([`read_tetgen_str`], [`read_tetgen_files`]) and Gmsh `.msh`
-//!   4.1 ASCII ([`read_msh_str`], [`read_msh_file`]) into a [`tetpbd::TetMesh`]. Malformed
-//!   input gives a [`ReadError`] naming the file kind and line; the readers never panic.
+//!   4.1 or 2.2 ASCII ([`read_msh_str`], [`read_msh_file`]) into a [`tetpbd::TetMesh`].
+//!   Malformed input gives a [`ReadError`] naming the file kind and line; the readers never
+//!   panic. Binary `.msh` is not read.
 //! * Out: surfaces as Wavefront OBJ ([`surface_obj`], [`triangles_obj`]) and tetrahedra as
 //!   VTK unstructured grids ([`tetrahedra_vtu`]) with per-tetrahedron `volume_ratio` and
 //!   `inverted` cell data; and meshes back as TetGen or Gmsh text ([`write_tetgen`],
@@ -31,6 +32,7 @@
 
 mod error;
 mod gmsh;
+mod gmsh22;
 mod obj;
 mod tetgen;
 mod text;

@@ -1,5 +1,6 @@
 //! Seeded fuzzing of the three parsers: 20,000 inputs per target (`.node`, `.ele`, `.msh`),
-//! 60,000 in all, half random bytes and half random mutations of valid files. Every input
+//! 60,000 in all, half random bytes and half random mutations of valid files (for `.msh`,
+//! alternately a format 4.1 and a format 2.2 file). Every input
 //! must give `Ok` or `Err` without panicking, and every `Ok` mesh must be consistent
 //! (finite coordinates, indices in range).
 
@@ -9,6 +10,11 @@ use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::nalgebra::Vector3;
 use tetpbd::TetMesh;
 use tetpbd_io::{read_msh_str, read_tetgen_str, write_msh, write_tetgen, ReadError};
+
+/// A valid format 2.2 file: two tetrahedra and a triangle.
+const V22: &str = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n\
+4 0 0 1\n5 1 1 1\n$EndNodes\n$Elements\n3\n1 2 2 0 1 1 2 3\n2 4 2 0 1 1 2 3 4\n\
+3 4 2 0 1 2 3 4 5\n$EndElements\n";
 
 /// Inputs tried per target.
 const INPUTS: usize = 20_000;
@@ -123,6 +129,10 @@ fn parsers_never_panic() {
     let (node, ele) = write_tetgen(&grid);
     let node = format!("# header\n{}", node.replacen("\n", " # c\n", 2));
     let msh = write_msh(&grid);
+    assert_eq!(
+        read_msh_str(V22).unwrap().tets,
+        vec![[0, 1, 2, 3], [1, 2, 3, 4]]
+    );
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     let mut tried = 0;
     let mut ok = [0usize; 3];
@@ -137,7 +147,7 @@ fn parsers_never_panic() {
         let inputs = [
             input(&mut rng, &node),
             input(&mut rng, &ele),
-            input(&mut rng, &msh),
+            input(&mut rng, if i % 4 == 3 { V22 } else { &msh }),
         ];
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             check(read_tetgen_str(&inputs[0], &ele), &mut ok[0]);

@@ -191,14 +191,23 @@ fn wrong_field_counts() {
 
 #[test]
 fn unsupported_versions_binary_and_stray_text() {
-    let err = error("4.1 0 8", "2.2 0 8", 2);
-    assert!(err.to_string().contains("version `2.2`"), "{err}");
+    let err = error("4.1 0 8", "3.0 0 8", 2);
+    assert!(
+        err.to_string().contains("version `3.0` (4.1 or 2.2)"),
+        "{err}"
+    );
     let err = error("4.1 0 8", "4.1 1 8", 2);
     assert!(err.to_string().contains("binary"), "{err}");
     let err = error("$PhysicalNames", "stray text\n$PhysicalNames", 4);
     assert!(matches!(err, ReadError::Unsupported { .. }), "{err}");
     let err = error("$NodeData", "$Nodes\n$EndNodes\n$NodeData", 36);
     assert!(err.to_string().contains("second $Nodes"), "{err}");
+    let err = error(
+        "$PhysicalNames",
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames",
+        4,
+    );
+    assert!(err.to_string().contains("second $MeshFormat"), "{err}");
 }
 
 #[test]
