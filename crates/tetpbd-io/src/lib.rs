@@ -8,6 +8,9 @@
 //!   VTK unstructured grids ([`tetrahedra_vtu`]) with per-tetrahedron `volume_ratio` and
 //!   `inverted` cell data; and meshes back as TetGen or Gmsh text ([`write_tetgen`],
 //!   [`write_msh`]).
+//! * The `tet_export` binary reads a `.msh` or `.node`/`.ele` mesh, hangs it from its highest
+//!   vertices under gravity and writes each frame as OBJ and VTU:
+//!   `cargo run -p tetpbd-io --bin tet_export -- mesh.node out/ 60`.
 //!
 //! ```
 //! use tetpbd::SoftBodyBuilder;
