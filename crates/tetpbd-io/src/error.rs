@@ -26,7 +26,8 @@ impl fmt::Display for FileKind {
 
 /// Why a mesh file could not be read.
 ///
-/// Every variant except [`ReadError::Io`] names the file kind and a 1-based line number
+/// Every variant except [`ReadError::Io`] and [`ReadError::Binary`] (a byte offset) names
+/// the file kind and a 1-based line number
 /// (for errors at the end of the input, the number of the last line, or 0 for empty input).
 #[derive(Debug)]
 pub enum ReadError {
@@ -138,6 +139,15 @@ pub enum ReadError {
         /// The sum of the blocks.
         found: u64,
     },
+    /// Something is wrong inside a binary `.msh` file (which has no useful line numbers).
+    Binary {
+        /// File kind.
+        kind: FileKind,
+        /// Byte offset of the problem from the start of the file.
+        offset: usize,
+        /// What is wrong.
+        what: String,
+    },
     /// A required header or section is missing, or a section is not closed.
     MissingSection {
         /// File kind.
@@ -163,14 +173,16 @@ impl ReadError {
             | ReadError::MissingRows { kind, .. }
             | ReadError::ExtraRows { kind, .. }
             | ReadError::CountMismatch { kind, .. }
+            | ReadError::Binary { kind, .. }
             | ReadError::MissingSection { kind, .. } => *kind,
         }
     }
 
-    /// The 1-based line number of the error; `None` for [`ReadError::Io`].
+    /// The 1-based line number of the error; `None` for [`ReadError::Io`] and
+    /// [`ReadError::Binary`].
     pub fn line(&self) -> Option<usize> {
         match self {
-            ReadError::Io { .. } => None,
+            ReadError::Io { .. } | ReadError::Binary { .. } => None,
             ReadError::BadNumber { line, .. }
             | ReadError::FieldCount { line, .. }
             | ReadError::Unsupported { line, .. }
@@ -257,6 +269,9 @@ impl fmt::Display for ReadError {
                 f,
                 "{kind} line {line}: header announces {expected} {what}, the blocks hold {found}"
             ),
+            ReadError::Binary { kind, offset, what } => {
+                write!(f, "{kind} (binary) byte {offset}: {what}")
+            }
             ReadError::MissingSection {
                 kind,
                 line,

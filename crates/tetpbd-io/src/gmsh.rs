@@ -6,7 +6,9 @@
 //! skipped. Vertices are the nodes in file order; node tags are mapped to those indices.
 //! Nodes used by no tetrahedron are kept (the soft-body builder rejects them).
 //!
-//! Not read: binary `.msh` (reported as [`ReadError::Unsupported`]).
+//! Binary 4.1 files are read by [`read_msh_bytes`] and [`read_msh_file`] (through
+//! [`crate::gmsh_binary`]); given as text to [`read_msh_str`] they are
+//! [`ReadError::Unsupported`].
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -16,7 +18,6 @@ use nalgebra::Vector3;
 use tetpbd::TetMesh;
 
 use crate::error::{FileKind, ReadError};
-use crate::tetgen::read_to_string;
 use crate::text::{capacity_hint, Rows};
 
 /// Vertices in file order and the map from node tag to vertex index.
@@ -100,9 +101,32 @@ pub fn read_msh_str(text: &str) -> Result<TetMesh, ReadError> {
     Ok(TetMesh { vertices, tets })
 }
 
-/// Reads a mesh from a `.msh` file, format 4.1 or 2.2 ASCII.
+/// Reads a mesh from the bytes of a `.msh` file: format 4.1 binary, or 4.1 or 2.2 ASCII.
+pub fn read_msh_bytes(bytes: &[u8]) -> Result<TetMesh, ReadError> {
+    let mut lines = bytes
+        .split(|&b| b == b'\n')
+        .map(<[u8]>::trim_ascii)
+        .filter(|l| !l.is_empty());
+    let binary = lines.next() == Some(b"$MeshFormat")
+        && lines
+            .next()
+            .is_some_and(|l| l.split(u8::is_ascii_whitespace).nth(1) == Some(b"1"));
+    if binary {
+        crate::gmsh_binary::read_binary(bytes)
+    } else {
+        read_msh_str(&String::from_utf8_lossy(bytes))
+    }
+}
+
+/// Reads a mesh from a `.msh` file: format 4.1 binary, or 4.1 or 2.2 ASCII.
 pub fn read_msh_file(path: impl AsRef<Path>) -> Result<TetMesh, ReadError> {
-    read_msh_str(&read_to_string(path.as_ref(), FileKind::Msh)?)
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
+        kind: FileKind::Msh,
+        path: path.to_path_buf(),
+        source,
+    })?;
+    read_msh_bytes(&bytes)
 }
 
 /// Writes `mesh` as a `.msh` 4.1 ASCII file: one volume entity holding all nodes (tags

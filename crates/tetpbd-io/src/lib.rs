@@ -1,9 +1,9 @@
 //! Mesh files in and frames out for [`tetpbd`] soft bodies.
 //!
 //! * In: TetGen `.node`/`.ele` ([`read_tetgen_str`], [`read_tetgen_files`]) and Gmsh `.msh`
-//!   4.1 or 2.2 ASCII ([`read_msh_str`], [`read_msh_file`]) into a [`tetpbd::TetMesh`].
-//!   Malformed input gives a [`ReadError`] naming the file kind and line; the readers never
-//!   panic. Binary `.msh` is not read.
+//!   4.1 or 2.2 ASCII and 4.1 binary ([`read_msh_str`], [`read_msh_bytes`],
+//!   [`read_msh_file`]) into a [`tetpbd::TetMesh`]. Malformed input gives a [`ReadError`]
+//!   naming the file kind and line (byte offset in binary data); the readers never panic.
 //! * Out: surfaces as Wavefront OBJ ([`surface_obj`], [`triangles_obj`]) and tetrahedra as
 //!   VTK unstructured grids ([`tetrahedra_vtu`]) with per-tetrahedron `volume_ratio` and
 //!   `inverted` cell data; and meshes back as TetGen or Gmsh text ([`write_tetgen`],
@@ -36,13 +36,14 @@
 mod error;
 mod gmsh;
 mod gmsh22;
+mod gmsh_binary;
 mod obj;
 mod tetgen;
 mod text;
 mod vtu;
 
 pub use error::{FileKind, ReadError, WriteError};
-pub use gmsh::{read_msh_file, read_msh_str, write_msh};
+pub use gmsh::{read_msh_bytes, read_msh_file, read_msh_str, write_msh};
 pub use obj::{surface_obj, triangles_obj, write_surface_obj};
 pub use tetgen::{read_tetgen_files, read_tetgen_str, write_tetgen};
 pub use vtu::{tetrahedra_vtu, write_tetrahedra_vtu};

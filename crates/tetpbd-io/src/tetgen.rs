@@ -61,7 +61,7 @@ pub fn write_tetgen(mesh: &TetMesh) -> (String, String) {
 }
 
 /// Reads a whole file, mapping failure to [`ReadError::Io`].
-pub(crate) fn read_to_string(path: &Path, kind: FileKind) -> Result<String, ReadError> {
+fn read_to_string(path: &Path, kind: FileKind) -> Result<String, ReadError> {
     std::fs::read_to_string(path).map_err(|source| ReadError::Io {
         kind,
         path: path.to_path_buf(),

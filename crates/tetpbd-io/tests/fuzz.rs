@@ -1,6 +1,7 @@
-//! Seeded fuzzing of the three parsers: 20,000 inputs per target (`.node`, `.ele`, `.msh`),
-//! 60,000 in all, half random bytes and half random mutations of valid files (for `.msh`,
-//! alternately a format 4.1 and a format 2.2 file). Every input
+//! Seeded fuzzing of the parsers: 20,000 inputs per target (`.node`, `.ele`, text `.msh`,
+//! binary `.msh`), 80,000 in all, half random bytes and half random mutations of valid files
+//! (for text `.msh`, alternately a format 4.1 and a format 2.2 file; for binary `.msh`, the
+//! random half starts with a valid binary header). Every input
 //! must give `Ok` or `Err` without panicking, and every `Ok` mesh must be consistent
 //! (finite coordinates, indices in range).
 
@@ -9,7 +10,9 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::nalgebra::Vector3;
 use tetpbd::TetMesh;
-use tetpbd_io::{read_msh_str, read_tetgen_str, write_msh, write_tetgen, ReadError};
+use tetpbd_io::{
+    read_msh_bytes, read_msh_str, read_tetgen_str, write_msh, write_tetgen, ReadError,
+};
 
 /// A valid format 2.2 file: two tetrahedra and a triangle.
 const V22: &str = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n\
@@ -65,7 +68,34 @@ const TOKENS: &[&str] = &[
     "\u{0}",
 ];
 
+/// A valid binary 4.1 file with one tetrahedron; its first 40 bytes are the format header.
+fn binary_seed() -> Vec<u8> {
+    let mut b = b"$MeshFormat\n4.1 1 8\n".to_vec();
+    b.extend_from_slice(&1i32.to_le_bytes());
+    b.extend_from_slice(b"\n$EndMeshFormat\n$Nodes\n");
+    let sizes = |b: &mut Vec<u8>, v: &[u64]| v.iter().for_each(|x| b.extend(x.to_le_bytes()));
+    let ints = |b: &mut Vec<u8>, v: &[i32]| v.iter().for_each(|x| b.extend(x.to_le_bytes()));
+    sizes(&mut b, &[1, 4, 1, 4]);
+    ints(&mut b, &[3, 1, 0]);
+    sizes(&mut b, &[4, 1, 2, 3, 4]);
+    for c in [
+        0.0f64, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0,
+    ] {
+        b.extend(c.to_le_bytes());
+    }
+    b.extend_from_slice(b"\n$EndNodes\n$Elements\n");
+    sizes(&mut b, &[1, 1, 1, 1]);
+    ints(&mut b, &[3, 1, 4]);
+    sizes(&mut b, &[1, 1, 1, 2, 3, 4]);
+    b.extend_from_slice(b"\n$EndElements\n");
+    b
+}
+
 fn random_bytes(rng: &mut Rng) -> String {
+    String::from_utf8_lossy(&random_raw(rng)).into_owned()
+}
+
+fn random_raw(rng: &mut Rng) -> Vec<u8> {
     let len = rng.below(300);
     let bytes: Vec<u8> = (0..len)
         .map(|_| {
@@ -76,11 +106,15 @@ fn random_bytes(rng: &mut Rng) -> String {
             }
         })
         .collect();
-    String::from_utf8_lossy(&bytes).into_owned()
+    bytes
 }
 
 fn mutate(rng: &mut Rng, valid: &str) -> String {
-    let mut bytes = valid.as_bytes().to_vec();
+    String::from_utf8_lossy(&mutate_raw(rng, valid.as_bytes())).into_owned()
+}
+
+fn mutate_raw(rng: &mut Rng, valid: &[u8]) -> Vec<u8> {
+    let mut bytes = valid.to_vec();
     for _ in 0..1 + rng.below(4) {
         let at = rng.below(bytes.len() + 1);
         match rng.below(6) {
@@ -105,7 +139,7 @@ fn mutate(rng: &mut Rng, valid: &str) -> String {
             _ => {}
         }
     }
-    String::from_utf8_lossy(&bytes).into_owned()
+    bytes
 }
 
 /// A successful read must be a consistent mesh.
@@ -119,7 +153,8 @@ fn check(result: Result<TetMesh, ReadError>, ok: &mut usize) {
         let n = mesh.vertices.len();
         assert!(mesh.tets.iter().flatten().all(|&i| (i as usize) < n));
     } else if let Err(e) = result {
-        assert!(e.to_string().contains("line "), "{e}");
+        let text = e.to_string();
+        assert!(text.contains("line ") || text.contains("byte "), "{text}");
     }
 }
 
@@ -135,7 +170,9 @@ fn parsers_never_panic() {
     );
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     let mut tried = 0;
-    let mut ok = [0usize; 3];
+    let binary = binary_seed();
+    assert_eq!(read_msh_bytes(&binary).unwrap().tets, vec![[0, 1, 2, 3]]);
+    let mut ok = [0usize; 4];
     for i in 0..INPUTS {
         let input = |rng: &mut Rng, valid: &str| {
             if i % 2 == 0 {
@@ -149,16 +186,27 @@ fn parsers_never_panic() {
             input(&mut rng, &ele),
             input(&mut rng, if i % 4 == 3 { V22 } else { &msh }),
         ];
+        let raw = if i % 2 == 0 {
+            let mut r = binary[..40].to_vec();
+            r.extend(random_raw(&mut rng));
+            r
+        } else {
+            mutate_raw(&mut rng, &binary)
+        };
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             check(read_tetgen_str(&inputs[0], &ele), &mut ok[0]);
             check(read_tetgen_str(&node, &inputs[1]), &mut ok[1]);
             check(read_msh_str(&inputs[2]), &mut ok[2]);
+            check(read_msh_bytes(&raw), &mut ok[3]);
         }));
-        assert!(outcome.is_ok(), "input {i} panicked: {inputs:?}");
-        tried += 3;
+        assert!(outcome.is_ok(), "input {i} panicked: {inputs:?} {raw:?}");
+        tried += 4;
     }
-    println!("fuzz: {tried} inputs ({INPUTS} per parser), Ok per parser (node, ele, msh): {ok:?}");
-    assert_eq!(tried, 3 * INPUTS);
+    println!(
+        "fuzz: {tried} inputs ({INPUTS} per target), Ok per target \
+         (node, ele, text msh, binary msh): {ok:?}"
+    );
+    assert_eq!(tried, 4 * INPUTS);
     // The mutations must leave some inputs readable, or they test only the first check.
     assert!(ok.iter().all(|&k| k > 100), "{ok:?}");
 }
