@@ -108,9 +108,10 @@ pub fn read_msh_bytes(bytes: &[u8]) -> Result<TetMesh, ReadError> {
         .map(<[u8]>::trim_ascii)
         .filter(|l| !l.is_empty());
     let binary = lines.next() == Some(b"$MeshFormat")
-        && lines
-            .next()
-            .is_some_and(|l| l.split(u8::is_ascii_whitespace).nth(1) == Some(b"1"));
+        && lines.next().is_some_and(|l| {
+            let mut fields = l.split(u8::is_ascii_whitespace).filter(|f| !f.is_empty());
+            fields.nth(1) == Some(b"1")
+        });
     if binary {
         crate::gmsh_binary::read_binary(bytes)
     } else {
@@ -245,7 +246,7 @@ fn read_format(rows: &mut Rows<'_>) -> Result<Version, ReadError> {
         return Err(ReadError::Unsupported {
             kind: FileKind::Msh,
             line,
-            what: "binary file (only ASCII)".to_string(),
+            what: "binary file as text (read it with read_msh_bytes or read_msh_file)".to_string(),
         });
     }
     end_section(rows, "$EndMeshFormat")?;

@@ -145,7 +145,16 @@ pub(crate) fn read_binary(bytes: &[u8]) -> Result<TetMesh, ReadError> {
         big_endian: false,
     };
     c.expect_line("$MeshFormat")?;
-    c.expect_line("4.1 1 8")?;
+    let start = c.pos;
+    let format = c.text_line().unwrap_or_default();
+    if !format
+        .split(u8::is_ascii_whitespace)
+        .filter(|f| !f.is_empty())
+        .eq([&b"4.1"[..], b"1", b"8"])
+    {
+        c.pos = start;
+        return Err(c.error("expected `4.1 1 8` (version 4.1, binary, 8-byte size_t)"));
+    }
     let one: [u8; 4] = c.take("the byte-order marker")?;
     c.big_endian = match one {
         [1, 0, 0, 0] => false,

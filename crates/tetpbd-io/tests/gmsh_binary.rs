@@ -140,6 +140,12 @@ fn errors_give_byte_offsets() {
     let tet_block = good.len() - "\n$EndElements\n".len() - mesh.tets.len() * 40 - 20;
     // Truncated inside the node coordinates.
     binary_error(&good[..nodes + 100], nodes + 32 + 20, "input ends before");
+    // A 4-byte size_t.
+    let mut bad = good.clone();
+    bad[18] = b'4';
+    binary_error(&bad, 12, "expected `4.1 1 8`");
+    let spaced = [&b"$MeshFormat\n4.1  1 8\n"[..], &good[20..]].concat();
+    assert_eq!(read_msh_bytes(&spaced).unwrap(), mesh);
     // Byte-order marker not 1.
     let mut bad = good.clone();
     bad[20] = 2;

@@ -67,6 +67,21 @@ fn obj_of_a_grid_surface_has_its_vertices_and_triangles() {
 }
 
 #[test]
+fn unwritable_paths_are_io_errors() {
+    let b = grid_body();
+    let missing = std::env::temp_dir().join("tetpbd-io-no-such-dir/x/frame.vtu");
+    let err = write_tetrahedra_vtu(&missing, &b.particles, &b.tetrahedra).unwrap_err();
+    assert!(matches!(err, WriteError::Io(_)), "{err}");
+    let err = write_surface_obj(
+        missing.with_extension("obj"),
+        &b.surface,
+        b.particles.positions(),
+    )
+    .unwrap_err();
+    assert!(err.to_string().starts_with("write failed: "), "{err}");
+}
+
+#[test]
 fn obj_rejects_indices_past_the_positions() {
     let positions = [Vector3::zeros(); 3];
     let err = triangles_obj(&positions, &[[0, 1, 3]]).unwrap_err();
