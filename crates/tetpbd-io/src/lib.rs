@@ -8,6 +8,8 @@
 //!   VTK unstructured grids ([`tetrahedra_vtu`]) with per-tetrahedron `volume_ratio` and
 //!   `inverted` cell data; and meshes back as TetGen or Gmsh text ([`write_tetgen`],
 //!   [`write_msh`]).
+//! * [`drop_unreferenced_vertices`] removes vertices no tetrahedron uses (Gmsh files often
+//!   hold surface or geometry nodes), which [`tetpbd::SoftBodyBuilder`] would reject.
 //! * The `tet_export` binary reads a `.msh` or `.node`/`.ele` mesh, hangs it from its highest
 //!   vertices under gravity and writes each frame as OBJ and VTU:
 //!   `cargo run -p tetpbd-io --bin tet_export -- mesh.node out/ 60`.
@@ -33,6 +35,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod compact;
 mod error;
 mod gmsh;
 mod gmsh22;
@@ -42,6 +45,7 @@ mod tetgen;
 mod text;
 mod vtu;
 
+pub use compact::drop_unreferenced_vertices;
 pub use error::{FileKind, ReadError, WriteError};
 pub use gmsh::{read_msh_bytes, read_msh_file, read_msh_str, write_msh};
 pub use obj::{surface_obj, triangles_obj, write_surface_obj};

@@ -5,7 +5,8 @@
 //! tet_export <mesh.msh | mesh.node> <out_dir> [frames = 60] [edge compliance = 1e-6]
 //! ```
 //!
-//! A `.node` file is read with the `.ele` file of the same stem. Frames are 1/60 s apart;
+//! A `.node` file is read with the `.ele` file of the same stem; vertices no tetrahedron
+//! uses are dropped. Frames are 1/60 s apart;
 //! files are `<out_dir>/surface_0000.obj` and `<out_dir>/tets_0000.vtu` (frame 0 = rest).
 //! Each frame prints its number of inverted tetrahedra and the lowest y, m.
 
@@ -14,7 +15,10 @@ use std::path::{Path, PathBuf};
 
 use tetpbd::hecs::World;
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, Surface, TetMesh, Tetrahedra};
-use tetpbd_io::{read_msh_file, read_tetgen_files, write_surface_obj, write_tetrahedra_vtu};
+use tetpbd_io::{
+    drop_unreferenced_vertices, read_msh_file, read_tetgen_files, write_surface_obj,
+    write_tetrahedra_vtu,
+};
 
 const USAGE: &str =
     "usage: tet_export <mesh.msh | mesh.node> <out_dir> [frames = 60] [edge compliance = 1e-6]";
@@ -48,7 +52,14 @@ fn run() -> Result<(), Box<dyn Error>> {
     }
     let frames: u32 = args.get(2).map_or(Ok(60), |s| s.parse())?;
     let compliance: f32 = args.get(3).map_or(Ok(1e-6), |s| s.parse())?;
-    let mesh = read_mesh(Path::new(&args[0]))?;
+    let read = read_mesh(Path::new(&args[0]))?;
+    let (mesh, _) = drop_unreferenced_vertices(&read);
+    if mesh.vertices.len() < read.vertices.len() {
+        println!(
+            "dropped {} vertices no tetrahedron uses",
+            read.vertices.len() - mesh.vertices.len()
+        );
+    }
     let out = PathBuf::from(&args[1]);
     std::fs::create_dir_all(&out)?;
     let pinned = top_vertices(&mesh);
