@@ -18,7 +18,8 @@ use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{Coupling, CouplingSettings, RapierContext, SoftColliderBuilder};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let frames: usize = std::env::args().nth(1).map_or(Ok(240), |a| a.parse())?;
+    let (mut viz, args) = tetpbd_viz::Viz::from_env()?;
+    let frames: usize = args.first().map_or(Ok(240), |a| a.parse())?;
     // The integrator's rapier state.
     let mut pipeline = PhysicsPipeline::new();
     let params = IntegrationParameters::default();
@@ -86,6 +87,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         )?;
         let ms = t.elapsed().as_secs_f64() * 1e3;
+        viz.frame(&(&world, &bodies, &colliders))?;
         let edge = stats.soft.edge.after.map_or(0.0, |e| e.max);
         let soft_x = world.get::<&Particles>(soft)?.center_of_mass().x;
         println!(
@@ -95,5 +97,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             bodies[platform].translation().x
         );
     }
+    viz.finish()?;
     Ok(())
 }

@@ -16,7 +16,7 @@ use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, Tetrahedra};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let all: Vec<String> = std::env::args().skip(1).collect();
+    let (mut viz, all) = tetpbd_viz::Viz::from_env()?;
     let flag = |name: &str| -> Result<Option<f32>, Box<dyn std::error::Error>> {
         match all.iter().position(|a| a == name) {
             Some(i) => Ok(Some(
@@ -96,6 +96,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut recovered = None;
     for frame in 1..=frames {
         let s = solver.step(&mut world)?;
+        viz.frame(&world)?;
         let p = world.get::<&Particles>(body)?;
         let t = world.get::<&Tetrahedra>(body)?;
         let ratio = t.volume_ratio(p.positions());
@@ -119,5 +120,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(f) => println!("recovered (0 inverted, volume within 1 %) at frame {f}"),
         None => println!("not recovered within {frames} frames"),
     }
+    viz.finish()?;
     Ok(())
 }

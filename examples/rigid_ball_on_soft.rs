@@ -13,7 +13,8 @@ use tetpbd::{SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let frames: usize = std::env::args().nth(1).map_or(Ok(180), |a| a.parse())?;
+    let (mut viz, args) = tetpbd_viz::Viz::from_env()?;
+    let frames: usize = args.first().map_or(Ok(180), |a| a.parse())?;
     let solver = SolverSettings {
         substeps: 10,
         measure_error: true,
@@ -44,6 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for frame in 0..frames {
         let t = Instant::now();
         let stats = scene.step()?;
+        viz.frame(&scene)?;
         let ms = t.elapsed().as_secs_f64() * 1e3;
         let edge = stats.soft.edge.after.map_or(0.0, |e| e.max);
         let b = &scene.physics.bodies[ball];
@@ -55,5 +57,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             b.linvel().y
         );
     }
+    viz.finish()?;
     Ok(())
 }

@@ -18,7 +18,7 @@ use tetpbd_rapier::{
 };
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (mut viz, args) = tetpbd_viz::Viz::from_env()?;
     let soft_ground = args.iter().any(|a| a == "soft");
     let seconds: u32 = args.iter().find_map(|a| a.parse().ok()).unwrap_or(5);
     let solver = SolverSettings {
@@ -64,6 +64,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "ground: {}\n  t (s)   max|v| (m/s)   soft pen. (m)   ground pen. (m)   soft contacts   clamps   ms/frame",
         if soft_ground { "pinned soft slab" } else { "rigid (rapier)" }
     );
+    let mut progress =
+        tetpbd_viz::Progress::new("soft_pile frames", u64::from(seconds * frames_per_second));
     for second in 1..=seconds {
         let (mut v, mut pen, mut ground, mut clamps, mut ms) = (0.0f32, 0.0f32, 0.0f32, 0u64, 0.0);
         for _ in 0..frames_per_second {
@@ -74,6 +76,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ground = ground.max(scene.step_with(&mut contacts)?.max_penetration);
             }
             ms += t.elapsed().as_secs_f64() * 1e3;
+            viz.frame(&scene)?;
+            progress.inc(1);
             let c = contacts.stats();
             pen = pen.max(c.max_penetration);
             clamps += c.clamps;
@@ -81,12 +85,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 v = v.max(p.max_speed());
             }
         }
-        println!(
-            "{second:>7} {v:>14.4} {pen:>15.5} {ground:>17.5} {:>15} {clamps:>8} {:>10.2}",
-            contacts.stats().contacts,
-            ms / f64::from(frames_per_second)
-        );
+        progress.suspend(|| {
+            println!(
+                "{second:>7} {v:>14.4} {pen:>15.5} {ground:>17.5} {:>15} {clamps:>8} {:>10.2}",
+                contacts.stats().contacts,
+                ms / f64::from(frames_per_second)
+            )
+        });
     }
+    progress.finish();
+    viz.finish()?;
     Ok(())
 }
 

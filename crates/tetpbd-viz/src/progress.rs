@@ -101,25 +101,43 @@ impl Progress {
     /// Records `n` more steps done.
     pub fn inc(&mut self, n: u64) {
         self.done = self.done.saturating_add(n);
-        let line = self.line();
         let decile = if self.total > 0 {
             (10 * self.done / self.total).min(10)
         } else {
             0
         };
-        match &mut self.mode {
-            Mode::Bar(bar) => bar.inc(n),
+        let unfinished = self.done < self.total;
+        let due = match &mut self.mode {
+            Mode::Bar(bar) => {
+                bar.inc(n);
+                false
+            }
             Mode::Lines {
                 last_line,
                 last_decile,
             } => {
-                if decile > *last_decile || last_line.elapsed() >= LINE_INTERVAL {
+                // The line at 100 % is left to `finish`, which adds the total time.
+                let due =
+                    unfinished && (decile > *last_decile || last_line.elapsed() >= LINE_INTERVAL);
+                if due {
                     *last_decile = decile;
                     *last_line = Instant::now();
-                    eprintln!("{line}");
                 }
+                due
             }
-            Mode::Finished => {}
+            Mode::Finished => false,
+        };
+        if due {
+            eprintln!("{}", self.line());
+        }
+    }
+
+    /// Runs `f` (which prints to standard output, say) with the bar hidden, so its lines do
+    /// not tear the bar; in plain mode just runs `f`.
+    pub fn suspend<R>(&self, f: impl FnOnce() -> R) -> R {
+        match &self.mode {
+            Mode::Bar(bar) => bar.suspend(f),
+            _ => f(),
         }
     }
 

@@ -17,8 +17,8 @@ const SOFT_COLORS: [Rgb; 4] = [
 ];
 /// Colour of fixed colliders.
 const FIXED_COLOR: Rgb = [150, 150, 150];
-/// Colour of dynamic rigid bodies.
-const DYNAMIC_COLOR: Rgb = [70, 110, 185];
+/// Colours of dynamic rigid bodies, cycled in snapshot order.
+const DYNAMIC_COLORS: [Rgb; 3] = [[70, 110, 185], [95, 140, 205], [55, 90, 160]];
 /// Colour of kinematic rigid bodies.
 const KINEMATIC_COLOR: Rgb = [80, 160, 90];
 /// Colour of the ground plane drawn when no fixed collider is the ground.
@@ -159,7 +159,7 @@ impl View {
             raster.triangle(&self.camera, [c(x0, z0), c(x1, z1), c(x1, z0)], color);
             raster.triangle(&self.camera, [c(x0, z0), c(x0, z1), c(x1, z1)], color);
         }
-        let mut soft = 0;
+        let (mut soft, mut dynamic) = (0, 0);
         for item in &snapshot.items {
             let base = match item.kind {
                 ItemKind::Soft => {
@@ -167,7 +167,10 @@ impl View {
                     SOFT_COLORS[(soft - 1) % SOFT_COLORS.len()]
                 }
                 ItemKind::Fixed => FIXED_COLOR,
-                ItemKind::Dynamic => DYNAMIC_COLOR,
+                ItemKind::Dynamic => {
+                    dynamic += 1;
+                    DYNAMIC_COLORS[(dynamic - 1) % DYNAMIC_COLORS.len()]
+                }
                 ItemKind::Kinematic => KINEMATIC_COLOR,
             };
             let p = &item.mesh.positions;
