@@ -11,6 +11,8 @@ use std::fmt::Write as _;
 use std::process::Command;
 use std::time::Instant;
 
+use tetpbd_viz::Progress;
+
 use tetpbd_stability::{
     all_cases, coupled_cases, markdown, run_scene, CaseKind, Config, CoupledOutcome, Outcome,
 };
@@ -81,43 +83,60 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Outcome::ENERGY_BOUND,
     )?;
 
-    let mut totals = Vec::new();
-    for (title, net) in [
+    let tables: Vec<(&str, Vec<_>)> = [
         ("Without safety net", None),
         (
             "With the correction-speed safety net (10 m/s)",
             Some(SAFETY_NET),
         ),
-    ] {
-        let cases: Vec<_> = all_cases(net)
+    ]
+    .into_iter()
+    .map(|(title, net)| {
+        let cases = all_cases(net)
             .into_iter()
             .filter(|c| !fast || c.kind == CaseKind::Fast)
             .collect();
+        (title, cases)
+    })
+    .collect();
+    let coupled: Vec<_> = coupled_cases()
+        .into_iter()
+        .filter(|c| !fast || c.kind != CaseKind::Long)
+        .collect();
+    let mut progress = Progress::new(
+        "stability cases",
+        (tables.iter().map(|t| t.1.len()).sum::<usize>() + coupled.len()) as u64,
+    );
+    let mut totals = Vec::new();
+    for (title, cases) in &tables {
         let mut results = Vec::new();
         let mut passed = 0;
-        for case in &cases {
+        for case in cases {
             let t = Instant::now();
             let row: Vec<Outcome> = configs.iter().map(|c| run_scene(&case.scene, c)).collect();
             passed += row.iter().filter(|o| o.pass()).count();
-            println!(
-                "[{:6.1} s] {title}: {} / {}: {} of {} pass ({:.1} s)",
-                started.elapsed().as_secs_f64(),
-                case.group,
-                case.name,
-                row.iter().filter(|o| o.pass()).count(),
-                row.len(),
-                t.elapsed().as_secs_f64()
-            );
+            progress.suspend(|| {
+                println!(
+                    "[{:6.1} s] {title}: {} / {}: {} of {} pass ({:.1} s)",
+                    started.elapsed().as_secs_f64(),
+                    case.group,
+                    case.name,
+                    row.iter().filter(|o| o.pass()).count(),
+                    row.len(),
+                    t.elapsed().as_secs_f64()
+                )
+            });
+            progress.inc(1);
             results.push(row);
         }
         let total = cases.len() * configs.len();
         totals.push((title, passed, total));
         writeln!(doc, "## {title}\n")?;
         writeln!(doc, "{passed} of {total} cells pass.\n")?;
-        doc.push_str(&markdown(&cases, &configs, &results));
+        doc.push_str(&markdown(cases, &configs, &results));
         writeln!(doc)?;
         writeln!(doc, "Cases:\n")?;
-        for c in &cases {
+        for c in cases {
             writeln!(doc, "- *{} / {}*: {}.", c.group, c.name, c.description)?;
         }
         writeln!(doc)?;
@@ -141,10 +160,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     writeln!(doc)?;
     let mut coupled_pass = (0, 0);
-    for case in coupled_cases() {
-        if fast && case.kind == CaseKind::Long {
-            continue;
-        }
+    for case in &coupled {
         let t = Instant::now();
         write!(doc, "| {} |", case.name)?;
         for c in &configs {
@@ -175,13 +191,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         writeln!(doc)?;
-        println!(
-            "[{:6.1} s] coupled: {} ({:.1} s)",
-            started.elapsed().as_secs_f64(),
-            case.name,
-            t.elapsed().as_secs_f64()
-        );
+        progress.suspend(|| {
+            println!(
+                "[{:6.1} s] coupled: {} ({:.1} s)",
+                started.elapsed().as_secs_f64(),
+                case.name,
+                t.elapsed().as_secs_f64()
+            )
+        });
+        progress.inc(1);
     }
+    progress.finish();
     writeln!(
         doc,
         "\n{} of {} coupled cells pass.\n",
