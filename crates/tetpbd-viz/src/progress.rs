@@ -101,11 +101,11 @@ impl Progress {
     /// Records `n` more steps done.
     pub fn inc(&mut self, n: u64) {
         self.done = self.done.saturating_add(n);
-        let decile = if self.total > 0 {
-            (10 * self.done / self.total).min(10)
-        } else {
-            0
-        };
+        let decile = self
+            .done
+            .saturating_mul(10)
+            .checked_div(self.total)
+            .map_or(0, |d| d.min(10));
         let unfinished = self.done < self.total;
         let due = match &mut self.mode {
             Mode::Bar(bar) => {

@@ -137,17 +137,33 @@ fn collider_shapes_become_triangle_meshes_of_their_size() {
 
 #[test]
 fn options_come_out_of_the_arguments_and_fall_back_on_the_environment() {
-    let args = ["mirror", "--export", "out/frames", "vf", "--strip-frames", "3", "60"]
-        .map(String::from);
+    let args = [
+        "mirror",
+        "--export",
+        "out/frames",
+        "vf",
+        "--strip-frames",
+        "3",
+        "60",
+    ]
+    .map(String::from);
     let env = |k: &str| (k == "TETPBD_STRIP" || k == "TETPBD_EXPORT").then(|| format!("{k}.png"));
     let (o, rest) = VizOptions::parse(args, env).unwrap();
     assert_eq!(rest, ["mirror", "vf", "60"]);
-    assert_eq!(o.export.unwrap().to_str(), Some("out/frames"), "the flag wins");
+    assert_eq!(
+        o.export.unwrap().to_str(),
+        Some("out/frames"),
+        "the flag wins"
+    );
     assert_eq!(o.strip.unwrap().to_str(), Some("TETPBD_STRIP.png"));
     assert_eq!(o.strip_frames, 3);
     assert_eq!(o.render, None);
 
-    for bad in [&["--export"][..], &["--strip", "--render", "x"], &["--strip-frames", "0"]] {
+    for bad in [
+        &["--export"][..],
+        &["--strip", "--render", "x"],
+        &["--strip-frames", "0"],
+    ] {
         let err = VizOptions::parse(bad.iter().map(|s| s.to_string()), |_| None).unwrap_err();
         assert!(
             matches!(&err, VizError::Option { name, .. } if name == bad[0]),
@@ -163,7 +179,11 @@ fn progress_counts_and_reports_its_count() {
         p.inc(3);
     }
     assert_eq!(p.done(), 30);
-    assert!(p.line().starts_with("frames: 30/40 (75 %), "), "{}", p.line());
+    assert!(
+        p.line().starts_with("frames: 30/40 (75 %), "),
+        "{}",
+        p.line()
+    );
     p.finish();
     let mut bar = Progress::with_terminal("bar", 5, true);
     bar.inc(5);
