@@ -97,30 +97,8 @@ impl Raster {
         if area.abs() < 1e-12 || !area.is_finite() {
             return;
         }
-        let min_x = s
-            .iter()
-            .map(|p| p.0)
-            .fold(f32::MAX, f32::min)
-            .floor()
-            .max(0.0);
-        let max_x = s
-            .iter()
-            .map(|p| p.0)
-            .fold(f32::MIN, f32::max)
-            .ceil()
-            .min(self.width as f32 - 1.0);
-        let min_y = s
-            .iter()
-            .map(|p| p.1)
-            .fold(f32::MAX, f32::min)
-            .floor()
-            .max(0.0);
-        let max_y = s
-            .iter()
-            .map(|p| p.1)
-            .fold(f32::MIN, f32::max)
-            .ceil()
-            .min(self.height as f32 - 1.0);
+        let (min_x, max_x) = pixel_span([s[0].0, s[1].0, s[2].0], self.width);
+        let (min_y, max_y) = pixel_span([s[0].1, s[1].1, s[2].1], self.height);
         if min_x > max_x || min_y > max_y {
             return;
         }
@@ -185,6 +163,14 @@ impl Raster {
             self.rgb[i] = color;
         }
     }
+}
+
+/// First and last pixel index (as floats) a triangle with corner coordinates `c` can touch on
+/// an axis of `size` pixels; first > last when it is off the image.
+fn pixel_span(c: [f32; 3], size: u32) -> (f32, f32) {
+    let lo = c[0].min(c[1]).min(c[2]).floor().max(0.0);
+    let hi = c[0].max(c[1]).max(c[2]).ceil().min(size as f32 - 1.0);
+    (lo, hi)
 }
 
 /// The point of segment `inside`–`outside` on the plane `depth = near`.
