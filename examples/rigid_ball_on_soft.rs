@@ -2,6 +2,9 @@
 //!
 //! Headless; prints one line of statistics per frame. Run with
 //! `cargo run --example rigid_ball_on_soft [-- FRAMES]`.
+//!
+//! Output flags (`--export DIR`, `--strip FILE`, `--animate FILE`, `--render DIR`): see the
+//! README's Gallery section.
 
 use std::time::Instant;
 

@@ -7,6 +7,10 @@
 //! ```text
 //! cargo run --release --example soft_pile -- [rigid|soft] [seconds]
 //! ```
+//!
+//! Progress goes to standard error (a bar on a terminal, a line per 10 % otherwise).
+//! Output flags (`--export DIR`, `--strip FILE`, `--animate FILE`, `--render DIR`): see the
+//! README's Gallery section.
 
 use nalgebra::Vector3;
 use rapier3d::math::Vector;

@@ -190,3 +190,60 @@ fn progress_counts_and_reports_its_count() {
     assert_eq!(bar.done(), 5);
     bar.finish();
 }
+
+#[test]
+fn a_viz_session_writes_every_output_it_was_asked_for() {
+    use tetpbd::{Solver, SolverSettings};
+    use tetpbd_viz::{RenderSettings, Viz};
+
+    let dir = temp_dir("session");
+    let options = VizOptions {
+        export: Some(dir.join("frames")),
+        render: Some(dir.join("png")),
+        strip: Some(dir.join("strip.png")),
+        strip_frames: 3,
+        animate: Some(dir.join("anim.png")),
+    };
+    let settings = RenderSettings {
+        width: 40,
+        height: 30,
+        ..Default::default()
+    };
+    let mut viz = Viz::new(options, settings).unwrap();
+    assert!(viz.is_active());
+    let mut world = tetpbd::hecs::World::new();
+    let mesh = box_grid(Vector3::repeat(0.5), [1, 1, 1], CellSplit::Six).unwrap();
+    SoftBodyBuilder::new(mesh)
+        .edges(0.0)
+        .build()
+        .unwrap()
+        .spawn(&mut world);
+    let mut solver = Solver::new(SolverSettings::default()).unwrap();
+    for _ in 0..5 {
+        solver.step(&mut world).unwrap();
+        viz.frame(&world).unwrap();
+    }
+    viz.finish().unwrap();
+    let count = |sub: &str| std::fs::read_dir(dir.join(sub)).unwrap().count();
+    assert_eq!(count("frames"), 10, "5 frames × (OBJ + VTU)");
+    assert_eq!(count("png"), 5);
+    let size = |name: &str| {
+        let reader = png::Decoder::new(std::fs::File::open(dir.join(name)).unwrap())
+            .read_info()
+            .unwrap();
+        let frames = reader
+            .info()
+            .animation_control()
+            .map_or(1, |a| a.num_frames);
+        (reader.info().width, reader.info().height, frames)
+    };
+    assert_eq!(size("strip.png"), (3 * 40 + 2 * 2, 30, 1));
+    assert_eq!(size("anim.png"), (40, 30, 5));
+    assert_eq!(size("png/frame_0004.png"), (40, 30, 1));
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    let mut idle = Viz::new(VizOptions::default(), RenderSettings::default()).unwrap();
+    assert!(!idle.is_active());
+    idle.frame(&world).unwrap();
+    idle.finish().unwrap();
+}
