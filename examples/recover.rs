@@ -10,6 +10,7 @@
 //! `e` = edges alone (which cannot un-invert a mirrored body). `--alpha` sets the compliance of
 //! every family (m/N; volume m⁵/N), default 0; `--max-correction-speed` turns on the solver's
 //! safety net (m/s). Defaults: mirror, vfe, 120 frames, 10 substeps, 4³ cells.
+//!
 //! Output flags (`--export DIR`, `--strip FILE`, `--animate FILE`, `--render DIR`): see the
 //! README's Gallery section.
 
