@@ -60,8 +60,13 @@ impl SurfaceMesh {
     }
 
     /// Reads the triangles of every object in OBJ text (polygons are fanned into triangles;
-    /// points, lines, normals, texture coordinates and materials are ignored).
+    /// points, lines, normals, texture coordinates, colours and materials are ignored).
+    ///
+    /// Only the `v` (first three coordinates), `f` (vertex indices, 1-based or negative
+    /// relative) and `o`/`g` lines reach `tobj`: its texture-coordinate and normal paths can
+    /// panic on crafted indices (found by the fuzz test), and a surface needs neither.
     pub fn from_obj_str(text: &str) -> Result<SurfaceMesh, SurfaceError> {
+        let text = positions_and_faces(text);
         let options = tobj::LoadOptions {
             triangulate: true,
             ignore_points: true,
@@ -145,6 +150,41 @@ impl SurfaceMesh {
         }
         Ok(welded)
     }
+}
+
+/// The `v`, `f` and `o`/`g` lines of OBJ text, with `v` cut to its three coordinates and
+/// each face corner cut to its vertex index.
+fn positions_and_faces(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        let mut tokens = line.split_whitespace();
+        match tokens.next() {
+            Some("v") => {
+                out.push('v');
+                for t in tokens.take(3) {
+                    out.push(' ');
+                    out.push_str(t);
+                }
+            }
+            Some("f") => {
+                out.push('f');
+                for t in tokens {
+                    out.push(' ');
+                    out.push_str(t.split('/').next().unwrap_or(t));
+                }
+            }
+            Some(k @ ("o" | "g")) => {
+                out.push_str(k);
+                for t in tokens {
+                    out.push(' ');
+                    out.push_str(t);
+                }
+            }
+            _ => continue,
+        }
+        out.push('\n');
+    }
+    out
 }
 
 /// Welds exactly equal positions (`-0.0` equals `0.0`): the kept vertices in order of first

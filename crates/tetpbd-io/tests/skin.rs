@@ -7,9 +7,12 @@ use tetpbd::generators::{self, CellSplit};
 use tetpbd::SoftBodyBuilder;
 use tetpbd_io::{shapes, Skin, SkinError, TetrahedralizeBuilder};
 
+/// Tetrahedron vertices, tetrahedra and points to embed.
+type Setup = (Vec<Vector3<f32>>, Vec<[u32; 4]>, Vec<Vector3<f32>>);
+
 /// A 2 × 2 × 2 cube of 1 m split into tetrahedra, and points on a lattice inside it and a
 /// few outside.
-fn cube_and_points() -> (Vec<Vector3<f32>>, Vec<[u32; 4]>, Vec<Vector3<f32>>) {
+fn cube_and_points() -> Setup {
     let mesh = generators::box_grid(Vector3::repeat(1.0), [2, 2, 2], CellSplit::Six).unwrap();
     let mut points = Vec::new();
     for i in 0..7 {
