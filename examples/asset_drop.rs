@@ -53,14 +53,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .build()?;
     // Embed the render vertices in the body's own (solver-ordered) tetrahedra.
     let points: Vec<_> = render.vertices.iter().map(|v| v + lift).collect();
+    let t = Instant::now();
     let skin = Skin::embed(
         body.particles.positions(),
         body.tetrahedra.indices(),
         &points,
     )?;
+    let embed_ms = t.elapsed().as_secs_f64() * 1e3;
     println!(
         "# {path}: {} surface triangles, {} vertices -> {} tetrahedra, {} particles \
-         (cell {cell} m, {mesh_ms:.1} ms); skin points outside: {}",
+         (cell {cell} m, {mesh_ms:.1} ms); skin embedded in {embed_ms:.2} ms, points \
+         outside: {}",
         render.triangles.len(),
         render.vertices.len(),
         body.tetrahedra.len(),

@@ -96,7 +96,17 @@ impl Skin {
         let mut bindings = Vec::with_capacity(points.len());
         for p in points {
             let q = to_glam(p);
+            let barycentric = |t: u32| {
+                let (a, m_inv) = &inverses[t as usize];
+                m_inv * (p.cast::<f64>() - a)
+            };
+            // Inside (by the barycentric coordinates, cheap) is distance 0; otherwise parry
+            // measures the distance to the tetrahedron.
             let tet_distance = |t: u32| {
+                let l = barycentric(t);
+                if l.min() >= 0.0 && l.sum() <= 1.0 {
+                    return 0.0;
+                }
                 let [a, b, c, d] = tets[t as usize].map(|i| to_glam(&positions[i as usize]));
                 Tetrahedron::new(a, b, c, d).distance_to_local_point(q, true)
             };
@@ -107,8 +117,7 @@ impl Skin {
                     |leaf, _| Some(tet_distance(leaf)),
                 )
                 .unwrap_or_else(|| (0, tet_distance(0)));
-            let (a, m_inv) = &inverses[t as usize];
-            let l = (m_inv * (p.cast::<f64>() - a)).map(|w| w as f32);
+            let l = barycentric(t).map(|w| w as f32);
             bindings.push(SkinBinding {
                 tet: t,
                 vertices: tets[t as usize],

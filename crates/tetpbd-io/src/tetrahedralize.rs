@@ -68,7 +68,9 @@ impl TetrahedralizeBuilder {
     }
 
     /// Largest lattice the cell size may ask for, as a guard against a cell size far too
-    /// small for the surface (which would exhaust memory rather than fail).
+    /// small for the surface (which would exhaust memory rather than fail). It counts the
+    /// uniform lattice at the cell size over the surface's box; [`Self::subdivisions`] adds
+    /// points near the surface on top of that.
     pub fn max_lattice_points(mut self, limit: u64) -> Self {
         self.max_lattice_points = limit;
         self
