@@ -109,15 +109,15 @@ impl SurfaceMesh {
 
     /// Volume enclosed by the triangles (divergence theorem), m³: positive when they are
     /// wound outward (counter-clockwise seen from outside), negative when inward. Only
-    /// meaningful for a closed surface.
+    /// meaningful for a closed surface. Triangles naming a missing vertex are skipped (the
+    /// fields are public; [`SurfaceMesh::new`] rejects them).
     pub fn enclosed_volume(&self) -> f32 {
+        let corner = |i: u32| self.vertices.get(i as usize).map(|v| v.cast::<f64>());
         let sum: f64 = self
             .triangles
             .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| self.vertices[i as usize].cast::<f64>());
-                a.dot(&b.cross(&c))
-            })
+            .filter_map(|t| Some((corner(t[0])?, corner(t[1])?, corner(t[2])?)))
+            .map(|(a, b, c)| a.dot(&b.cross(&c)))
             .sum();
         (sum / 6.0) as f32
     }
