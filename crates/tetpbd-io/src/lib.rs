@@ -10,6 +10,12 @@
 //!   [`write_msh`]).
 //! * [`drop_unreferenced_vertices`] removes vertices no tetrahedron uses (Gmsh files often
 //!   hold surface or geometry nodes), which [`tetpbd::SoftBodyBuilder`] would reject.
+//! * Surface meshes in (feature `mesher`, on by default; it brings rapier3d through
+//!   `tetpbd-rapier`, and `tobj`): a closed triangle [`SurfaceMesh`] from an OBJ file or
+//!   arrays is filled with tetrahedra by parry's `volume_mesh` ([`TetrahedralizeBuilder`],
+//!   cell size in m), and a fine render mesh is embedded in the tetrahedra and moved with
+//!   them ([`Skin`], barycentric skinning). Errors are [`SurfaceError`] and [`SkinError`].
+//!   [`shapes`] generates the sample assets under `examples/assets/`.
 //! * The `tet_export` binary reads a `.msh` or `.node`/`.ele` mesh, hangs it from its highest
 //!   vertices under gravity and writes each frame as OBJ and VTU:
 //!   `cargo run -p tetpbd-io --bin tet_export -- mesh.node out/ 60`.
@@ -40,14 +46,32 @@ mod error;
 mod gmsh;
 mod gmsh22;
 mod gmsh_binary;
+#[cfg(feature = "mesher")]
+mod mesher_error;
 mod obj;
+#[cfg(feature = "mesher")]
+pub mod shapes;
+#[cfg(feature = "mesher")]
+mod skin;
+#[cfg(feature = "mesher")]
+mod surface;
 mod tetgen;
+#[cfg(feature = "mesher")]
+mod tetrahedralize;
 mod text;
 mod vtu;
 
 pub use compact::drop_unreferenced_vertices;
 pub use error::{FileKind, ReadError, WriteError};
 pub use gmsh::{read_msh_bytes, read_msh_file, read_msh_str, write_msh};
+#[cfg(feature = "mesher")]
+pub use mesher_error::{SkinError, SurfaceError};
 pub use obj::{surface_obj, triangles_obj, write_surface_obj};
+#[cfg(feature = "mesher")]
+pub use skin::{Skin, SkinBinding};
+#[cfg(feature = "mesher")]
+pub use surface::SurfaceMesh;
 pub use tetgen::{read_tetgen_files, read_tetgen_str, write_tetgen};
+#[cfg(feature = "mesher")]
+pub use tetrahedralize::TetrahedralizeBuilder;
 pub use vtu::{tetrahedra_vtu, write_tetrahedra_vtu};
