@@ -4,6 +4,9 @@
 //! Headless; prints one line of statistics per frame. Run with
 //! `cargo run --release --example asset_drop [-- OBJ [FRAMES [CELL_M]]]`
 //! (defaults: `examples/assets/bunny_blob.obj`, 180 frames, 0.07 m cells).
+//!
+//! Output flags (`--export DIR`, `--strip FILE`, `--animate FILE`, `--render DIR`): see the
+//! README's Gallery section.
 
 use std::time::Instant;
 
@@ -15,7 +18,8 @@ use tetpbd_io::{Skin, SurfaceMesh, TetrahedralizeBuilder};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping, SoftColliderBuilder};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut args = std::env::args().skip(1);
+    let (mut viz, args) = tetpbd_viz::Viz::from_env()?;
+    let mut args = args.into_iter();
     let path = args.next().unwrap_or_else(|| {
         concat!(
             env!("CARGO_MANIFEST_DIR"),
@@ -84,6 +88,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for frame in 0..frames {
         let t = Instant::now();
         let stats = scene.step()?;
+        viz.frame(&scene)?;
         let (p, tets) = scene.soft.query_one_mut::<(&Particles, &Tetrahedra)>(e)?;
         skin.deform(p.positions(), &mut skinned)?;
         let ms = t.elapsed().as_secs_f64() * 1e3;
@@ -98,5 +103,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             p.aabb().0.y,
         );
     }
+    viz.finish()?;
     Ok(())
 }
