@@ -286,7 +286,10 @@ impl SoftBodyBuilder {
         let positions = permute(positions);
         let velocities = permute(velocities);
         let vertices = permute(mesh.vertices);
-        let masses: Vec<f32> = particle_source.iter().map(|&i| masses[i as usize]).collect();
+        let masses: Vec<f32> = particle_source
+            .iter()
+            .map(|&i| masses[i as usize])
+            .collect();
         let inv_masses: Vec<f32> = particle_source
             .iter()
             .map(|&i| inv_masses[i as usize])

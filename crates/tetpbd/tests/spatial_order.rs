@@ -27,7 +27,11 @@ fn shuffling_keeps_the_geometry() {
     for (k, &i) in order.iter().enumerate() {
         assert_eq!(mesh.vertices[k], grid.vertices[i as usize]);
     }
-    let mut a: Vec<[u32; 4]> = mesh.tets.iter().map(|t| t.map(|k| order[k as usize])).collect();
+    let mut a: Vec<[u32; 4]> = mesh
+        .tets
+        .iter()
+        .map(|t| t.map(|k| order[k as usize]))
+        .collect();
     let mut b = grid.tets.clone();
     a.sort_unstable();
     b.sort_unstable();
@@ -120,7 +124,10 @@ fn the_renumbered_order_is_more_local() {
         .unwrap();
     let s_off = spread(&off.particles, off.tetrahedra.indices());
     let s_on = spread(&on.particles, on.tetrahedra.indices());
-    assert!(s_on * 4.0 < s_off, "index spread {s_on} (on) vs {s_off} (off)");
+    assert!(
+        s_on * 4.0 < s_off,
+        "index spread {s_on} (on) vs {s_off} (off)"
+    );
 }
 
 #[test]
@@ -177,7 +184,10 @@ fn renumbered_and_input_order_bodies_agree() {
     }
     let off = world.get::<&Particles>(bodies[0]).unwrap();
     let on = world.get::<&Particles>(bodies[1]).unwrap();
-    assert_eq!(off.source(), (0..off.len() as u32).collect::<Vec<_>>().as_slice());
+    assert_eq!(
+        off.source(),
+        (0..off.len() as u32).collect::<Vec<_>>().as_slice()
+    );
     // Gauss–Seidel visits the constraints in another order, so the states differ by the
     // solver's convergence error, not more.
     let mut worst = 0.0f32;
@@ -186,11 +196,18 @@ fn renumbered_and_input_order_bodies_agree() {
         let b = on.positions()[on.particle_of(v).unwrap() as usize];
         worst = worst.max((a - b).norm());
     }
-    let sag = mesh.vertices.iter().map(|x| x.y).fold(f32::INFINITY, f32::min)
+    let sag = mesh
+        .vertices
+        .iter()
+        .map(|x| x.y)
+        .fold(f32::INFINITY, f32::min)
         - off.aabb().0.y;
     println!("sag {sag} m, largest difference {worst} m");
     assert!(sag > 5e-3, "the cube hangs (sag {sag} m)");
-    assert!(worst < 0.2 * sag, "largest difference {worst} m, sag {sag} m");
+    assert!(
+        worst < 0.2 * sag,
+        "largest difference {worst} m, sag {sag} m"
+    );
 }
 
 #[test]

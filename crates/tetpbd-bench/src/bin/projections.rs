@@ -1,7 +1,7 @@
 //! ns per constraint projection, per family, single-threaded, on a ~40k-tetrahedron grid.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --bin projections [-- --cells N --repeats R --shuffle --spatial-order on|off|both]
+//! cargo run --release -p tetpbd-bench --bin projections [-- --cells N --repeats R --shuffle --spatial-order on|off|both --simd-only]
 //! ```
 //!
 //! Each family is measured alone (a body with only that family's component), as full
@@ -10,7 +10,7 @@
 //!
 //! `--shuffle` numbers the grid's vertices and tetrahedra in a random order (as mesh files
 //! may); `--spatial-order` builds the body with the builder's particle renumbering on, off
-//! or both (default: the builder's default).
+//! or both (default: the builder's default). `--simd-only` skips the scalar kernels.
 
 use std::time::Instant;
 
@@ -45,6 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (family, kernel, spatial) in ["edge", "volume", "vertex-face"]
         .into_iter()
         .flat_map(|f| [(f, Kernel::Scalar), (f, Kernel::Simd)])
+        .filter(|(_, k)| *k == Kernel::Simd || !flag("--simd-only"))
         .flat_map(|(f, k)| orders().into_iter().map(move |o| (f, k, o)))
     {
         let mut world = hecs::World::new();
