@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use crate::constraint::{signed_height, signed_volume, VERTEX_FACE_ORDER};
 use crate::error::BuildError;
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-use crate::locality::{inverse, morton_order, relabel_tets};
+use crate::locality::{inverse, mean_edge_length, relabel_tets, row_order};
 use crate::mesh::{Surface, Tetrahedra};
 use crate::ordering::colour_order;
 use crate::particles::Particles;
@@ -159,7 +159,7 @@ impl SoftBodyBuilder {
         self
     }
 
-    /// Renumbers the particles along a space-filling curve (see [`crate::locality`]) so that
+    /// Renumbers the particles in rows of about one edge length (see [`crate::locality`]) so that
     /// particles close in space are close in memory, which speeds up the projections of
     /// meshes whose vertex numbering is unrelated to space (mesh files). When on, particle `k`
     /// of the built body is input vertex [`Particles::source`]`()[k]`, and
@@ -273,7 +273,7 @@ impl SoftBodyBuilder {
             .collect();
         // Particle order (see `locality`): particle `k` is input vertex `particle_source[k]`.
         let (particle_source, local_tets, local_source) = if spatial_order {
-            let order = morton_order(&mesh.vertices);
+            let order = row_order(&mesh.vertices, mean_edge_length(&mesh.vertices, &mesh.tets));
             let (tets, tet_source) = relabel_tets(&mesh.tets, &inverse(&order));
             (order, tets, tet_source)
         } else {
