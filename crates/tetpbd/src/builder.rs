@@ -273,7 +273,10 @@ impl SoftBodyBuilder {
             .collect();
         // Particle order (see `locality`): particle `k` is input vertex `particle_source[k]`.
         let (particle_source, local_tets, local_source) = if spatial_order {
-            let order = row_order(&mesh.vertices, mean_edge_length(&mesh.vertices, &mesh.tets));
+            // Rows half an edge thick: each layer of a box grid gets its own row, so a grid
+            // generator's numbering is kept.
+            let cell = 0.5 * mean_edge_length(&mesh.vertices, &mesh.tets);
+            let order = row_order(&mesh.vertices, cell);
             let (tets, tet_source) = relabel_tets(&mesh.tets, &inverse(&order));
             (order, tets, tet_source)
         } else {

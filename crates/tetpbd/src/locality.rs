@@ -3,9 +3,9 @@
 //! The projections gather and scatter the positions of a constraint's particles. Mesh files
 //! (TetGen, Gmsh, volume meshers) often number vertices in an order unrelated to space, so
 //! the particles of one tetrahedron lie far apart in memory and almost every gather misses
-//! the cache. Renumbering the particles in *rows* — bucketed into cells of about one edge
+//! the cache. Renumbering the particles in *rows* — bucketed into cells of half the mean edge
 //! length along z and y, sorted by x within a row, rows in (z, y) order, the order a box
-//! grid generator writes — puts a tetrahedron's particles within one or two rows and planes
+//! grid generator writes (a grid of cubic cells keeps its numbering) — puts a tetrahedron's particles within one or two rows and planes
 //! of each other. The tetrahedra are then sorted by their smallest particle index, so a
 //! sweep over a colour class walks memory forward in a few streams the hardware prefetcher
 //! follows. (A Morton / Z-order curve was measured too: it has fewer cache misses in a

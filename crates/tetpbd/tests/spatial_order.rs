@@ -1,4 +1,4 @@
-//! Particle renumbering for locality (`SoftBodyBuilder::spatial_order`): the mapping to the
+//! Particle renumbering in rows (`SoftBodyBuilder::spatial_order`): the mapping to the
 //! input mesh is exact, pins given by input vertex index hold the right physical points, and
 //! the body behaves like the one built in input order.
 
@@ -36,6 +36,30 @@ fn shuffling_keeps_the_geometry() {
     a.sort_unstable();
     b.sort_unstable();
     assert_eq!(a, b);
+}
+
+#[test]
+fn a_shuffled_grid_gets_the_grid_numbering_back() {
+    let grid = box_grid(Vector3::repeat(1.0), [5, 4, 3], CellSplit::Six).unwrap();
+    let kept = SoftBodyBuilder::new(grid.clone())
+        .spatial_order(true)
+        .build()
+        .unwrap();
+    let identity: Vec<u32> = (0..grid.vertices.len() as u32).collect();
+    assert_eq!(kept.particles.source(), identity.as_slice());
+    let (mesh, order) = shuffled(&grid, 9);
+    let body = SoftBodyBuilder::new(mesh)
+        .spatial_order(true)
+        .build()
+        .unwrap();
+    // Particle k is shuffled vertex source[k], which is grid vertex order[source[k]] = k.
+    let back: Vec<u32> = body
+        .particles
+        .source()
+        .iter()
+        .map(|&v| order[v as usize])
+        .collect();
+    assert_eq!(back, identity);
 }
 
 #[test]
