@@ -12,6 +12,9 @@ const VTK_TETRA: u8 = 10;
 
 /// `.vtu` text of a soft body's tetrahedra at its current positions (m).
 ///
+/// Points are the body's particles in particle order ([`Particles::source`] gives the input
+/// vertex of each when the builder renumbered them).
+///
 /// Cell data per tetrahedron, in the body's stored (solver) order:
 /// * `volume_ratio`: current signed volume over signed rest volume (1 at rest, negative when
 ///   inverted; 0 for a zero rest volume);

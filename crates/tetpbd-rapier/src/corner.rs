@@ -67,54 +67,51 @@ pub(crate) struct CornerContact {
     pub impulse: Vector3<f32>,
 }
 
-/// Corners of `shape` in its local frame, with the extra thickness of a rounded shape.
-pub(crate) fn corners_of(shape: &dyn Shape) -> (Vec<Vector3<f32>>, f32) {
-    let cuboid_corners = |h: Vector3<f32>| {
-        (0..8)
-            .map(|k| {
-                Vector3::new(
-                    if k & 1 == 0 { -h.x } else { h.x },
-                    if k & 2 == 0 { -h.y } else { h.y },
-                    if k & 4 == 0 { -h.z } else { h.z },
-                )
-            })
-            .collect()
+/// Appends the corners of `shape` in its local frame to `out`; returns the extra thickness
+/// of a rounded shape.
+pub(crate) fn corners_into(shape: &dyn Shape, out: &mut Vec<Vector3<f32>>) -> f32 {
+    let cuboid_corners = |h: Vector3<f32>, out: &mut Vec<Vector3<f32>>| {
+        out.extend((0..8).map(|k| {
+            Vector3::new(
+                if k & 1 == 0 { -h.x } else { h.x },
+                if k & 2 == 0 { -h.y } else { h.y },
+                if k & 4 == 0 { -h.z } else { h.z },
+            )
+        }));
     };
     if let Some(c) = shape.as_cuboid() {
-        (cuboid_corners(to_na(c.half_extents)), 0.0)
+        cuboid_corners(to_na(c.half_extents), out);
+        0.0
     } else if let Some(c) = shape.as_round_cuboid() {
-        (
-            cuboid_corners(to_na(c.inner_shape.half_extents)),
-            c.border_radius,
-        )
+        cuboid_corners(to_na(c.inner_shape.half_extents), out);
+        c.border_radius
     } else if let Some(c) = shape.as_convex_polyhedron() {
-        (c.points().iter().map(|p| to_na(*p)).collect(), 0.0)
+        out.extend(c.points().iter().map(|p| to_na(*p)));
+        0.0
     } else if let Some(c) = shape.as_round_convex_polyhedron() {
-        (
-            c.inner_shape.points().iter().map(|p| to_na(*p)).collect(),
-            c.border_radius,
-        )
+        out.extend(c.inner_shape.points().iter().map(|p| to_na(*p)));
+        c.border_radius
     } else if let Some(t) = shape.as_triangle() {
-        (vec![to_na(t.a), to_na(t.b), to_na(t.c)], 0.0)
+        out.extend([to_na(t.a), to_na(t.b), to_na(t.c)]);
+        0.0
     } else if let Some(compound) = shape.as_compound() {
         // The corners of the polyhedral parts, in the compound's frame (a rounded part's
         // border radius is not added: parts may differ).
-        let mut all = Vec::new();
         for (pose, part) in compound.shapes() {
-            let (corners, _) = corners_of(part.as_ref());
-            all.extend(
-                corners
-                    .into_iter()
-                    .map(|c| to_na(pose.transform_point(to_glam(&c)))),
-            );
+            let first = out.len();
+            corners_into(part.as_ref(), out);
+            for c in &mut out[first..] {
+                *c = to_na(pose.transform_point(to_glam(c)));
+            }
         }
-        (all, 0.0)
+        0.0
     } else {
-        (Vec::new(), 0.0)
+        0.0
     }
 }
 
-/// Adds the corner–triangle candidates of one collider against one soft body.
+/// Adds the corner–triangle candidates of one collider against one soft body. `corners` is
+/// scratch space (its capacity is reused across calls).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn gather_corners(
     out: &mut Vec<CornerContact>,
@@ -127,12 +124,15 @@ pub(crate) fn gather_corners(
     thickness: f32,
     (mu_d, mu_s, restitution): (f32, f32, f32),
     vertex_contacts: &[(u32, usize)],
+    corners: &mut Vec<Vector3<f32>>,
 ) {
-    let (corners, extra) = corners_of(shape);
-    let corners: Vec<Option<Vector3<f32>>> = if !corners.is_empty() {
-        corners.into_iter().map(Some).collect()
+    corners.clear();
+    let extra = corners_into(shape, corners);
+    // No corners: the support point of a shape with a support map, as the single `None`.
+    let count = if !corners.is_empty() {
+        corners.len()
     } else if shape.as_support_map().is_some() {
-        vec![None]
+        1
     } else {
         return;
     };
@@ -156,10 +156,10 @@ pub(crate) fn gather_corners(
                 .ok()
                 .map(|k| vertex_contacts[k].1)
         });
-        for corner in &corners {
+        for j in 0..count {
             out.push(CornerContact {
                 collider,
-                corner: *corner,
+                corner: corners.get(j).copied(),
                 triangle: t as u32,
                 vertex_contacts: vc,
                 thickness: reach,

@@ -292,12 +292,19 @@ impl Coupling {
             self.solver.step_with(world, &mut (hook, extra))?
         };
         let mut stats = std::mem::take(&mut self.frame.stats);
-        for b in &self.frame.bodies {
+        // Only the bodies that get a reaction are borrowed mutably: `get_mut` marks a body
+        // as modified for rapier's next step.
+        for b in self
+            .frame
+            .bodies
+            .iter()
+            .filter(|b| b.is_dynamic() && b.touched)
+        {
             if let Some(rb) = ctx.bodies.get_mut(b.handle) {
-                if !b.write_back(rb) {
-                    stats.non_finite_bodies += 1;
-                } else if b.is_dynamic() && b.touched {
+                if b.write_back(rb) {
                     stats.bodies_written += 1;
+                } else {
+                    stats.non_finite_bodies += 1;
                 }
             }
         }

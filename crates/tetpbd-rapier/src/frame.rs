@@ -1,7 +1,7 @@
 //! The per-frame state of the coupling: soft bodies, rigid proxies and constraint
 //! candidates gathered once per frame from rapier's broad-phase BVH.
 
-use std::collections::BTreeMap;
+use std::collections::HashMap;
 
 use hecs::{Entity, World};
 use nalgebra::{Isometry3, Vector3};
@@ -116,14 +116,20 @@ pub(crate) struct Frame {
     pub start_poses: Vec<((u32, u32), StartState)>,
     pub soft: Vec<SoftEntry>,
     pub bodies: Vec<BodyProxy>,
-    body_index: BTreeMap<(u32, u32), usize>,
+    /// Proxy index of a rigid body handle (lookups only; cleared, capacity kept).
+    body_index: HashMap<(u32, u32), usize>,
     pub colliders: Vec<ColliderProxy>,
-    collider_index: BTreeMap<(u32, u32), usize>,
+    /// Proxy index of a collider handle (lookups only; cleared, capacity kept).
+    collider_index: HashMap<(u32, u32), usize>,
     pub contacts: Vec<ParticleContact>,
     pub corners: Vec<CornerContact>,
     pub attachments: Vec<AttachRun>,
     near: Vec<ColliderHandle>,
     vertex_contacts: Vec<(u32, usize)>,
+    /// Scratch: a shape's corners (`corner::gather_corners`).
+    shape_corners: Vec<Vector3<f32>>,
+    /// Scratch: the colliders of a body's active contacts (`restitution::restitution_pass`).
+    pub active_colliders: Vec<usize>,
     /// Impact episodes in progress (kept across frames).
     pub episodes: Vec<crate::restitution::Episode>,
     pub substep: u32,
@@ -356,6 +362,7 @@ impl Frame {
                             sc.thickness,
                             (mu_d, mu_s, e),
                             &vertex_contacts,
+                            &mut self.shape_corners,
                         );
                         self.vertex_contacts = vertex_contacts;
                     }

@@ -106,6 +106,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             contacts,
             corners,
             episodes,
+            active_colliders,
             ..
         } = &mut *self.frame;
         for b in bodies.iter_mut() {
@@ -124,6 +125,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             velocity_pass(&mut contacts[range.clone()], p, bodies, colliders);
             restitution_pass(
                 episodes,
+                active_colliders,
                 s.entity,
                 &mut contacts[range.clone()],
                 &mut corners[s.corners.clone()],

@@ -60,10 +60,11 @@ pub(crate) fn com_velocity(p: &Particles) -> (Vector3<f32>, f32) {
 
 /// Runs the episodes of one soft body after a substep's velocity update. `contacts` are the
 /// body's contacts (contiguous per collider), `v_cm_pre` its centre-of-mass velocity before
-/// the substep.
+/// the substep. `active` is scratch space (its capacity is reused across calls).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn restitution_pass(
     episodes: &mut Vec<Episode>,
+    active: &mut Vec<usize>,
     entity: Entity,
     contacts: &mut [ParticleContact],
     corners: &mut [CornerContact],
@@ -80,15 +81,17 @@ pub(crate) fn restitution_pass(
     // A body with pinned particles is anchored to the world: its centre of mass takes no
     // share of the restitution impulse.
     let anchored = p.inv_masses().contains(&0.0);
-    let mut active: Vec<usize> = contacts
-        .iter()
-        .filter(|c| c.active && c.solve)
-        .map(|c| c.collider)
-        .chain(corners.iter().filter(|k| k.active).map(|k| k.collider))
-        .collect();
+    active.clear();
+    active.extend(
+        contacts
+            .iter()
+            .filter(|c| c.active && c.solve)
+            .map(|c| c.collider)
+            .chain(corners.iter().filter(|k| k.active).map(|k| k.collider)),
+    );
     active.sort_unstable();
     active.dedup();
-    for ci in active {
+    for &ci in active.iter() {
         let mut n = Vector3::zeros();
         let mut q = Vector3::zeros();
         let mut count = 0usize;

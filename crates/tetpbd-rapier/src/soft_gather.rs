@@ -96,6 +96,10 @@ pub(crate) struct Gather {
     pub pairs: Vec<(usize, usize)>,
     deep_a: Vec<Vector3<f32>>,
     deep_b: Vec<Vector3<f32>>,
+    /// Scratch of `refit`: whether a body's triangle / tetrahedron BVH is needed.
+    need: Vec<(bool, bool)>,
+    /// Scratch of `candidates`: triangles found near a particle.
+    found: Vec<u32>,
     pub bodies: Vec<FrameBody>,
 }
 
@@ -291,7 +295,9 @@ impl Gather {
     /// Refits the triangle BVH of every body in a pair or colliding with itself, and the
     /// tetrahedron BVH of every body in a pair.
     fn refit(&mut self, world: &mut World, frame: &ContactFrame) {
-        let mut need = vec![(false, false); self.bodies.len()];
+        let need = &mut self.need;
+        need.clear();
+        need.resize(self.bodies.len(), (false, false));
         for &(a, b) in &self.pairs {
             need[a] = (true, true);
             need[b] = (true, true);
@@ -317,7 +323,7 @@ impl Gather {
 
     /// Candidates of the surface particles of body `a` against the triangles of body `b`.
     fn candidates(
-        &self,
+        &mut self,
         world: &mut World,
         frame: &mut ContactFrame,
         s: &SoftContactSettings,
@@ -334,7 +340,7 @@ impl Gather {
         };
         let pad = s.margin + s.thickness;
         let xb = &frame.x[bb.offset..bb.offset + bb.len];
-        let mut found = Vec::new();
+        let found = &mut self.found;
         for k in 0..ba.len {
             let slot = ba.offset + k;
             let x0 = frame.x[slot];
@@ -358,7 +364,7 @@ impl Gather {
             found.clear();
             found.extend(cache_b.tri_bvh.intersect_aabb(&query));
             found.sort_unstable();
-            for &t in &found {
+            for &t in found.iter() {
                 let t = t as usize;
                 if own && cache_a.excluded(k, t) {
                     continue;

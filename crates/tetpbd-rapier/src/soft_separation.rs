@@ -78,18 +78,17 @@ impl Separation {
         }
         let centre = sa.centre - sb.centre;
         let len = centre.norm();
-        let mut dirs: Vec<Vector3<f32>> = Vec::with_capacity(7);
-        if len.is_finite() && len > 1e-6 {
-            dirs.push(centre / len);
-        }
-        for k in 0..3 {
-            let mut e = Vector3::zeros();
-            e[k] = 1.0;
-            dirs.push(e);
-            dirs.push(-e);
-        }
+        let axes = [
+            Vector3::x(),
+            -Vector3::x(),
+            Vector3::y(),
+            -Vector3::y(),
+            Vector3::z(),
+            -Vector3::z(),
+        ];
+        let towards = (len.is_finite() && len > 1e-6).then(|| centre / len);
         let mut best: Option<(f32, Vector3<f32>)> = None;
-        for d in dirs {
+        for d in towards.into_iter().chain(axes) {
             let Some(need) = need_along(sa, sb, &d) else {
                 continue;
             };

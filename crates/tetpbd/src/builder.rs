@@ -6,6 +6,7 @@ use nalgebra::Vector3;
 use crate::constraint::{signed_height, signed_volume, VERTEX_FACE_ORDER};
 use crate::error::BuildError;
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::locality::{inverse, mean_edge_length, relabel_tets, row_order};
 use crate::mesh::{Surface, Tetrahedra};
 use crate::ordering::colour_order;
 use crate::particles::Particles;
@@ -76,12 +77,17 @@ pub struct SoftBodyBuilder {
     velocity: Vector3<f32>,
     translation: Vector3<f32>,
     epsilon: f32,
+    spatial_order: bool,
 }
 
 impl SoftBodyBuilder {
     /// Default relative volume epsilon: a tetrahedron with `|V| < 1e-6 · (longest edge)³`
     /// is rejected as degenerate.
     pub const DEFAULT_EPSILON: f32 = 1e-6;
+
+    /// Whether [`Self::spatial_order`] is on by default (see `docs/performance.md` for the
+    /// measurement behind the choice).
+    pub const DEFAULT_SPATIAL_ORDER: bool = false;
 
     /// Starts from a mesh. Defaults: density 1000 kg/m³, no constraint family, nothing pinned.
     pub fn new(mesh: TetMesh) -> Self {
@@ -95,6 +101,7 @@ impl SoftBodyBuilder {
             velocity: Vector3::zeros(),
             translation: Vector3::zeros(),
             epsilon: Self::DEFAULT_EPSILON,
+            spatial_order: Self::DEFAULT_SPATIAL_ORDER,
         }
     }
 
@@ -127,7 +134,8 @@ impl SoftBodyBuilder {
         self
     }
 
-    /// Pins these vertices (inverse mass 0).
+    /// Pins these vertices (inverse mass 0), given as indices into the input mesh's
+    /// vertices (whatever [`Self::spatial_order`] does to the particle numbering).
     pub fn pinned(mut self, vertices: impl IntoIterator<Item = u32>) -> Self {
         self.pinned.extend(vertices);
         self
@@ -151,6 +159,17 @@ impl SoftBodyBuilder {
         self
     }
 
+    /// Renumbers the particles in rows of about one edge length (see [`crate::locality`]) so that
+    /// particles close in space are close in memory, which speeds up the projections of
+    /// meshes whose vertex numbering is unrelated to space (mesh files). When on, particle `k`
+    /// of the built body is input vertex [`Particles::source`]`()[k]`, and
+    /// [`Particles::particle_of`] maps a vertex index to its particle. Default
+    /// [`Self::DEFAULT_SPATIAL_ORDER`].
+    pub fn spatial_order(mut self, on: bool) -> Self {
+        self.spatial_order = on;
+        self
+    }
+
     /// Validates the input and builds the components.
     pub fn build(self) -> Result<SoftBody, BuildError> {
         let SoftBodyBuilder {
@@ -163,6 +182,7 @@ impl SoftBodyBuilder {
             velocity,
             translation,
             epsilon,
+            spatial_order,
         } = self;
         let n = mesh.vertices.len();
         if n == 0 {
@@ -247,20 +267,46 @@ impl SoftBodyBuilder {
                 }
             }
         }
-        let velocities = inv_masses
+        let velocities: Vec<Vector3<f32>> = inv_masses
             .iter()
             .map(|w| if *w > 0.0 { velocity } else { Vector3::zeros() })
             .collect();
-        let surface = Surface::from_tetrahedra(&mesh.tets, &mesh.vertices);
-        // Solver order for tetrahedra and edges (see `ordering`); `source` maps back.
-        let (order, tet_classes) = colour_order(&mesh.tets, n);
-        let tets: Vec<[u32; 4]> = order.iter().map(|&t| mesh.tets[t]).collect();
-        let rest_volumes: Vec<f32> = order.iter().map(|&t| rest_volumes[t]).collect();
-        let source: Vec<u32> = order.iter().map(|&t| t as u32).collect();
-        let mesh = TetMesh {
-            vertices: mesh.vertices,
-            tets,
+        // Particle order (see `locality`): particle `k` is input vertex `particle_source[k]`.
+        let (particle_source, local_tets, local_source) = if spatial_order {
+            // Rows half an edge thick: each layer of a box grid gets its own row, so a grid
+            // generator's numbering is kept.
+            let cell = 0.5 * mean_edge_length(&mesh.vertices, &mesh.tets);
+            let order = row_order(&mesh.vertices, cell);
+            let (tets, tet_source) = relabel_tets(&mesh.tets, &inverse(&order));
+            (order, tets, tet_source)
+        } else {
+            let identity = |len: usize| (0..len as u32).collect::<Vec<u32>>();
+            (identity(n), mesh.tets, identity(rest_volumes.len()))
         };
+        let permute = |v: Vec<Vector3<f32>>| -> Vec<Vector3<f32>> {
+            particle_source.iter().map(|&i| v[i as usize]).collect()
+        };
+        let positions = permute(positions);
+        let velocities = permute(velocities);
+        let vertices = permute(mesh.vertices);
+        let masses: Vec<f32> = particle_source
+            .iter()
+            .map(|&i| masses[i as usize])
+            .collect();
+        let inv_masses: Vec<f32> = particle_source
+            .iter()
+            .map(|&i| inv_masses[i as usize])
+            .collect();
+        let surface = Surface::from_tetrahedra(&local_tets, &vertices);
+        // Solver order for tetrahedra and edges (see `ordering`); `source` maps back.
+        let (order, tet_classes) = colour_order(&local_tets, n);
+        let tets: Vec<[u32; 4]> = order.iter().map(|&t| local_tets[t]).collect();
+        let rest_volumes: Vec<f32> = order
+            .iter()
+            .map(|&t| rest_volumes[local_source[t] as usize])
+            .collect();
+        let source: Vec<u32> = order.iter().map(|&t| local_source[t]).collect();
+        let mesh = TetMesh { vertices, tets };
         let edges = edge.map(|alpha| {
             let sorted = unique_edges(&mesh.tets);
             let (edge_order, classes) = colour_order(&sorted, n);
@@ -305,6 +351,8 @@ impl SoftBodyBuilder {
                 masses,
                 rest_positions: mesh.vertices,
                 residuals: vec![Vector3::zeros(); n],
+                vertex_to_particle: inverse(&particle_source),
+                source: particle_source,
             },
             tetrahedra: Tetrahedra {
                 indices: mesh.tets,

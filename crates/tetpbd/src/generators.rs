@@ -1,4 +1,4 @@
-//! Mesh generators: a box grid and a ball.
+//! Mesh generators: a box grid, a ball, a beam, and a shuffled copy of a mesh.
 
 use nalgebra::Vector3;
 
@@ -166,4 +166,37 @@ pub fn beam_root(mesh: &TetMesh) -> Vec<u32> {
     (0..mesh.vertices.len() as u32)
         .filter(|&i| (mesh.vertices[i as usize].x - min).abs() <= tol)
         .collect()
+}
+
+/// `mesh` with its vertices and its tetrahedra each in a pseudo-random order (a
+/// Fisher–Yates shuffle driven by `seed`; the same seed gives the same mesh), the way mesh
+/// files may number them. Returns the mesh and, for each new vertex, its index in `mesh`.
+/// Benchmarks and tests use it to measure and check [`crate::SoftBodyBuilder::spatial_order`].
+pub fn shuffled(mesh: &TetMesh, seed: u64) -> (TetMesh, Vec<u32>) {
+    let mut state = seed ^ 0x9E37_79B9_7F4A_7C15;
+    let mut next = move |bound: usize| {
+        // xorshift64*; `bound` ≥ 1.
+        state ^= state >> 12;
+        state ^= state << 25;
+        state ^= state >> 27;
+        (state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 33) as usize % bound
+    };
+    let mut order: Vec<u32> = (0..mesh.vertices.len() as u32).collect();
+    for i in (1..order.len()).rev() {
+        order.swap(i, next(i + 1));
+    }
+    let mut new_index = vec![0u32; order.len()];
+    for (k, &i) in order.iter().enumerate() {
+        new_index[i as usize] = k as u32;
+    }
+    let mut tets: Vec<[u32; 4]> = mesh
+        .tets
+        .iter()
+        .map(|t| t.map(|i| new_index.get(i as usize).copied().unwrap_or(i)))
+        .collect();
+    for i in (1..tets.len()).rev() {
+        tets.swap(i, next(i + 1));
+    }
+    let vertices = order.iter().map(|&i| mesh.vertices[i as usize]).collect();
+    (TetMesh { vertices, tets }, order)
 }

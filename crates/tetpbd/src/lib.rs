@@ -31,6 +31,7 @@ mod error;
 mod families;
 pub mod generators;
 mod lanes;
+pub mod locality;
 mod mesh;
 pub mod ordering;
 #[cfg(feature = "parallel")]

@@ -11,7 +11,9 @@ use crate::error::StateError;
 ///
 /// All arrays have the same length, fixed when the body is built; the accessors hand out
 /// slices so the length cannot change. Particle `i` is the `i`-th vertex the body was built
-/// from. A particle with inverse mass 0 is pinned: the solver never moves it (it can still be
+/// from, unless the builder renumbered the particles for locality
+/// ([`crate::SoftBodyBuilder::spatial_order`]): then [`Particles::source`] and
+/// [`Particles::particle_of`] map between particles and input vertices. A particle with inverse mass 0 is pinned: the solver never moves it (it can still be
 /// moved by writing its position, e.g. to drive it kinematically).
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
@@ -25,6 +27,10 @@ pub struct Particles {
     /// Rounding residual of the current substep's position updates (see
     /// [`crate::systems::add_compensated`]); zeroed by prediction.
     pub(crate) residuals: Vec<Vector3<f32>>,
+    /// Input vertex of each particle (see [`crate::SoftBodyBuilder::spatial_order`]).
+    pub(crate) source: Vec<u32>,
+    /// Particle of each input vertex (the inverse of `source`).
+    pub(crate) vertex_to_particle: Vec<u32>,
 }
 
 impl Particles {
@@ -72,6 +78,19 @@ impl Particles {
     /// Lumped masses, kg (also for pinned particles).
     pub fn masses(&self) -> &[f32] {
         &self.masses
+    }
+
+    /// For each particle, the index of the input mesh vertex it was built from (the
+    /// identity unless [`crate::SoftBodyBuilder::spatial_order`] renumbered the particles).
+    pub fn source(&self) -> &[u32] {
+        &self.source
+    }
+
+    /// The particle built from input mesh vertex `vertex`; `None` when the mesh had no such
+    /// vertex. Use it to turn a mesh vertex index into the particle index that
+    /// [`Particles::positions`], pinning and attachments take.
+    pub fn particle_of(&self, vertex: u32) -> Option<u32> {
+        self.vertex_to_particle.get(vertex as usize).copied()
     }
 
     /// Rest-pose positions the body was built from, m.

@@ -1,28 +1,24 @@
 //! ns per constraint projection, per family, single-threaded, on a ~40k-tetrahedron grid.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --bin projections [-- --cells N --repeats R]
+//! cargo run --release -p tetpbd-bench --bin projections [-- --cells N --repeats R --shuffle --spatial-order on|off|both --simd-only]
 //! ```
 //!
 //! Each family is measured alone (a body with only that family's component), as full
 //! Gauss–Seidel sweeps of the family's system over a slightly perturbed grid so every
 //! projection does real work. Prints the median and the spread over the repeats.
+//!
+//! `--shuffle` numbers the grid's vertices and tetrahedra in a random order (as mesh files
+//! may); `--spatial-order` builds the body with the builder's particle renumbering on, off
+//! or both (default: the builder's default). `--simd-only` skips the scalar kernels.
 
 use std::time::Instant;
 
 use nalgebra::Vector3;
-use tetpbd::generators::{box_grid, CellSplit};
+use tetpbd::generators::{box_grid, shuffled, CellSplit};
 use tetpbd::systems::{self, Kernel};
 use tetpbd::{Particles, SoftBodyBuilder};
-
-fn arg(name: &str, default: usize) -> usize {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+use tetpbd_bench::{arg, flag, orders};
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -34,19 +30,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let repeats = arg("--repeats", 15);
     let sweeps = 10;
     let h = 1.0 / 600.0;
-    let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Six)?;
+    let mut mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Six)?;
+    let shuffle = flag("--shuffle");
+    if shuffle {
+        mesh = shuffled(&mesh, 1).0;
+    }
+    let numbering = if shuffle { "shuffled" } else { "grid" };
     println!(
-        "grid {cells}³ cells × 6 = {} tetrahedra, {} particles; {sweeps} sweeps per sample, {repeats} samples",
+        "grid {cells}³ cells × 6 = {} tetrahedra, {} particles, {numbering} numbering; {sweeps} sweeps per sample, {repeats} samples",
         mesh.tets.len(),
         mesh.vertices.len()
     );
-    println!("family        kernel  projections/sweep   median ns/projection   min      max");
-    for (family, kernel) in ["edge", "volume", "vertex-face"]
+    println!("family        kernel  spatial order  projections/sweep   median ns/projection   min      max");
+    for (family, kernel, spatial) in ["edge", "volume", "vertex-face"]
         .into_iter()
         .flat_map(|f| [(f, Kernel::Scalar), (f, Kernel::Simd)])
+        .filter(|(_, k)| *k == Kernel::Simd || !flag("--simd-only"))
+        .flat_map(|(f, k)| orders().into_iter().map(move |o| (f, k, o)))
     {
         let mut world = hecs::World::new();
-        let b = SoftBodyBuilder::new(mesh.clone()).density(1000.0);
+        let b = SoftBodyBuilder::new(mesh.clone())
+            .density(1000.0)
+            .spatial_order(spatial);
         let b = match family {
             "edge" => b.edges(1e-6),
             "volume" => b.volume(1e-9),
@@ -96,8 +101,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let lo = samples.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = samples.iter().copied().fold(0.0, f64::max);
         println!(
-            "{family:12}  {:6}  {per_sweep:17}   {:20.1}   {lo:6.1}   {hi:6.1}",
+            "{family:12}  {:6}  {:13}  {per_sweep:17}   {:20.1}   {lo:6.1}   {hi:6.1}",
             format!("{kernel:?}"),
+            if spatial { "on" } else { "off" },
             median(&mut samples)
         );
     }

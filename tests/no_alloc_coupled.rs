@@ -1,0 +1,224 @@
+//! The coupled step allocates nothing of its own once a scene has run its first frames:
+//! candidate gathering through rapier's broad phase, the projections, the write-back, the
+//! contact reports and the soft–soft contacts all reuse their buffers.
+//!
+//! rapier's own work is excused, by the backtrace of each allocation:
+//! * everything under `PhysicsPipeline::step` (the integrator's call);
+//! * the regrowth of rapier's list of modified rigid bodies under `RigidBodySet::get_mut`.
+//!   The pipeline moves that list out of the set at every step (`mem::take` in
+//!   `RigidBodySet::take_modified`), so the first body the write-back modifies after each
+//!   step regrows it from zero capacity; no public rapier API writes a pose or velocity
+//!   without it. Bounded below: about one allocation per frame and written body batch.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::{Cell, RefCell};
+
+use nalgebra::Vector3;
+use rapier3d::math::Vector;
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
+use tetpbd::generators::{self, CellSplit};
+use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
+use tetpbd_rapier::{
+    Attachments, CoupledWorld, CouplingSettings, SelfCollision, SoftContactSettings, SoftContacts,
+};
+
+/// Counts the allocations of the current thread while enabled, sorted by who made them.
+struct Counting;
+
+#[derive(Default)]
+struct Tally {
+    ours: u64,
+    pipeline: u64,
+    modified_list: u64,
+    /// Backtraces of the first few allocations counted as ours.
+    traces: Vec<String>,
+}
+
+thread_local! {
+    static ENABLED: Cell<bool> = const { Cell::new(false) };
+    static INSIDE: Cell<bool> = const { Cell::new(false) };
+    static TALLY: RefCell<Tally> = RefCell::new(Tally::default());
+}
+
+fn record() {
+    if !ENABLED.with(Cell::get) || INSIDE.with(Cell::get) {
+        return;
+    }
+    INSIDE.with(|i| i.set(true));
+    // Capturing and resolving allocate: `INSIDE` keeps them out of the tally.
+    let trace = std::backtrace::Backtrace::force_capture().to_string();
+    TALLY.with(|t| {
+        let mut t = t.borrow_mut();
+        if trace.contains("PhysicsPipeline::step") {
+            t.pipeline += 1;
+        } else if trace.contains("RigidBodySet::get_mut") {
+            t.modified_list += 1;
+        } else {
+            t.ours += 1;
+            if t.traces.len() < 3 {
+                t.traces.push(trace);
+            }
+        }
+    });
+    INSIDE.with(|i| i.set(false));
+}
+
+// SAFETY: forwards every call to the system allocator unchanged; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        record();
+        // SAFETY: same contract as ours.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as ours.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        record();
+        // SAFETY: same contract as ours.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Runs `step` `frames` times with counting on; returns the tally.
+fn counted(frames: usize, mut step: impl FnMut()) -> Tally {
+    TALLY.with(|t| *t.borrow_mut() = Tally::default());
+    ENABLED.with(|e| e.set(true));
+    for _ in 0..frames {
+        step();
+    }
+    ENABLED.with(|e| e.set(false));
+    TALLY.with(|t| std::mem::take(&mut *t.borrow_mut()))
+}
+
+fn check(name: &str, tally: &Tally, frames: u64) {
+    println!(
+        "{name}: {} of ours, {} in PhysicsPipeline::step, {} in rapier's modified-body list over {frames} frames",
+        tally.ours, tally.pipeline, tally.modified_list
+    );
+    assert_eq!(
+        tally.ours,
+        0,
+        "{name}: allocations inside the coupled step; first ones:\n{}",
+        tally.traces.join("\n----\n")
+    );
+    assert!(
+        tally.modified_list <= frames,
+        "{name}: {} allocations in rapier's modified-body list",
+        tally.modified_list
+    );
+}
+
+fn scene() -> CoupledWorld {
+    let solver = SolverSettings {
+        substeps: 10,
+        ..SolverSettings::default()
+    };
+    let mut scene = CoupledWorld::new(solver, CouplingSettings::default()).expect("settings");
+    scene.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
+        ColliderBuilder::cuboid(5.0, 0.5, 5.0),
+    );
+    scene
+}
+
+fn soft_cube(scene: &mut CoupledWorld, cells: u32, at: Vector3<f32>) -> hecs::Entity {
+    let mesh =
+        generators::box_grid(Vector3::repeat(1.0), [cells; 3], CellSplit::Six).expect("mesh");
+    SoftBodyBuilder::new(mesh)
+        .edges(0.0)
+        .volume(0.0)
+        .translation(at)
+        .build()
+        .expect("body")
+        .spawn(&mut scene.soft)
+}
+
+#[test]
+fn the_counter_sees_our_allocations() {
+    let tally = counted(1, || {
+        std::hint::black_box(vec![1u8; 16]);
+    });
+    assert_eq!(tally.ours, 1);
+}
+
+/// A soft cube on rigid ground with a dynamic rigid box on it and a ball beside it, and a
+/// second cube hanging from the box by an attachment and from a point target.
+#[test]
+fn coupled_scene_steps_without_allocating() {
+    let mut scene = scene();
+    soft_cube(&mut scene, 3, Vector3::new(0.0, 0.5, 0.0));
+    let (boxed, _) = scene.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 1.26, 0.0)),
+        ColliderBuilder::cuboid(0.25, 0.25, 0.25),
+    );
+    scene.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vector::new(0.3, 1.3, 0.3)),
+        ColliderBuilder::ball(0.15),
+    );
+    let hanging = soft_cube(&mut scene, 2, Vector3::new(2.0, 1.0, 0.0));
+    let mut att = Attachments::new();
+    {
+        let p = scene.soft.get::<&Particles>(hanging).expect("body");
+        let top = (0..p.len() as u32)
+            .max_by(|&a, &b| {
+                p.positions()[a as usize]
+                    .y
+                    .total_cmp(&p.positions()[b as usize].y)
+            })
+            .expect("particles");
+        att.attach_to_body(&p, top, &scene.physics.bodies, boxed, 0.0)
+            .expect("attachment");
+        att.attach_to_point(&p, 0, p.positions()[0], 1e-4)
+            .expect("attachment");
+    }
+    scene.soft.insert_one(hanging, att).expect("entity");
+    for _ in 0..20 {
+        scene.step().expect("step");
+    }
+    let frames = 30;
+    let mut contacts = 0;
+    let tally = counted(frames, || {
+        let stats = scene.step().expect("step");
+        contacts = contacts.max(stats.contacts);
+    });
+    assert!(contacts > 0, "the scene has soft–rigid contacts");
+    check("coupled", &tally, frames as u64);
+}
+
+/// Three soft cubes stacked on rigid ground with soft–soft contacts, and a self-colliding
+/// cube beside them.
+#[test]
+fn soft_pile_steps_without_allocating() {
+    let mut scene = scene();
+    for i in 0..3 {
+        soft_cube(
+            &mut scene,
+            3,
+            Vector3::new(0.1 * i as f32, 0.5 + 1.01 * i as f32, 0.0),
+        );
+    }
+    let folded = soft_cube(&mut scene, 2, Vector3::new(2.0, 0.5, 0.0));
+    scene
+        .soft
+        .insert_one(folded, SelfCollision)
+        .expect("entity");
+    let mut soft = SoftContacts::new(SoftContactSettings::default()).expect("settings");
+    for _ in 0..20 {
+        scene.step_with(&mut soft).expect("step");
+    }
+    let frames = 30;
+    let mut candidates = 0;
+    let tally = counted(frames, || {
+        scene.step_with(&mut soft).expect("step");
+        candidates = candidates.max(soft.stats().candidates);
+    });
+    assert!(candidates > 0, "the pile has soft–soft contact candidates");
+    check("pile", &tally, frames as u64);
+}
