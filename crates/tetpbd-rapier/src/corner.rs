@@ -23,6 +23,13 @@
 //!   rounded variants), the support point in direction `−n`: the shape's deepest point
 //!   towards the triangle.
 //!
+//! A point that crossed the triangle's plane from the front within the substep (a fast
+//! rigid body, motion taken relative to the triangle) is caught at any depth, at the point
+//! where it crossed (`sweep` module docs). Points of moving bodies that crossed are projected
+//! in a pass of their own before the particle contacts, even where a vertex touches the
+//! collider: one particle alone cannot stop a fast body, and its contact normal may be tilted
+//! enough to let the body slip past it.
+//!
 //! A triangle whose vertex is itself in contact with the collider (in the same iteration)
 //! is skipped: there the particle contacts hold the surface, and two sets of constraints on
 //! the same spot only fight. A compound contributes the vertices of its polyhedral parts;
@@ -38,7 +45,7 @@ use rapier3d::parry::bounding_volume::BoundingVolume;
 use rapier3d::parry::shape::Shape;
 use tetpbd::{Particles, Surface};
 
-use crate::bodies::BodyProxy;
+use crate::bodies::{BodyKind, BodyProxy};
 use crate::convert::{to_glam, to_na};
 use crate::frame::{ColliderProxy, ParticleContact};
 
@@ -180,7 +187,11 @@ pub(crate) fn gather_corners(
     }
 }
 
-/// One Gauss–Seidel sweep over a soft body's corner contacts.
+/// One Gauss–Seidel sweep over a soft body's corner contacts. With `crossing_only`, only
+/// points of moving (non-fixed) bodies that crossed their triangle within the substep are
+/// projected: this pass runs before the particle contacts, so a fast body is stopped by the
+/// surface it hits first rather than by a particle poking into it from the side.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn project_corners(
     corners: &mut [CornerContact],
     contacts: &[ParticleContact],
@@ -189,20 +200,27 @@ pub(crate) fn project_corners(
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
     set: &ColliderSet,
+    crossing_only: bool,
 ) {
     for k in corners {
+        if crossing_only
+            && colliders[k.collider]
+                .body
+                .is_none_or(|b| bodies[b].kind == BodyKind::Fixed)
+        {
+            continue;
+        }
         let Some(tri) = surface.triangles().get(k.triangle as usize) else {
             continue;
         };
         // Where a vertex already touches the collider, the particle contacts hold the
-        // surface; the triangle only stops what slips between particles.
-        if k.vertex_contacts
+        // surface; the triangle only stops what slips between particles (and what crosses
+        // it within the substep, below).
+        let vertex_touches = k
+            .vertex_contacts
             .iter()
             .flatten()
-            .any(|&c| contacts.get(c).is_some_and(|c| c.active))
-        {
-            continue;
-        }
+            .any(|&c| contacts.get(c).is_some_and(|c| c.active));
         let idx = tri.map(|i| i as usize);
         let [a, b, c] = idx.map(|i| p.positions()[i]);
         let cp = &colliders[k.collider];
@@ -233,11 +251,33 @@ pub(crate) fn project_corners(
         }
         let s = (v - a).dot(&n);
         let c_val = s - k.thickness;
-        if c_val >= 0.0 || s < -0.5 * shortest {
+        if c_val >= 0.0 {
             continue;
         }
-        // Barycentric weights of v's projection onto the triangle's plane.
-        let q = v - n * s;
+        // The point's start of the substep, carried along with the triangle's vertex `a`:
+        // its motion relative to the triangle.
+        let v_start = (cp.prev_pose(bodies) * Point3::from(local)).coords;
+        let v_prev = v_start + (a - p.prev_positions()[idx[0]]);
+        let s_prev = (v_prev - a).dot(&n);
+        // Crossed the plane from the front within this substep (a fast body): caught at any
+        // depth, at the crossing point. Otherwise only within half the shortest edge behind
+        // the plane, so triangles on the far side of the body never grab it.
+        // Only a fast rigid point counts: one that itself moved more than a tenth of the
+        // triangle's shortest edge within the substep. Slow crossings (a body settling on the
+        // surface, or the soft surface moving fast under a slow body) are left to the
+        // ordinary rule, where the particle contacts take precedence.
+        let crossed =
+            s_prev > 0.0 && s < 0.0 && (v - v_start).norm_squared() > (0.1 * shortest).powi(2);
+        let q = if crossed && (crossing_only || !vertex_touches) {
+            let tau = s_prev / (s_prev - s);
+            v_prev + (v - v_prev) * tau
+        } else if s >= -0.5 * shortest && !vertex_touches && !crossing_only {
+            v
+        } else {
+            continue;
+        };
+        // Barycentric weights of q's projection onto the triangle's plane.
+        let q = q - n * (q - a).dot(&n);
         let wa = (b - q).cross(&(c - q)).dot(&n) / area2;
         let wb = (c - q).cross(&(a - q)).dot(&n) / area2;
         let wc = 1.0 - wa - wb;

@@ -54,6 +54,14 @@ impl ColliderProxy {
             None => self.local,
         }
     }
+
+    /// World pose at the end of the previous substep.
+    pub fn prev_pose(&self, bodies: &[BodyProxy]) -> Isometry3<f32> {
+        match self.body {
+            Some(b) => bodies[b].prev * self.local,
+            None => self.local,
+        }
+    }
 }
 
 /// A surface particle near a collider: an XPBD inequality contact re-evaluated every
@@ -123,6 +131,8 @@ pub(crate) struct Frame {
     pub corners: Vec<CornerContact>,
     pub attachments: Vec<AttachRun>,
     near: Vec<ColliderHandle>,
+    /// Colliders of fast bodies with their swept AABB over the frame (`sweep` module docs).
+    fast: Vec<(ColliderHandle, Aabb)>,
     vertex_contacts: Vec<(u32, usize)>,
     /// Impact episodes in progress (kept across frames).
     pub episodes: Vec<crate::restitution::Episode>,
@@ -256,6 +266,13 @@ impl Frame {
         self.attachments.clear();
         self.substep = 0;
         let qp = input.qp;
+        crate::sweep::fast_colliders(
+            &mut self.fast,
+            &self.start_poses,
+            qp.bodies,
+            qp.colliders,
+            input.margin,
+        );
         let dt = self.dt;
         let fall = 0.5 * self.gravity * dt * dt;
         for (entity, p, surface, sc, att) in world.query_mut::<(
@@ -276,15 +293,25 @@ impl Frame {
                 let aabb = Aabb::new(to_glam(&lo), to_glam(&hi)).loosened(reach);
                 let mut near = std::mem::take(&mut self.near);
                 near.clear();
+                let keep = |co: &rapier3d::geometry::Collider| {
+                    co.is_enabled()
+                        && !co.is_sensor()
+                        && sc.collision_groups.test(co.collision_groups())
+                };
                 near.extend(
                     qp.intersect_aabb_conservative(aabb)
-                        .filter(|(_, co)| {
-                            co.is_enabled()
-                                && !co.is_sensor()
-                                && sc.collision_groups.test(co.collision_groups())
-                        })
+                        .filter(|(_, co)| keep(co))
                         .map(|(h, _)| h),
                 );
+                // Fast bodies that crossed the soft body during rapier's step.
+                for (h, swept) in &self.fast {
+                    if swept.intersects(&aabb)
+                        && !near.contains(h)
+                        && qp.colliders.get(*h).is_some_and(keep)
+                    {
+                        near.push(*h);
+                    }
+                }
                 for &handle in &near {
                     let Some(ci) =
                         self.collider_proxy(handle, qp.bodies, qp.colliders, input.narrow_phase)
