@@ -19,6 +19,9 @@
 //! * every vertex of a polyhedral shape (cuboid, convex polyhedron, triangle; the inner
 //!   vertices of the rounded variants, border radius added to the thickness), each its own
 //!   constraint, so a face resting flat on the soft surface pushes evenly;
+//! * the vertices of a triangle mesh or heightfield near the soft body (of its triangles
+//!   inside the soft body's swept bounds), each paired only with the soft triangles near it;
+//! * a compound's parts by these rules, each rounded part with its own border radius;
 //! * for the other shapes with a support map (ball, capsule, cylinder, cone, segment and
 //!   rounded variants), the support point in direction `−n`: the shape's deepest point
 //!   towards the triangle.
@@ -32,21 +35,20 @@
 //!
 //! A triangle whose vertex is itself in contact with the collider (in the same iteration)
 //! is skipped: there the particle contacts hold the surface, and two sets of constraints on
-//! the same spot only fight. A compound contributes the vertices of its polyhedral parts;
-//! triangle meshes, heightfields and the smooth parts of compounds take no part (their
-//! contacts with the soft particles still act). `v` is only caught while its projection
+//! the same spot only fight. The smooth parts of a compound take no part (their contacts
+//! with the soft particles still act). `v` is only caught while its projection
 //! falls inside the triangle (within 0.1 % of its barycentric range, so a point on a shared
 //! edge is not lost between two triangles) and it is less than half the triangle's shortest
 //! edge behind it, so triangles on the far side of the body never grab it.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use rapier3d::geometry::{Aabb, ColliderSet};
 use rapier3d::parry::bounding_volume::BoundingVolume;
 use rapier3d::parry::shape::Shape;
 use tetpbd::{Particles, Surface};
 
 use crate::bodies::{BodyKind, BodyProxy};
-use crate::convert::{to_glam, to_na};
+use crate::convert::{pose_to_glam, to_glam, to_na};
 use crate::frame::{ColliderProxy, ParticleContact};
 
 /// One rigid shape over one soft surface triangle.
@@ -74,50 +76,99 @@ pub(crate) struct CornerContact {
     pub impulse: Vector3<f32>,
 }
 
-/// Corners of `shape` in its local frame, with the extra thickness of a rounded shape.
-pub(crate) fn corners_of(shape: &dyn Shape) -> (Vec<Vector3<f32>>, f32) {
-    let cuboid_corners = |h: Vector3<f32>| {
+/// The rigid points of a shape, in its local frame.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Corners {
+    /// Each point with the extra thickness of its (rounded) part, m.
+    pub points: Vec<(Vector3<f32>, f32)>,
+    /// Some points are vertices of a triangle mesh or heightfield: many, so each is only
+    /// paired with the soft triangles near it.
+    pub from_mesh: bool,
+}
+
+/// Corners of `shape` in its local frame. A triangle mesh or heightfield contributes the
+/// vertices of its triangles inside `near` (local frame).
+pub(crate) fn corners_of(shape: &dyn Shape, near: &Aabb) -> Corners {
+    let cuboid_corners = |h: Vector3<f32>, extra: f32| {
         (0..8)
             .map(|k| {
-                Vector3::new(
+                let c = Vector3::new(
                     if k & 1 == 0 { -h.x } else { h.x },
                     if k & 2 == 0 { -h.y } else { h.y },
                     if k & 4 == 0 { -h.z } else { h.z },
-                )
+                );
+                (c, extra)
             })
             .collect()
     };
+    let plain = |points: Vec<(Vector3<f32>, f32)>| Corners {
+        points,
+        from_mesh: false,
+    };
     if let Some(c) = shape.as_cuboid() {
-        (cuboid_corners(to_na(c.half_extents)), 0.0)
+        plain(cuboid_corners(to_na(c.half_extents), 0.0))
     } else if let Some(c) = shape.as_round_cuboid() {
-        (
-            cuboid_corners(to_na(c.inner_shape.half_extents)),
+        plain(cuboid_corners(
+            to_na(c.inner_shape.half_extents),
             c.border_radius,
-        )
+        ))
     } else if let Some(c) = shape.as_convex_polyhedron() {
-        (c.points().iter().map(|p| to_na(*p)).collect(), 0.0)
+        plain(c.points().iter().map(|p| (to_na(*p), 0.0)).collect())
     } else if let Some(c) = shape.as_round_convex_polyhedron() {
-        (
-            c.inner_shape.points().iter().map(|p| to_na(*p)).collect(),
-            c.border_radius,
+        let r = c.border_radius;
+        plain(
+            c.inner_shape
+                .points()
+                .iter()
+                .map(|p| (to_na(*p), r))
+                .collect(),
         )
     } else if let Some(t) = shape.as_triangle() {
-        (vec![to_na(t.a), to_na(t.b), to_na(t.c)], 0.0)
+        plain(vec![
+            (to_na(t.a), 0.0),
+            (to_na(t.b), 0.0),
+            (to_na(t.c), 0.0),
+        ])
+    } else if let Some(mesh) = shape.as_trimesh() {
+        let mut v = Vec::new();
+        for t in mesh.bvh().intersect_aabb(near) {
+            let tri = mesh.triangle(t);
+            v.extend([tri.a, tri.b, tri.c].map(to_na));
+        }
+        mesh_corners(v)
+    } else if let Some(hf) = shape.as_heightfield() {
+        let mut v = Vec::new();
+        hf.map_elements_in_local_aabb(near, &mut |_, tri| {
+            v.extend([tri.a, tri.b, tri.c].map(to_na));
+        });
+        mesh_corners(v)
     } else if let Some(compound) = shape.as_compound() {
-        // The corners of the polyhedral parts, in the compound's frame (a rounded part's
-        // border radius is not added: parts may differ).
-        let mut all = Vec::new();
+        // The corners of every part, in the compound's frame, each with its part's radius.
+        let mut all = Corners::default();
         for (pose, part) in compound.shapes() {
-            let (corners, _) = corners_of(part.as_ref());
-            all.extend(
-                corners
+            let part_near = near.transform_by(&pose.inverse());
+            let c = corners_of(part.as_ref(), &part_near);
+            all.from_mesh |= c.from_mesh;
+            all.points.extend(
+                c.points
                     .into_iter()
-                    .map(|c| to_na(pose.transform_point(to_glam(&c)))),
+                    .map(|(c, r)| (to_na(pose.transform_point(to_glam(&c))), r)),
             );
         }
-        (all, 0.0)
+        all
     } else {
-        (Vec::new(), 0.0)
+        Corners::default()
+    }
+}
+
+/// Mesh vertices without repeats (sorted by coordinates, so the order is deterministic).
+fn mesh_corners(mut v: Vec<Vector3<f32>>) -> Corners {
+    let key = |p: &Vector3<f32>| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+    v.sort_unstable_by_key(key);
+    v.dedup_by_key(|p| key(p));
+    Corners {
+        points: v.into_iter().map(|p| (p, 0.0)).collect(),
+        from_mesh: true,
     }
 }
 
@@ -128,6 +179,7 @@ pub(crate) fn gather_corners(
     shape: &dyn Shape,
     collider: usize,
     collider_aabb: &Aabb,
+    pose: &Isometry3<f32>,
     p: &Particles,
     surface: &Surface,
     dt: f32,
@@ -135,15 +187,32 @@ pub(crate) fn gather_corners(
     (mu_d, mu_s, restitution): (f32, f32, f32),
     vertex_contacts: &[(u32, usize)],
 ) {
-    let (corners, extra) = corners_of(shape);
-    let corners: Vec<Option<Vector3<f32>>> = if !corners.is_empty() {
-        corners.into_iter().map(Some).collect()
-    } else if shape.as_support_map().is_some() {
-        vec![None]
+    // The soft body's surface over the frame, in the collider's frame (at its end pose).
+    let mut lo = Vector3::repeat(f32::INFINITY);
+    let mut hi = Vector3::repeat(f32::NEG_INFINITY);
+    for &i in surface.vertices() {
+        let x = p.positions()[i as usize];
+        let y = x + p.velocities()[i as usize] * dt;
+        lo = lo.inf(&x.inf(&y));
+        hi = hi.sup(&x.sup(&y));
+    }
+    let near = Aabb::new(to_glam(&lo), to_glam(&hi))
+        .loosened(thickness)
+        .transform_by(&pose_to_glam(&pose.inverse()));
+    let found = corners_of(shape, &near);
+    let corners: Vec<(Option<Vector3<f32>>, f32)> = if !found.points.is_empty() {
+        found
+            .points
+            .into_iter()
+            .map(|(c, r)| (Some(c), r))
+            .collect()
+    } else if shape.as_support_map().is_some() && !found.from_mesh {
+        vec![(None, 0.0)]
     } else {
         return;
     };
-    let reach = thickness + extra;
+    let max_extra = corners.iter().map(|c| c.1).fold(0.0f32, f32::max);
+    let reach = thickness + max_extra;
     for (t, tri) in surface.triangles().iter().enumerate() {
         let mut lo = Vector3::repeat(f32::INFINITY);
         let mut hi = Vector3::repeat(f32::NEG_INFINITY);
@@ -163,13 +232,21 @@ pub(crate) fn gather_corners(
                 .ok()
                 .map(|k| vertex_contacts[k].1)
         });
-        for corner in &corners {
+        for &(corner, extra) in &corners {
+            // A mesh vertex only with the soft triangles near it.
+            if found.from_mesh
+                && corner.is_some_and(|c| {
+                    !ta.contains_local_point(to_glam(&(pose * Point3::from(c)).coords))
+                })
+            {
+                continue;
+            }
             out.push(CornerContact {
                 collider,
-                corner: *corner,
+                corner,
                 triangle: t as u32,
                 vertex_contacts: vc,
-                thickness: reach,
+                thickness: thickness + extra,
                 restitution,
                 active: false,
                 mu_d,
@@ -368,4 +445,51 @@ fn friction(
     }
     k.lambda_t += applied;
     k.sub_impulse += t * applied;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rapier3d::geometry::SharedShape;
+    use rapier3d::math::{Pose, Vector};
+
+    #[test]
+    fn compound_parts_keep_their_own_border_radius() {
+        let compound = SharedShape::compound(vec![
+            (
+                Pose::translation(-1.0, 0.0, 0.0),
+                SharedShape::cuboid(0.5, 0.5, 0.5),
+            ),
+            (
+                Pose::translation(1.0, 0.0, 0.0),
+                SharedShape::round_cuboid(0.4, 0.4, 0.4, 0.1),
+            ),
+        ]);
+        let near = Aabb::new(Vector::splat(-10.0), Vector::splat(10.0));
+        let c = corners_of(compound.as_ref(), &near);
+        assert_eq!(c.points.len(), 16);
+        assert!(!c.from_mesh);
+        for (p, r) in &c.points {
+            let expected = if p.x > 0.0 { 0.1 } else { 0.0 };
+            assert_eq!(*r, expected, "corner {p:?}");
+        }
+    }
+
+    #[test]
+    fn mesh_vertices_only_near_the_soft_body_and_once_each() {
+        let v = vec![
+            Vector::new(0.0, 0.0, 0.0),
+            Vector::new(1.0, 0.0, 0.0),
+            Vector::new(0.0, 0.0, 1.0),
+            Vector::new(10.0, 0.0, 10.0),
+            Vector::new(11.0, 0.0, 10.0),
+            Vector::new(10.0, 0.0, 11.0),
+        ];
+        let mesh = SharedShape::trimesh(v, vec![[0, 2, 1], [1, 2, 0], [3, 5, 4]]).expect("mesh");
+        let near = Aabb::new(Vector::splat(-1.0), Vector::splat(2.0));
+        let c = corners_of(mesh.as_ref(), &near);
+        assert!(c.from_mesh);
+        assert_eq!(c.points.len(), 3, "{:?}", c.points);
+        assert!(c.points.iter().all(|(p, _)| p.x < 2.0 && p.z < 2.0));
+    }
 }

@@ -377,6 +377,7 @@ impl Frame {
                             co.shape(),
                             ci,
                             &caabb,
+                            &pose_to_na(co.position()),
                             p,
                             surface,
                             dt,
