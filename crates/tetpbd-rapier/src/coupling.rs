@@ -163,10 +163,11 @@ impl<'a> RapierContext<'a> {
 ///
 /// # Constraints in the substeps
 ///
-/// Each iteration, after the soft body's own families: particle–collider contacts
+/// Each iteration, after the soft body's own families: rigid points of moving bodies that
+/// crossed a soft surface triangle within the substep, particle–collider contacts
 /// (`contact` module docs: XPBD inequality, positional Coulomb friction with static and
-/// dynamic coefficients), rigid points against soft surface triangles (`corner` module
-/// docs), then attachments ([`crate::Attachments`]). After each substep's velocity update:
+/// dynamic coefficients), the other rigid points against soft surface triangles (`corner`
+/// module docs), then attachments ([`crate::Attachments`]). After each substep's velocity update:
 /// the per-particle separating velocity is removed, then restitution acts per (soft body,
 /// collider) impact episode on the body's centre of mass (`restitution` module docs), and
 /// [`crate::DeformationDamping`] damps deformation of bodies that carry it.
