@@ -34,7 +34,7 @@ use nalgebra::{Point3, Vector3};
 use rapier3d::geometry::ColliderSet;
 use tetpbd::Particles;
 
-use crate::bodies::BodyProxy;
+use crate::bodies::{BodyKind, BodyProxy};
 use crate::frame::{ColliderProxy, ParticleContact};
 use crate::shape_query::surface_point;
 use crate::sweep::swept_entry;
@@ -61,10 +61,11 @@ pub(crate) fn project_contacts(
         let fallback = c.has_normal.then_some(c.normal);
         let closest = surface_point(shape, cp.rule, &pose, &x, fallback);
         // Relative motion that entered the shape within the substep (`sweep` module docs).
+        let moving = cp.body.is_some_and(|b| bodies[b].kind != BodyKind::Fixed);
         let swept = swept_entry(
             shape,
             &pose,
-            &cp.prev_pose(bodies),
+            &if moving { cp.prev_pose(bodies) } else { pose },
             &x,
             &p.prev_positions()[i],
             closest.as_ref(),

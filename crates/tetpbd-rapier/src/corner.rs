@@ -55,6 +55,9 @@ use crate::frame::{ColliderProxy, ParticleContact};
 #[derive(Clone, Debug)]
 pub(crate) struct CornerContact {
     pub collider: usize,
+    /// On the first candidate of a collider's run (they are gathered per collider, one run
+    /// each): the run's length; 0 elsewhere. Lets the crossing pass skip fixed colliders.
+    pub run: u32,
     /// A polyhedral shape's corner in its local frame; `None`: the support point.
     pub corner: Option<Vector3<f32>>,
     pub triangle: u32,
@@ -213,6 +216,7 @@ pub(crate) fn gather_corners(
     };
     let max_extra = corners.iter().map(|c| c.1).fold(0.0f32, f32::max);
     let reach = thickness + max_extra;
+    let first = out.len();
     for (t, tri) in surface.triangles().iter().enumerate() {
         let mut lo = Vector3::repeat(f32::INFINITY);
         let mut hi = Vector3::repeat(f32::NEG_INFINITY);
@@ -243,6 +247,7 @@ pub(crate) fn gather_corners(
             }
             out.push(CornerContact {
                 collider,
+                run: 0,
                 corner,
                 triangle: t as u32,
                 vertex_contacts: vc,
@@ -262,6 +267,10 @@ pub(crate) fn gather_corners(
             });
         }
     }
+    let run = out.len() - first;
+    if let Some(k) = out.get_mut(first) {
+        k.run = u32::try_from(run).unwrap_or(u32::MAX);
+    }
 }
 
 /// One Gauss–Seidel sweep over a soft body's corner contacts. With `crossing_only`, only
@@ -279,12 +288,51 @@ pub(crate) fn project_corners(
     set: &ColliderSet,
     crossing_only: bool,
 ) {
-    for k in corners {
-        if crossing_only
-            && colliders[k.collider]
+    if crossing_only {
+        // Only the runs of moving colliders.
+        let mut i = 0;
+        while i < corners.len() {
+            let run = (corners[i].run as usize).clamp(1, corners.len() - i);
+            let moving = colliders[corners[i].collider]
                 .body
-                .is_none_or(|b| bodies[b].kind == BodyKind::Fixed)
-        {
+                .is_some_and(|b| bodies[b].kind != BodyKind::Fixed);
+            if moving {
+                sweep_corners(
+                    &mut corners[i..i + run],
+                    contacts,
+                    p,
+                    surface,
+                    bodies,
+                    colliders,
+                    set,
+                    true,
+                );
+            }
+            i += run;
+        }
+    } else {
+        sweep_corners(corners, contacts, p, surface, bodies, colliders, set, false);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn sweep_corners(
+    corners: &mut [CornerContact],
+    contacts: &[ParticleContact],
+    p: &mut Particles,
+    surface: &Surface,
+    bodies: &mut [BodyProxy],
+    colliders: &[ColliderProxy],
+    set: &ColliderSet,
+    crossing_only: bool,
+) {
+    for k in corners {
+        // The crossing pass only sees moving bodies; a fixed one cannot cross by itself.
+        let moved = match colliders[k.collider].body {
+            Some(b) if bodies[b].kind != BodyKind::Fixed => Some(bodies[b].substep_motion),
+            _ => None,
+        };
+        if crossing_only && moved.is_none() {
             continue;
         }
         let Some(tri) = surface.triangles().get(k.triangle as usize) else {
@@ -298,12 +346,37 @@ pub(crate) fn project_corners(
             .iter()
             .flatten()
             .any(|&c| contacts.get(c).is_some_and(|c| c.active));
+        // Outside the crossing pass a touching vertex rules the triangle out (a crossing
+        // there is only taken in the crossing pass).
+        if vertex_touches && !crossing_only {
+            continue;
+        }
         let idx = tri.map(|i| i as usize);
         let [a, b, c] = idx.map(|i| p.positions()[i]);
         let cp = &colliders[k.collider];
+        let shortest = (b - a).norm().min((c - b).norm()).min((a - c).norm());
+        // Fast: the rigid point moves more than a tenth of the shortest edge in the substep
+        // (bounded by the body's shift plus its turn times the point's distance from the
+        // body's origin; support points bounded by the shape's bounding sphere).
+        let fast = moved.is_some_and(|(shift, turn)| {
+            let limit = 0.1 * shortest;
+            if shift > limit || turn <= 0.0 {
+                return shift > limit;
+            }
+            let radius = match k.corner {
+                Some(c) => c.norm(),
+                None => set.get(cp.handle).map_or(f32::INFINITY, |co| {
+                    let sphere = co.shape().compute_local_bounding_sphere();
+                    sphere.radius + to_na(sphere.center).norm()
+                }),
+            };
+            shift + turn * (radius + cp.local.translation.vector.norm()) > limit
+        });
+        if crossing_only && !fast {
+            continue;
+        }
         let m = (b - a).cross(&(c - a));
         let area2 = m.norm();
-        let shortest = (b - a).norm().min((c - b).norm()).min((a - c).norm());
         if area2.is_nan() || area2 <= 1e-12 {
             continue;
         }
@@ -331,24 +404,24 @@ pub(crate) fn project_corners(
         if c_val >= 0.0 {
             continue;
         }
-        // The point's start of the substep, carried along with the triangle's vertex `a`:
-        // its motion relative to the triangle.
-        let v_start = (cp.prev_pose(bodies) * Point3::from(local)).coords;
-        let v_prev = v_start + (a - p.prev_positions()[idx[0]]);
-        let s_prev = (v_prev - a).dot(&n);
-        // Crossed the plane from the front within this substep (a fast body): caught at any
-        // depth, at the crossing point. Otherwise only within half the shortest edge behind
-        // the plane, so triangles on the far side of the body never grab it.
-        // Only a fast rigid point counts: one that itself moved more than a tenth of the
-        // triangle's shortest edge within the substep. Slow crossings (a body settling on the
-        // surface, or the soft surface moving fast under a slow body) are left to the
-        // ordinary rule, where the particle contacts take precedence.
-        let crossed =
-            s_prev > 0.0 && s < 0.0 && (v - v_start).norm_squared() > (0.1 * shortest).powi(2);
-        let q = if crossed && (crossing_only || !vertex_touches) {
-            let tau = s_prev / (s_prev - s);
-            v_prev + (v - v_prev) * tau
-        } else if s >= -0.5 * shortest && !vertex_touches && !crossing_only {
+        // Crossed the plane from the front within this substep (a fast rigid point, one that
+        // itself moved more than a tenth of the shortest edge): caught at any depth, at the
+        // crossing point. The point's start of the substep is carried along with the
+        // triangle's vertex `a`, so the motion is relative to the triangle. Slow crossings (a
+        // body settling on the surface, or the soft surface moving fast under a slow body)
+        // are left to the ordinary rule: only within half the shortest edge behind the
+        // plane, so triangles on the far side of the body never grab it.
+        let crossing = fast.then(|| {
+            let v_start = (cp.prev_pose(bodies) * Point3::from(local)).coords;
+            let v_prev = v_start + (a - p.prev_positions()[idx[0]]);
+            let s_prev = (v_prev - a).dot(&n);
+            let fast_point = (v - v_start).norm_squared() > (0.1 * shortest).powi(2);
+            (s_prev > 0.0 && s < 0.0 && fast_point)
+                .then(|| v_prev + (v - v_prev) * (s_prev / (s_prev - s)))
+        });
+        let q = if let Some(Some(q)) = crossing {
+            q
+        } else if s >= -0.5 * shortest && !crossing_only {
             v
         } else {
             continue;

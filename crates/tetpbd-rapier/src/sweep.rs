@@ -88,6 +88,14 @@ pub(crate) fn swept_entry(
     x_prev: &Vector3<f32>,
     current: Option<&SurfacePoint>,
 ) -> Option<SurfacePoint> {
+    // A collider that did not move this substep (fixed ground, resting bodies): the relative
+    // motion is the particle's own, and a slow particle needs no transform at all.
+    if pose == prev {
+        let len = (x - x_prev).norm();
+        if len.is_nan() || len <= 1e-7 || current.is_some_and(|c| c.distance > len) {
+            return None;
+        }
+    }
     let now = pose.inverse_transform_point(&Point3::from(*x)).coords;
     let before = prev.inverse_transform_point(&Point3::from(*x_prev)).coords;
     let d = now - before;
