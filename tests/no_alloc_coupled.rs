@@ -129,9 +129,19 @@ fn scene() -> CoupledWorld {
 }
 
 fn soft_cube(scene: &mut CoupledWorld, cells: u32, at: Vector3<f32>) -> hecs::Entity {
+    soft_cube_with_density(scene, cells, at, 1000.0)
+}
+
+fn soft_cube_with_density(
+    scene: &mut CoupledWorld,
+    cells: u32,
+    at: Vector3<f32>,
+    density: f32,
+) -> hecs::Entity {
     let mesh =
         generators::box_grid(Vector3::repeat(1.0), [cells; 3], CellSplit::Six).expect("mesh");
     SoftBodyBuilder::new(mesh)
+        .density(density)
         .edges(0.0)
         .volume(0.0)
         .translation(at)
@@ -148,34 +158,42 @@ fn the_counter_sees_our_allocations() {
     assert_eq!(tally.ours, 1);
 }
 
-/// A soft cube on rigid ground with a dynamic rigid box on it and a ball beside it, and a
-/// second cube hanging from the box by an attachment and from a point target.
+/// A soft cube on rigid ground with a rigid ball resting on it; a second soft cube hanging
+/// from a fixed rigid bar by a body attachment and from a soft point target, with a dynamic
+/// rigid box resting on the ground beside it.
 #[test]
 fn coupled_scene_steps_without_allocating() {
     let mut scene = scene();
     soft_cube(&mut scene, 3, Vector3::new(0.0, 0.5, 0.0));
-    let (boxed, _) = scene.physics.insert(
-        RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 1.26, 0.0)),
-        ColliderBuilder::cuboid(0.25, 0.25, 0.25),
-    );
     scene.physics.insert(
-        RigidBodyBuilder::dynamic().translation(Vector::new(0.3, 1.3, 0.3)),
+        RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 1.16, 0.0)),
         ColliderBuilder::ball(0.15),
     );
-    let hanging = soft_cube(&mut scene, 2, Vector3::new(2.0, 1.0, 0.0));
+    scene.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vector::new(-2.0, 0.25, 0.0)),
+        ColliderBuilder::cuboid(0.25, 0.25, 0.25),
+    );
+    let (bar, _) = scene.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vector::new(2.0, 2.6, 0.0)),
+        ColliderBuilder::cuboid(0.5, 0.1, 0.1),
+    );
+    let hanging = soft_cube_with_density(&mut scene, 2, Vector3::new(2.0, 1.5, 0.0), 100.0);
     let mut att = Attachments::new();
     {
         let p = scene.soft.get::<&Particles>(hanging).expect("body");
-        let top = (0..p.len() as u32)
-            .max_by(|&a, &b| {
-                p.positions()[a as usize]
-                    .y
-                    .total_cmp(&p.positions()[b as usize].y)
-            })
-            .expect("particles");
-        att.attach_to_body(&p, top, &scene.physics.bodies, boxed, 0.0)
+        let nearest = |target: Vector3<f32>| {
+            (0..p.len() as u32)
+                .min_by(|&a, &b| {
+                    let d = |i: u32| (p.positions()[i as usize] - target).norm();
+                    d(a).total_cmp(&d(b))
+                })
+                .expect("particles")
+        };
+        let top = nearest(Vector3::new(2.0, 2.5, 0.0));
+        let corner = nearest(Vector3::new(1.5, 2.5, -0.5));
+        att.attach_to_body(&p, top, &scene.physics.bodies, bar, 0.0)
             .expect("attachment");
-        att.attach_to_point(&p, 0, p.positions()[0], 1e-4)
+        att.attach_to_point(&p, corner, p.positions()[corner as usize], 1e-4)
             .expect("attachment");
     }
     scene.soft.insert_one(hanging, att).expect("entity");
@@ -189,6 +207,15 @@ fn coupled_scene_steps_without_allocating() {
         contacts = contacts.max(stats.contacts);
     });
     assert!(contacts > 0, "the scene has soft–rigid contacts");
+    // The counted frames are a sane scene, not an exploded one.
+    let p = scene.soft.get::<&Particles>(hanging).expect("body");
+    let (lo, hi) = p.aabb();
+    assert!(
+        lo.y > 0.5 && hi.norm() < 10.0 && p.max_speed() < 1.0,
+        "hanging cube bounds {lo:?}..{hi:?}, max speed {}",
+        p.max_speed()
+    );
+    drop(p);
     check("coupled", &tally, frames as u64);
 }
 

@@ -65,6 +65,9 @@ pub(crate) struct BodyProxy {
     pub prev: Isometry3<f32>,
     /// Whether a soft correction moved the body this frame.
     pub touched: bool,
+    /// How far the body moves along its path in the current substep: the shift of its
+    /// origin (m) and its turn (rad), from `prev` to `pose` before soft corrections.
+    pub substep_motion: (f32, f32),
     sub_impulse: Vector3<f32>,
     sub_angular: Vector3<f32>,
     impulse: Vector3<f32>,
@@ -149,6 +152,7 @@ impl BodyProxy {
             pose: start,
             prev: start,
             touched: false,
+            substep_motion: (0.0, 0.0),
             sub_impulse: Vector3::zeros(),
             sub_angular: Vector3::zeros(),
             impulse: Vector3::zeros(),
@@ -173,6 +177,14 @@ impl BodyProxy {
             self.dq = UnitQuaternion::from_scaled_axis(self.dw * h) * self.dq;
         }
         self.set_pose(frac);
+        self.substep_motion = if self.kind == BodyKind::Fixed {
+            (0.0, 0.0)
+        } else {
+            (
+                (self.pose.translation.vector - self.prev.translation.vector).norm(),
+                self.pose.rotation.angle_to(&self.prev.rotation),
+            )
+        };
         if self.kind != BodyKind::Fixed {
             self.pre = (
                 self.v_start.lerp(&self.v_end, self.frac) + self.dv,

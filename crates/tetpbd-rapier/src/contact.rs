@@ -15,6 +15,10 @@
 //! while the accumulated tangential multiplier stays under `μ_s λ_n` (sticking), otherwise
 //! only up to `μ_d λ_n` (sliding).
 //!
+//! A particle whose motion relative to the collider entered the shape during the substep
+//! (a fast body, or a thin shape) takes the entry point and entry face's normal as `q` and
+//! `n` instead of the closest point, which may lie on the far side (`sweep` module docs).
+//!
 //! Overlap a soft body is created with (its first frame in the coupling, a particle already
 //! inside a collider) is not resolved at once: the contact tolerates an allowance, the
 //! starting penetration into the collider itself (the thickness skin is resolved as usual)
@@ -30,9 +34,10 @@ use nalgebra::{Point3, Vector3};
 use rapier3d::geometry::ColliderSet;
 use tetpbd::Particles;
 
-use crate::bodies::BodyProxy;
+use crate::bodies::{BodyKind, BodyProxy};
 use crate::frame::{ColliderProxy, ParticleContact};
 use crate::shape_query::surface_point;
+use crate::sweep::swept_entry;
 
 /// One sweep over a soft body's particle contacts. Returns the number of degenerate
 /// evaluations (no usable normal).
@@ -54,7 +59,18 @@ pub(crate) fn project_contacts(
         let x = p.positions()[i];
         let pose = cp.pose(bodies);
         let fallback = c.has_normal.then_some(c.normal);
-        let Some(sp) = surface_point(shape, cp.rule, &pose, &x, fallback) else {
+        let closest = surface_point(shape, cp.rule, &pose, &x, fallback);
+        // Relative motion that entered the shape within the substep (`sweep` module docs).
+        let moving = cp.body.is_some_and(|b| bodies[b].kind != BodyKind::Fixed);
+        let swept = swept_entry(
+            shape,
+            &pose,
+            &if moving { cp.prev_pose(bodies) } else { pose },
+            &x,
+            &p.prev_positions()[i],
+            closest.as_ref(),
+        );
+        let Some(sp) = swept.or(closest) else {
             degenerate += 1;
             continue;
         };

@@ -19,33 +19,45 @@
 //! * every vertex of a polyhedral shape (cuboid, convex polyhedron, triangle; the inner
 //!   vertices of the rounded variants, border radius added to the thickness), each its own
 //!   constraint, so a face resting flat on the soft surface pushes evenly;
+//! * the vertices of a triangle mesh or heightfield near the soft body (of its triangles
+//!   inside the soft body's swept bounds), each paired only with the soft triangles near it;
+//! * a compound's parts by these rules, each rounded part with its own border radius;
 //! * for the other shapes with a support map (ball, capsule, cylinder, cone, segment and
 //!   rounded variants), the support point in direction `−n`: the shape's deepest point
 //!   towards the triangle.
 //!
+//! A point that crossed the triangle's plane from the front within the substep (a fast
+//! rigid body, motion taken relative to the triangle) is caught at any depth, at the point
+//! where it crossed (`sweep` module docs). Points of moving bodies that crossed are projected
+//! in a pass of their own before the particle contacts, even where a vertex touches the
+//! collider: one particle alone cannot stop a fast body, and its contact normal may be tilted
+//! enough to let the body slip past it.
+//!
 //! A triangle whose vertex is itself in contact with the collider (in the same iteration)
 //! is skipped: there the particle contacts hold the surface, and two sets of constraints on
-//! the same spot only fight. A compound contributes the vertices of its polyhedral parts;
-//! triangle meshes, heightfields and the smooth parts of compounds take no part (their
-//! contacts with the soft particles still act). `v` is only caught while its projection
+//! the same spot only fight. The smooth parts of a compound take no part (their contacts
+//! with the soft particles still act). `v` is only caught while its projection
 //! falls inside the triangle (within 0.1 % of its barycentric range, so a point on a shared
 //! edge is not lost between two triangles) and it is less than half the triangle's shortest
 //! edge behind it, so triangles on the far side of the body never grab it.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use rapier3d::geometry::{Aabb, ColliderSet};
 use rapier3d::parry::bounding_volume::BoundingVolume;
 use rapier3d::parry::shape::Shape;
 use tetpbd::{Particles, Surface};
 
-use crate::bodies::BodyProxy;
-use crate::convert::{to_glam, to_na};
+use crate::bodies::{BodyKind, BodyProxy};
+use crate::convert::{pose_to_glam, to_glam, to_na};
 use crate::frame::{ColliderProxy, ParticleContact};
 
 /// One rigid shape over one soft surface triangle.
 #[derive(Clone, Debug)]
 pub(crate) struct CornerContact {
     pub collider: usize,
+    /// On the first candidate of a collider's run (they are gathered per collider, one run
+    /// each): the run's length; 0 elsewhere. Lets the crossing pass skip fixed colliders.
+    pub run: u32,
     /// A polyhedral shape's corner in its local frame; `None`: the support point.
     pub corner: Option<Vector3<f32>>,
     pub triangle: u32,
@@ -67,47 +79,93 @@ pub(crate) struct CornerContact {
     pub impulse: Vector3<f32>,
 }
 
-/// Appends the corners of `shape` in its local frame to `out`; returns the extra thickness
-/// of a rounded shape.
-pub(crate) fn corners_into(shape: &dyn Shape, out: &mut Vec<Vector3<f32>>) -> f32 {
-    let cuboid_corners = |h: Vector3<f32>, out: &mut Vec<Vector3<f32>>| {
+/// The rigid points of a shape, in its local frame: scratch space whose capacity is reused
+/// from one collider to the next, so gathering allocates nothing once warm.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Corners {
+    /// Each point with the extra thickness of its (rounded) part, m.
+    pub points: Vec<(Vector3<f32>, f32)>,
+    /// Some points are vertices of a triangle mesh or heightfield: many, so each is only
+    /// paired with the soft triangles near it.
+    pub from_mesh: bool,
+}
+
+impl Corners {
+    /// Replaces the points with the corners of `shape`. A triangle mesh or heightfield
+    /// contributes the vertices of its triangles inside `near` (local frame).
+    pub fn fill(&mut self, shape: &dyn Shape, near: &Aabb) {
+        self.points.clear();
+        self.from_mesh = append_corners(shape, near, &mut self.points);
+    }
+}
+
+/// Appends the corners of `shape` to `out`; returns whether some are mesh vertices.
+fn append_corners(shape: &dyn Shape, near: &Aabb, out: &mut Vec<(Vector3<f32>, f32)>) -> bool {
+    let cuboid_corners = |h: Vector3<f32>, extra: f32, out: &mut Vec<(Vector3<f32>, f32)>| {
         out.extend((0..8).map(|k| {
-            Vector3::new(
+            let c = Vector3::new(
                 if k & 1 == 0 { -h.x } else { h.x },
                 if k & 2 == 0 { -h.y } else { h.y },
                 if k & 4 == 0 { -h.z } else { h.z },
-            )
+            );
+            (c, extra)
         }));
     };
     if let Some(c) = shape.as_cuboid() {
-        cuboid_corners(to_na(c.half_extents), out);
-        0.0
+        cuboid_corners(to_na(c.half_extents), 0.0, out);
     } else if let Some(c) = shape.as_round_cuboid() {
-        cuboid_corners(to_na(c.inner_shape.half_extents), out);
-        c.border_radius
+        cuboid_corners(to_na(c.inner_shape.half_extents), c.border_radius, out);
     } else if let Some(c) = shape.as_convex_polyhedron() {
-        out.extend(c.points().iter().map(|p| to_na(*p)));
-        0.0
+        out.extend(c.points().iter().map(|p| (to_na(*p), 0.0)));
     } else if let Some(c) = shape.as_round_convex_polyhedron() {
-        out.extend(c.inner_shape.points().iter().map(|p| to_na(*p)));
-        c.border_radius
+        let r = c.border_radius;
+        out.extend(c.inner_shape.points().iter().map(|p| (to_na(*p), r)));
     } else if let Some(t) = shape.as_triangle() {
-        out.extend([to_na(t.a), to_na(t.b), to_na(t.c)]);
-        0.0
+        out.extend([t.a, t.b, t.c].map(|v| (to_na(v), 0.0)));
+    } else if let Some(mesh) = shape.as_trimesh() {
+        let first = out.len();
+        for t in mesh.bvh().intersect_aabb(near) {
+            let tri = mesh.triangle(t);
+            out.extend([tri.a, tri.b, tri.c].map(|v| (to_na(v), 0.0)));
+        }
+        dedup_mesh_vertices(out, first);
+        return true;
+    } else if let Some(hf) = shape.as_heightfield() {
+        let first = out.len();
+        hf.map_elements_in_local_aabb(near, &mut |_, tri| {
+            out.extend([tri.a, tri.b, tri.c].map(|v| (to_na(v), 0.0)));
+        });
+        dedup_mesh_vertices(out, first);
+        return true;
     } else if let Some(compound) = shape.as_compound() {
-        // The corners of the polyhedral parts, in the compound's frame (a rounded part's
-        // border radius is not added: parts may differ).
+        // The corners of every part, in the compound's frame, each with its part's radius.
+        let mut from_mesh = false;
         for (pose, part) in compound.shapes() {
+            let part_near = near.transform_by(&pose.inverse());
             let first = out.len();
-            corners_into(part.as_ref(), out);
-            for c in &mut out[first..] {
+            from_mesh |= append_corners(part.as_ref(), &part_near, out);
+            for (c, _) in &mut out[first..] {
                 *c = to_na(pose.transform_point(to_glam(c)));
             }
         }
-        0.0
-    } else {
-        0.0
+        return from_mesh;
     }
+    false
+}
+
+/// Mesh vertices from `first` on without repeats (sorted by coordinates, so the order is
+/// deterministic).
+fn dedup_mesh_vertices(out: &mut Vec<(Vector3<f32>, f32)>, first: usize) {
+    let key = |p: &(Vector3<f32>, f32)| [p.0.x.to_bits(), p.0.y.to_bits(), p.0.z.to_bits()];
+    out[first..].sort_unstable_by_key(key);
+    let mut keep = first;
+    for k in first..out.len() {
+        if keep == first || key(&out[k]) != key(&out[keep - 1]) {
+            out[keep] = out[k];
+            keep += 1;
+        }
+    }
+    out.truncate(keep);
 }
 
 /// Adds the corner–triangle candidates of one collider against one soft body. `corners` is
@@ -118,25 +176,39 @@ pub(crate) fn gather_corners(
     shape: &dyn Shape,
     collider: usize,
     collider_aabb: &Aabb,
+    pose: &Isometry3<f32>,
     p: &Particles,
     surface: &Surface,
     dt: f32,
     thickness: f32,
     (mu_d, mu_s, restitution): (f32, f32, f32),
     vertex_contacts: &[(u32, usize)],
-    corners: &mut Vec<Vector3<f32>>,
+    corners: &mut Corners,
 ) {
-    corners.clear();
-    let extra = corners_into(shape, corners);
+    // The soft body's surface over the frame, in the collider's frame (at its end pose).
+    let mut lo = Vector3::repeat(f32::INFINITY);
+    let mut hi = Vector3::repeat(f32::NEG_INFINITY);
+    for &i in surface.vertices() {
+        let x = p.positions()[i as usize];
+        let y = x + p.velocities()[i as usize] * dt;
+        lo = lo.inf(&x.inf(&y));
+        hi = hi.sup(&x.sup(&y));
+    }
+    let near = Aabb::new(to_glam(&lo), to_glam(&hi))
+        .loosened(thickness)
+        .transform_by(&pose_to_glam(&pose.inverse()));
+    corners.fill(shape, &near);
     // No corners: the support point of a shape with a support map, as the single `None`.
-    let count = if !corners.is_empty() {
-        corners.len()
-    } else if shape.as_support_map().is_some() {
+    let count = if !corners.points.is_empty() {
+        corners.points.len()
+    } else if shape.as_support_map().is_some() && !corners.from_mesh {
         1
     } else {
         return;
     };
-    let reach = thickness + extra;
+    let max_extra = corners.points.iter().map(|c| c.1).fold(0.0f32, f32::max);
+    let reach = thickness + max_extra;
+    let first = out.len();
     for (t, tri) in surface.triangles().iter().enumerate() {
         let mut lo = Vector3::repeat(f32::INFINITY);
         let mut hi = Vector3::repeat(f32::NEG_INFINITY);
@@ -157,12 +229,25 @@ pub(crate) fn gather_corners(
                 .map(|k| vertex_contacts[k].1)
         });
         for j in 0..count {
+            let (corner, extra) = match corners.points.get(j) {
+                Some(&(c, r)) => (Some(c), r),
+                None => (None, 0.0),
+            };
+            // A mesh vertex only with the soft triangles near it.
+            if corners.from_mesh
+                && corner.is_some_and(|c| {
+                    !ta.contains_local_point(to_glam(&(pose * Point3::from(c)).coords))
+                })
+            {
+                continue;
+            }
             out.push(CornerContact {
                 collider,
-                corner: corners.get(j).copied(),
+                run: 0,
+                corner,
                 triangle: t as u32,
                 vertex_contacts: vc,
-                thickness: reach,
+                thickness: thickness + extra,
                 restitution,
                 active: false,
                 mu_d,
@@ -178,9 +263,17 @@ pub(crate) fn gather_corners(
             });
         }
     }
+    let run = out.len() - first;
+    if let Some(k) = out.get_mut(first) {
+        k.run = u32::try_from(run).unwrap_or(u32::MAX);
+    }
 }
 
-/// One Gauss–Seidel sweep over a soft body's corner contacts.
+/// One Gauss–Seidel sweep over a soft body's corner contacts. With `crossing_only`, only
+/// points of moving (non-fixed) bodies that crossed their triangle within the substep are
+/// projected: this pass runs before the particle contacts, so a fast body is stopped by the
+/// surface it hits first rather than by a particle poking into it from the side.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn project_corners(
     corners: &mut [CornerContact],
     contacts: &[ParticleContact],
@@ -189,26 +282,97 @@ pub(crate) fn project_corners(
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
     set: &ColliderSet,
+    crossing_only: bool,
+) {
+    if crossing_only {
+        // Only the runs of moving colliders.
+        let mut i = 0;
+        while i < corners.len() {
+            let run = (corners[i].run as usize).clamp(1, corners.len() - i);
+            let moving = colliders[corners[i].collider]
+                .body
+                .is_some_and(|b| bodies[b].kind != BodyKind::Fixed);
+            if moving {
+                sweep_corners(
+                    &mut corners[i..i + run],
+                    contacts,
+                    p,
+                    surface,
+                    bodies,
+                    colliders,
+                    set,
+                    true,
+                );
+            }
+            i += run;
+        }
+    } else {
+        sweep_corners(corners, contacts, p, surface, bodies, colliders, set, false);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn sweep_corners(
+    corners: &mut [CornerContact],
+    contacts: &[ParticleContact],
+    p: &mut Particles,
+    surface: &Surface,
+    bodies: &mut [BodyProxy],
+    colliders: &[ColliderProxy],
+    set: &ColliderSet,
+    crossing_only: bool,
 ) {
     for k in corners {
+        // The crossing pass only sees moving bodies; a fixed one cannot cross by itself.
+        let moved = match colliders[k.collider].body {
+            Some(b) if bodies[b].kind != BodyKind::Fixed => Some(bodies[b].substep_motion),
+            _ => None,
+        };
+        if crossing_only && moved.is_none() {
+            continue;
+        }
         let Some(tri) = surface.triangles().get(k.triangle as usize) else {
             continue;
         };
         // Where a vertex already touches the collider, the particle contacts hold the
-        // surface; the triangle only stops what slips between particles.
-        if k.vertex_contacts
+        // surface; the triangle only stops what slips between particles (and what crosses
+        // it within the substep, below).
+        let vertex_touches = k
+            .vertex_contacts
             .iter()
             .flatten()
-            .any(|&c| contacts.get(c).is_some_and(|c| c.active))
-        {
+            .any(|&c| contacts.get(c).is_some_and(|c| c.active));
+        // Outside the crossing pass a touching vertex rules the triangle out (a crossing
+        // there is only taken in the crossing pass).
+        if vertex_touches && !crossing_only {
             continue;
         }
         let idx = tri.map(|i| i as usize);
         let [a, b, c] = idx.map(|i| p.positions()[i]);
         let cp = &colliders[k.collider];
+        let shortest = (b - a).norm().min((c - b).norm()).min((a - c).norm());
+        // Fast: the rigid point moves more than a tenth of the shortest edge in the substep
+        // (bounded by the body's shift plus its turn times the point's distance from the
+        // body's origin; support points bounded by the shape's bounding sphere).
+        let fast = moved.is_some_and(|(shift, turn)| {
+            let limit = 0.1 * shortest;
+            if shift > limit || turn <= 0.0 {
+                return shift > limit;
+            }
+            let radius = match k.corner {
+                Some(c) => c.norm(),
+                None => set.get(cp.handle).map_or(f32::INFINITY, |co| {
+                    let sphere = co.shape().compute_local_bounding_sphere();
+                    sphere.radius + to_na(sphere.center).norm()
+                }),
+            };
+            shift + turn * (radius + cp.local.translation.vector.norm()) > limit
+        });
+        if crossing_only && !fast {
+            continue;
+        }
         let m = (b - a).cross(&(c - a));
         let area2 = m.norm();
-        let shortest = (b - a).norm().min((c - b).norm()).min((a - c).norm());
         if area2.is_nan() || area2 <= 1e-12 {
             continue;
         }
@@ -233,11 +397,33 @@ pub(crate) fn project_corners(
         }
         let s = (v - a).dot(&n);
         let c_val = s - k.thickness;
-        if c_val >= 0.0 || s < -0.5 * shortest {
+        if c_val >= 0.0 {
             continue;
         }
-        // Barycentric weights of v's projection onto the triangle's plane.
-        let q = v - n * s;
+        // Crossed the plane from the front within this substep (a fast rigid point, one that
+        // itself moved more than a tenth of the shortest edge): caught at any depth, at the
+        // crossing point. The point's start of the substep is carried along with the
+        // triangle's vertex `a`, so the motion is relative to the triangle. Slow crossings (a
+        // body settling on the surface, or the soft surface moving fast under a slow body)
+        // are left to the ordinary rule: only within half the shortest edge behind the
+        // plane, so triangles on the far side of the body never grab it.
+        let crossing = fast.then(|| {
+            let v_start = (cp.prev_pose(bodies) * Point3::from(local)).coords;
+            let v_prev = v_start + (a - p.prev_positions()[idx[0]]);
+            let s_prev = (v_prev - a).dot(&n);
+            let fast_point = (v - v_start).norm_squared() > (0.1 * shortest).powi(2);
+            (s_prev > 0.0 && s < 0.0 && fast_point)
+                .then(|| v_prev + (v - v_prev) * (s_prev / (s_prev - s)))
+        });
+        let q = if let Some(Some(q)) = crossing {
+            q
+        } else if s >= -0.5 * shortest && !crossing_only {
+            v
+        } else {
+            continue;
+        };
+        // Barycentric weights of q's projection onto the triangle's plane.
+        let q = q - n * (q - a).dot(&n);
         let wa = (b - q).cross(&(c - q)).dot(&n) / area2;
         let wb = (c - q).cross(&(a - q)).dot(&n) / area2;
         let wc = 1.0 - wa - wb;
@@ -328,4 +514,53 @@ fn friction(
     }
     k.lambda_t += applied;
     k.sub_impulse += t * applied;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rapier3d::geometry::SharedShape;
+    use rapier3d::math::{Pose, Vector};
+
+    #[test]
+    fn compound_parts_keep_their_own_border_radius() {
+        let compound = SharedShape::compound(vec![
+            (
+                Pose::translation(-1.0, 0.0, 0.0),
+                SharedShape::cuboid(0.5, 0.5, 0.5),
+            ),
+            (
+                Pose::translation(1.0, 0.0, 0.0),
+                SharedShape::round_cuboid(0.4, 0.4, 0.4, 0.1),
+            ),
+        ]);
+        let near = Aabb::new(Vector::splat(-10.0), Vector::splat(10.0));
+        let mut c = Corners::default();
+        c.fill(compound.as_ref(), &near);
+        assert_eq!(c.points.len(), 16);
+        assert!(!c.from_mesh);
+        for (p, r) in &c.points {
+            let expected = if p.x > 0.0 { 0.1 } else { 0.0 };
+            assert_eq!(*r, expected, "corner {p:?}");
+        }
+    }
+
+    #[test]
+    fn mesh_vertices_only_near_the_soft_body_and_once_each() {
+        let v = vec![
+            Vector::new(0.0, 0.0, 0.0),
+            Vector::new(1.0, 0.0, 0.0),
+            Vector::new(0.0, 0.0, 1.0),
+            Vector::new(10.0, 0.0, 10.0),
+            Vector::new(11.0, 0.0, 10.0),
+            Vector::new(10.0, 0.0, 11.0),
+        ];
+        let mesh = SharedShape::trimesh(v, vec![[0, 2, 1], [1, 2, 0], [3, 5, 4]]).expect("mesh");
+        let near = Aabb::new(Vector::splat(-1.0), Vector::splat(2.0));
+        let mut c = Corners::default();
+        c.fill(mesh.as_ref(), &near);
+        assert!(c.from_mesh);
+        assert_eq!(c.points.len(), 3, "{:?}", c.points);
+        assert!(c.points.iter().all(|(p, _)| p.x < 2.0 && p.z < 2.0));
+    }
 }

@@ -153,12 +153,21 @@ impl<'a> RapierContext<'a> {
 /// lag); the price is that a soft push on a rigid body reaches rigid–rigid contacts one
 /// frame later.
 ///
+/// Fast rigid bodies: rapier steps first, so a fast body may already stand beyond a thin
+/// soft body when the soft substeps run. rapier still integrates it (to `P₁`); the coupling
+/// gathers it from its swept motion `P₀ → P₁` rather than its end pose, and inside the
+/// substeps its path is tested continuously against the soft surface (a particle's motion
+/// relative to the collider cast as a ray; a rigid point that crossed a surface triangle's
+/// plane caught where it crossed, in a pass before the particle contacts). A body the soft
+/// contacts stop is written back where they stopped it (`sweep` module docs).
+///
 /// # Constraints in the substeps
 ///
-/// Each iteration, after the soft body's own families: particle–collider contacts
+/// Each iteration, after the soft body's own families: rigid points of moving bodies that
+/// crossed a soft surface triangle within the substep, particle–collider contacts
 /// (`contact` module docs: XPBD inequality, positional Coulomb friction with static and
-/// dynamic coefficients), rigid points against soft surface triangles (`corner` module
-/// docs), then attachments ([`crate::Attachments`]). After each substep's velocity update:
+/// dynamic coefficients), the other rigid points against soft surface triangles (`corner`
+/// module docs), then attachments ([`crate::Attachments`]). After each substep's velocity update:
 /// the per-particle separating velocity is removed, then restitution acts per (soft body,
 /// collider) impact episode on the body's centre of mass (`restitution` module docs), and
 /// [`crate::DeformationDamping`] damps deformation of bodies that carry it.

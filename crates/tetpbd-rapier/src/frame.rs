@@ -14,7 +14,7 @@ use tetpbd::{Particles, Surface};
 use crate::attachment::{AttachTarget, Attachments};
 use crate::bodies::BodyProxy;
 use crate::convert::{pose_to_glam, pose_to_na, to_glam};
-use crate::corner::{gather_corners, CornerContact};
+use crate::corner::{gather_corners, CornerContact, Corners};
 use crate::material::SoftCollider;
 use crate::report::CouplingStats;
 use crate::shape_query::InsideRule;
@@ -51,6 +51,14 @@ impl ColliderProxy {
     pub fn pose(&self, bodies: &[BodyProxy]) -> Isometry3<f32> {
         match self.body {
             Some(b) => bodies[b].pose * self.local,
+            None => self.local,
+        }
+    }
+
+    /// World pose at the end of the previous substep.
+    pub fn prev_pose(&self, bodies: &[BodyProxy]) -> Isometry3<f32> {
+        match self.body {
+            Some(b) => bodies[b].prev * self.local,
             None => self.local,
         }
     }
@@ -125,9 +133,11 @@ pub(crate) struct Frame {
     pub corners: Vec<CornerContact>,
     pub attachments: Vec<AttachRun>,
     near: Vec<ColliderHandle>,
+    /// Colliders of fast bodies with their swept AABB over the frame (`sweep` module docs).
+    fast: Vec<(ColliderHandle, Aabb)>,
     vertex_contacts: Vec<(u32, usize)>,
     /// Scratch: a shape's corners (`corner::gather_corners`).
-    shape_corners: Vec<Vector3<f32>>,
+    shape_corners: Corners,
     /// Scratch: the colliders of a body's active contacts (`restitution::restitution_pass`).
     pub active_colliders: Vec<usize>,
     /// Impact episodes in progress (kept across frames).
@@ -262,6 +272,13 @@ impl Frame {
         self.attachments.clear();
         self.substep = 0;
         let qp = input.qp;
+        crate::sweep::fast_colliders(
+            &mut self.fast,
+            &self.start_poses,
+            qp.bodies,
+            qp.colliders,
+            input.margin,
+        );
         let dt = self.dt;
         let fall = 0.5 * self.gravity * dt * dt;
         for (entity, p, surface, sc, att) in world.query_mut::<(
@@ -282,15 +299,25 @@ impl Frame {
                 let aabb = Aabb::new(to_glam(&lo), to_glam(&hi)).loosened(reach);
                 let mut near = std::mem::take(&mut self.near);
                 near.clear();
+                let keep = |co: &rapier3d::geometry::Collider| {
+                    co.is_enabled()
+                        && !co.is_sensor()
+                        && sc.collision_groups.test(co.collision_groups())
+                };
                 near.extend(
                     qp.intersect_aabb_conservative(aabb)
-                        .filter(|(_, co)| {
-                            co.is_enabled()
-                                && !co.is_sensor()
-                                && sc.collision_groups.test(co.collision_groups())
-                        })
+                        .filter(|(_, co)| keep(co))
                         .map(|(h, _)| h),
                 );
+                // Fast bodies that crossed the soft body during rapier's step.
+                for (h, swept) in &self.fast {
+                    if swept.intersects(&aabb)
+                        && !near.contains(h)
+                        && qp.colliders.get(*h).is_some_and(keep)
+                    {
+                        near.push(*h);
+                    }
+                }
                 for &handle in &near {
                     let Some(ci) =
                         self.collider_proxy(handle, qp.bodies, qp.colliders, input.narrow_phase)
@@ -356,6 +383,7 @@ impl Frame {
                             co.shape(),
                             ci,
                             &caabb,
+                            &pose_to_na(co.position()),
                             p,
                             surface,
                             dt,

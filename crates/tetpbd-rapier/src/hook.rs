@@ -76,6 +76,16 @@ impl SubstepHook for CouplingHook<'_, '_> {
             else {
                 continue;
             };
+            project_corners(
+                &mut corners[s.corners.clone()],
+                &contacts[s.contacts.clone()],
+                p,
+                surface,
+                bodies,
+                colliders,
+                self.qp.colliders,
+                true,
+            );
             stats.degenerate_contacts += project_contacts(
                 &mut contacts[s.contacts.clone()],
                 p,
@@ -92,6 +102,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 bodies,
                 colliders,
                 self.qp.colliders,
+                false,
             );
             project_attachments(&mut attachments[s.attachments.clone()], p, bodies, frac, h);
         }

@@ -219,7 +219,7 @@ fn light_soft_on_heavy_plank(config: &Config) -> Result<CoupledOutcome, String> 
     Ok(out)
 }
 
-fn ball_at_100_m_s(config: &Config) -> Result<CoupledOutcome, String> {
+fn ball_at(config: &Config, speed: f32) -> Result<CoupledOutcome, String> {
     let mut out = CoupledOutcome::default();
     let mut s = scene(10)?;
     ground(&mut s);
@@ -235,18 +235,25 @@ fn ball_at_100_m_s(config: &Config) -> Result<CoupledOutcome, String> {
     let (rb, _) = s.physics.insert(
         RigidBodyBuilder::dynamic()
             .translation(Vector::new(0.05, 1.0, 0.05))
-            .linvel(Vector::new(0.0, -100.0, 0.0))
+            .linvel(Vector::new(0.0, -speed, 0.0))
             .ccd_enabled(true),
         ColliderBuilder::ball(0.1).density(1000.0),
     );
     let mut lowest = f32::INFINITY;
     run(&mut s, e, Some(rb), 120, &mut out, |s| {
         if let Some(b) = s.physics.bodies.get(rb) {
-            lowest = lowest.min(b.translation().y);
+            let t = b.translation();
+            // Over the slab (the impact may set the ball rolling off its edge).
+            if t.x.abs() < 1.0 && t.z.abs() < 1.0 {
+                lowest = lowest.min(t.y);
+            }
         }
     });
     // No tunnelling: the ball's centre never reaches the slab's lower half.
-    out.criterion = (lowest > 0.1, format!("ball centre lowest {lowest:.3} m"));
+    out.criterion = (
+        lowest > 0.1,
+        format!("ball centre lowest over the slab {lowest:.3} m"),
+    );
     Ok(out)
 }
 
@@ -354,9 +361,15 @@ pub fn coupled_cases() -> Vec<CoupledCase> {
         },
         CoupledCase {
             name: "rigid ball at 100 m/s",
-            description: "a 0.1 m rigid ball (CCD on) at 100 m/s onto a soft slab one cell (0.2 m) thick on the ground, 2 s: the ball's centre never reaches the slab's lower half",
+            description: "a 0.1 m rigid ball (CCD on) at 100 m/s onto a soft slab one cell (0.2 m) thick on the ground, 2 s: the ball's centre never reaches the slab's lower half while over the slab",
             kind: CaseKind::Fast,
-            run: |c| guarded(ball_at_100_m_s(c)),
+            run: |c| guarded(ball_at(c, 100.0)),
+        },
+        CoupledCase {
+            name: "rigid ball at 30 m/s",
+            description: "the same at 30 m/s",
+            kind: CaseKind::Fast,
+            run: |c| guarded(ball_at(c, 30.0)),
         },
         CoupledCase {
             name: "created half in the ground",
