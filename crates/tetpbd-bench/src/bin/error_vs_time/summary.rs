@@ -4,8 +4,11 @@
 use std::fmt::Write as _;
 use std::process::Command;
 
+use tetpbd_bench::ContactScene;
+
+use crate::contacts::ContactRow;
 use crate::engines::Model;
-use crate::pareto::{compare, median, Point};
+use crate::pareto::{compare, median, Match, Point};
 use crate::report::{Row, RunInfo};
 use crate::scenes::{Scene, SceneKind};
 
@@ -97,7 +100,7 @@ fn points(rows: &[Row], idx: &[usize], m: &Metric, cpu: bool) -> Vec<Point> {
 }
 
 /// Three significant digits, without an exponent for ordinary ratios.
-fn sig(x: f64) -> String {
+pub fn sig(x: f64) -> String {
     match x.abs() {
         a if a >= 1e5 || (a < 1e-2 && a > 0.0) => format!("{x:.2e}"),
         a if a >= 100.0 => format!("{x:.0}"),
@@ -110,17 +113,17 @@ fn describe(r: &Row) -> String {
     format!("{} {}", r.model.label(), r.budget())
 }
 
-/// The headline paragraph and table for one scene, one metric and one selection of rows.
 /// The medians of one headline comparison.
-struct Brief {
+pub struct Brief {
     /// Median of rapier ms / tetpbd ms at equal error.
-    speed: Option<f64>,
+    pub speed: Option<f64>,
     /// Median of rapier error / tetpbd error at equal time.
-    gain: Option<f64>,
+    pub gain: Option<f64>,
     /// rapier Pareto points.
-    points: usize,
+    pub points: usize,
 }
 
+/// The headline paragraph and table for one scene, one metric and one selection of rows.
 fn headline(
     s: &mut String,
     rows: &[Row],
@@ -145,13 +148,6 @@ fn headline(
         &points(rows, &sel("tetpbd"), m, cpu),
         &points(rows, &sel("rapier"), m, cpu),
     );
-    let speed: Vec<f64> = matches.iter().filter_map(|x| x.speedup()).collect();
-    let gain: Vec<f64> = matches.iter().filter_map(|x| x.accuracy_gain()).collect();
-    let range = |v: &[f64]| {
-        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        format!("{}–{}", sig(lo), sig(hi))
-    };
     let which = if hard_only {
         "hard models only"
     } else {
@@ -178,6 +174,23 @@ fn headline(
             );
         }
     }
+    pareto_text(s, &matches, &|i| describe(&rows[i]))
+}
+
+/// The medians and the table of one comparison at rapier's Pareto points; `describe(i)` names
+/// the run behind point row `i`.
+pub fn pareto_text(
+    s: &mut String,
+    matches: &[Match],
+    describe: &dyn Fn(usize) -> String,
+) -> Brief {
+    let speed: Vec<f64> = matches.iter().filter_map(|x| x.speedup()).collect();
+    let gain: Vec<f64> = matches.iter().filter_map(|x| x.accuracy_gain()).collect();
+    let range = |v: &[f64]| {
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        format!("{}–{}", sig(lo), sig(hi))
+    };
     match median(speed.clone()) {
         Some(x) => {
             let _ = writeln!(
@@ -217,11 +230,10 @@ fn headline(
     }
     let _ = writeln!(s, "| rapier Pareto point | ms | error | tetpbd at equal error | ms | speed-up | tetpbd at equal time | error | gain |");
     let _ = writeln!(s, "|---|---:|---:|---|---:|---:|---|---:|---:|");
-    for x in &matches {
-        let t = &rows[x.theirs.row];
+    for x in matches {
         let (ee, ee_ms, sp) = match x.at_equal_error {
             Some(p) => (
-                describe(&rows[p.row]),
+                describe(p.row),
                 format!("{:.3}", p.ms),
                 format!("{:.2}×", x.theirs.ms / p.ms),
             ),
@@ -229,7 +241,7 @@ fn headline(
         };
         let (et, et_err, g) = match x.at_equal_time {
             Some(p) => (
-                describe(&rows[p.row]),
+                describe(p.row),
                 format!("{:.2e}", p.err),
                 format!("{}×", sig(x.theirs.err / p.err.max(f64::MIN_POSITIVE))),
             ),
@@ -238,7 +250,7 @@ fn headline(
         let _ = writeln!(
             s,
             "| {} | {:.3} | {:.2e} | {ee} | {ee_ms} | {sp} | {et} | {et_err} | {g} |",
-            describe(t),
+            describe(x.theirs.row),
             x.theirs.ms,
             x.theirs.err
         );
@@ -256,6 +268,7 @@ pub fn markdown(
     scenes: &[Scene],
     rows: &[Row],
     references: &[(&'static str, Model, u32, f32)],
+    contacts: (&[ContactScene], &[ContactRow]),
     info: &RunInfo,
 ) -> String {
     let (quick, elapsed_s) = (info.quick, info.elapsed_s);
@@ -303,6 +316,11 @@ pub fn markdown(
             ));
         }
     }
+    briefs.extend(crate::summary_contacts::headlines(
+        &mut details,
+        contacts.0,
+        contacts.1,
+    ));
     let _ = writeln!(s, "| scene | models | error | speed at equal error | accuracy at equal time | rapier front points | speed, by CPU time | accuracy, by CPU time |\n|---|---|---|---:|---:|---:|---:|---:|");
     for b in &briefs {
         let _ = writeln!(s, "{b}");
@@ -319,5 +337,6 @@ pub fn markdown(
     let _ = writeln!(s, "\nThe last two columns repeat the comparison with each run's median thread CPU time per frame instead of its wall time (both engines run on the calling thread): on a loaded machine they show how much of the wall-time figure is contention.");
     let _ = writeln!(s, "\n### Details\n\n{details}");
     crate::summary_setup::setup(&mut s, scenes, rows, references);
+    crate::summary_contacts::section(&mut s, contacts.0, contacts.1);
     s
 }

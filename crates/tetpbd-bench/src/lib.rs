@@ -1,0 +1,25 @@
+//! Scene code shared by the tetpbd-bench binaries (`error_vs_time`, `vs_rapier`): how rapier's
+//! built-in soft bodies are set up next to tetpbd's, the contact scenes (a soft cube dropped
+//! on rigid ground, a pile of nine cubes) in both engines, and the observables measured the
+//! same way from either engine's particle positions.
+#![warn(missing_docs)]
+
+mod clock;
+mod contact_metrics;
+mod contact_scene;
+mod contact_sim;
+mod rapier_setup;
+
+pub use clock::thread_cpu_ms;
+pub use contact_metrics::{
+    interpenetration, observe_contact, run_contact, ContactObservables, ContactResult,
+    SETTLED_SPEED,
+};
+pub use contact_scene::{ContactKind, ContactScene, GROUND_HALF_EXTENTS};
+pub use contact_sim::{build_contact, ContactEngine, ContactSim};
+pub use rapier_setup::{
+    lumped_masses, rapier_material, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON, RAPIER_YOUNG,
+};
+
+/// Frame time step of every benchmark run, s.
+pub const DT: f32 = 1.0 / 60.0;
