@@ -54,9 +54,7 @@ pub fn observe_contact(
                 o.inverted += 1;
             }
         }
-        o.volume_err_pct = o
-            .volume_err_pct
-            .max(((v / v0 - 1.0).abs() * 100.0) as f32);
+        o.volume_err_pct = o.volume_err_pct.max(((v / v0 - 1.0).abs() * 100.0) as f32);
         for (i, p) in xb.iter().enumerate() {
             o.ground_penetration = o.ground_penetration.max(-p.y);
             if let Some(q) = prev.get(b).and_then(|pb| pb.get(i)) {
@@ -74,7 +72,10 @@ fn tet_volume(t: &[u32; 4], x: &[Vector3<f32>]) -> f32 {
 
 fn aabb(x: &[Vector3<f32>]) -> (Vector3<f32>, Vector3<f32>) {
     x.iter().fold(
-        (Vector3::repeat(f32::INFINITY), Vector3::repeat(f32::NEG_INFINITY)),
+        (
+            Vector3::repeat(f32::INFINITY),
+            Vector3::repeat(f32::NEG_INFINITY),
+        ),
         |(lo, hi), p| (lo.inf(p), hi.sup(p)),
     )
 }
@@ -110,7 +111,8 @@ pub fn interpenetration(scene: &ContactScene, x: &[Vec<Vector3<f32>>]) -> f32 {
     worst
 }
 
-/// `p` lies inside one of the tetrahedra of the body at `x`.
+/// `p` lies inside one of the tetrahedra of the body at `x` or on its boundary (a point on a
+/// face shared by two tetrahedra belongs to both).
 fn inside(scene: &ContactScene, x: &[Vector3<f32>], p: &Vector3<f32>) -> bool {
     scene.cube.tets.iter().any(|t| {
         let [a, b, c, d] = t.map(|i| x[i as usize]);
@@ -121,7 +123,7 @@ fn inside(scene: &ContactScene, x: &[Vector3<f32>], p: &Vector3<f32>) -> bool {
             signed_volume(&a, &b, p, &d),
             signed_volume(&a, &b, &c, p),
         ];
-        v != 0.0 && parts.iter().all(|s| s * v.signum() > 0.0)
+        v != 0.0 && parts.iter().all(|s| s * v.signum() >= 0.0)
     })
 }
 
@@ -219,11 +221,15 @@ pub fn run_contact(
             r.rest_penetration = r.rest_penetration.max(o.ground_penetration);
             r.rest_volume_err_pct = r.rest_volume_err_pct.max(o.volume_err_pct);
             let k = f - scene.rest_from;
-            if many && (k % INTERPENETRATION_EVERY == 0 || f + 1 == scene.frames) {
+            if many && (k.is_multiple_of(INTERPENETRATION_EVERY) || f + 1 == scene.frames) {
                 worst_inter = worst_inter.max(interpenetration(scene, &x));
             }
         }
-        r.rest_min_y = x.iter().flatten().map(|p| p.y).fold(f32::INFINITY, f32::min);
+        r.rest_min_y = x
+            .iter()
+            .flatten()
+            .map(|p| p.y)
+            .fold(f32::INFINITY, f32::min);
         prev = x;
     }
     r.frame_ms.sort_by(f64::total_cmp);

@@ -155,7 +155,9 @@ impl Ours {
                 .build()?
                 .spawn(&mut scene.soft);
             if damping > 0.0 {
-                scene.soft.insert_one(e, DeformationDamping::new(damping)?)?;
+                scene
+                    .soft
+                    .insert_one(e, DeformationDamping::new(damping)?)?;
             }
             bodies.push(e);
         }

@@ -15,9 +15,7 @@
 //! (5 to 80 substeps, both dampings) that is at least as accurate as rapier's on every one of
 //! those observables: the speed-up at equal or better error.
 
-use tetpbd_bench::{
-    build_contact, run_contact, ContactEngine, ContactResult, ContactScene, DT,
-};
+use tetpbd_bench::{build_contact, run_contact, ContactEngine, ContactResult, ContactScene, DT};
 
 use rapier3d::prelude::{SoftBodyCellModel, SoftBodySolver};
 
@@ -73,7 +71,9 @@ fn compare(scene: &ContactScene) -> Res<()> {
             } else {
                 measure(e, scene, substeps)?
             };
-            let cheaper = best.as_ref().is_none_or(|(_, _, b)| x.ms_median < b.ms_median);
+            let cheaper = best
+                .as_ref()
+                .is_none_or(|(_, _, b)| x.ms_median < b.ms_median);
             if x.at_least_as_accurate_as(&r) && cheaper {
                 best = Some((e, substeps, x));
             }

@@ -5,7 +5,9 @@
 use std::fmt::Write as _;
 
 use rapier3d::prelude::{SoftBodyCellModel, SoftBodySolver};
-use tetpbd_bench::{build_contact, run_contact, ContactEngine, ContactResult, ContactScene};
+use tetpbd_bench::{
+    build_contact, run_contact, ContactEngine, ContactKind, ContactResult, ContactScene,
+};
 
 /// One run of one contact configuration.
 #[derive(Clone, Debug)]
@@ -93,7 +95,10 @@ fn engines(scene: &ContactScene, quick: bool) -> Vec<ContactEngine> {
 fn budgets(engine: &ContactEngine, scene: &ContactScene, quick: bool) -> Vec<u32> {
     match (engine, quick, scene.cells) {
         (_, true, _) => vec![10],
-        (ContactEngine::Tetpbd { .. }, false, 4) => vec![5, 10, 20, 40, 80],
+        (ContactEngine::Tetpbd { .. }, false, 4) if scene.kind == ContactKind::Drop => {
+            vec![5, 10, 20, 40, 80]
+        }
+        (ContactEngine::Tetpbd { .. }, false, 4) => vec![5, 10, 20, 40],
         (ContactEngine::Tetpbd { .. }, false, _) => vec![10, 20, 40],
         (ContactEngine::Rapier { .. }, false, 4) => vec![5, 10, 20],
         (ContactEngine::Rapier { .. }, false, _) => vec![10],

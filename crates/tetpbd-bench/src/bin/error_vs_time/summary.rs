@@ -179,11 +179,7 @@ fn headline(
 
 /// The medians and the table of one comparison at rapier's Pareto points; `describe(i)` names
 /// the run behind point row `i`.
-pub fn pareto_text(
-    s: &mut String,
-    matches: &[Match],
-    describe: &dyn Fn(usize) -> String,
-) -> Brief {
+pub fn pareto_text(s: &mut String, matches: &[Match], describe: &dyn Fn(usize) -> String) -> Brief {
     let speed: Vec<f64> = matches.iter().filter_map(|x| x.speedup()).collect();
     let gain: Vec<f64> = matches.iter().filter_map(|x| x.accuracy_gain()).collect();
     let range = |v: &[f64]| {
@@ -279,11 +275,11 @@ pub fn markdown(
         s,
         "# Error against run time: tetpbd vs rapier 0.36 soft bodies\n"
     );
-    let _ = writeln!(s, "Regenerate: `cargo run --release -p tetpbd-bench --bin error_vs_time{}` (this run took {elapsed_s:.0} s).\n", if quick { " -- --quick" } else { "" });
+    let _ = writeln!(s, "Regenerate: `cargo run --release -p tetpbd-bench{} --bin error_vs_time{}` (this run took {elapsed_s:.0} s).\n", if cfg!(feature = "parallel") { " --features parallel" } else { "" }, if quick { " -- --quick" } else { "" });
     if quick {
         let _ = writeln!(s, "**This is a `--quick` smoke run: fewer models, budgets, frames and a cheaper reference. Do not quote it.**\n");
     }
-    let _ = writeln!(s, "- Machine: {}\n- Date: {date}\n- Commit: {}\n- Load average (1/5/15 min) at start: {}, at end: {} (the machine is shared; a load above 1 on 2 cores inflates the times of both engines alike).\n- Every run single-threaded, one after the other. rapier is built without its `parallel` feature. tetpbd's `parallel` feature (colour-class Gauss–Seidel on rayon) only parallelises a family with at least 4096 constraints, more than these meshes have (at most 1920 per family), so a parallel column would repeat the serial one; large bodies on 2 threads are measured by the `scaling` binary instead.\n", machine(), commit(), info.load_start, info.load_end);
+    let _ = writeln!(s, "- Machine: {}\n- Date: {date}\n- Commit: {}\n- Load average (1/5/15 min) at start: {}, at end: {} (the machine is shared; a load above 1 on 2 cores inflates the times of both engines alike).\n- Every run one after the other, single-threaded unless marked '2 threads'. rapier is built without its `parallel` feature. tetpbd's `parallel` feature (colour-class Gauss–Seidel on rayon) only parallelises a family with at least 4096 constraints, more than the meshes of scenes a, b, c and d have (at most 1920 per family per body), so for those a parallel column would repeat the serial one; {}\n", machine(), commit(), info.load_start, info.load_end, if cfg!(feature = "parallel") { "this run was built with it and adds a 12³-cell drop (c_drop_12, 10 368 tetrahedra) run by tetpbd on 1 and 2 threads (see 'Parallel' below)." } else { "this run was built without it (see 'Parallel' below); large bodies on 2 threads are also measured by the `scaling` binary." });
     let _ = writeln!(s, "![error vs time](plot.png)\n\nData: [results.csv](results.csv) (one row per run), [squash_volume.csv](squash_volume.csv) (volume error per frame of every squash run), drawn for one budget in [squash_volume.png](squash_volume.png).\n");
     let _ = writeln!(s, "## Headline (Pareto fronts)\n");
     let _ = writeln!(s, "Each engine's Pareto front is the set of its runs that no other run of the same engine beats in both median ms per frame and error. At each rapier front point we take tetpbd's cheapest run with an error at most rapier's (equal error) and tetpbd's most accurate run costing at most rapier's (equal time), and quote the medians over rapier's front: **speed** = rapier ms / tetpbd ms at equal error, **accuracy** = rapier error / tetpbd error at equal time; above 1 favours tetpbd. The hard models are the like-for-like comparison (same exact answer in both engines); 'all models' mixes materials that differ between the engines, each measured against its own reference.\n");

@@ -80,7 +80,11 @@ fn one(
 }
 
 /// The headline table lines (same columns as scenes a and b) and the detail paragraphs.
-pub fn headlines(details: &mut String, scenes: &[ContactScene], rows: &[ContactRow]) -> Vec<String> {
+pub fn headlines(
+    details: &mut String,
+    scenes: &[ContactScene],
+    rows: &[ContactRow],
+) -> Vec<String> {
     let mut out = Vec::new();
     for sc in scenes {
         let metrics: &[&Metric] = match sc.kind {
@@ -142,7 +146,8 @@ pub fn section(s: &mut String, scenes: &[ContactScene], rows: &[ContactRow]) {
     let _ = writeln!(s, "| scene | run | ms/frame | CPU ms | settled max\\|v\\| m/s | settle s | ground pen. at rest m | peak ground pen. m | interpen. at rest m | vol. err. at rest % | rest min y m | inverted (max) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for r in rows {
         let x = &r.res;
-        let _ = writeln!(
+        let _ =
+            writeln!(
             s,
             "| {} | {} | {:.3} | {:.3} | {:.2e} | {} | {:.2e} | {:.2e} | {} | {:.4} | {:.4} | {} |",
             r.scene,
@@ -168,9 +173,10 @@ pub fn section(s: &mut String, scenes: &[ContactScene], rows: &[ContactRow]) {
 fn same_budget(s: &mut String, scenes: &[ContactScene], rows: &[ContactRow]) {
     let _ = writeln!(s, "### Same substeps\n\nrapier `Constraints` with the hard volume model against tetpbd at the same substep count (one thread): rapier ms / tetpbd ms per frame, and each engine's observables.\n\n| scene | substeps | tetpbd run | speed-up | settled max\\|v\\| tetpbd / rapier | vol. err. % tetpbd / rapier | interpen. m tetpbd / rapier |\n|---|---:|---|---:|---|---|---|");
     for sc in scenes {
-        for t in rows.iter().filter(|r| {
-            r.scene == sc.name && r.engine.label() == "rapier Constraints Volume hard"
-        }) {
+        for t in rows
+            .iter()
+            .filter(|r| r.scene == sc.name && r.engine.label() == "rapier Constraints Volume hard")
+        {
             for o in rows.iter().filter(|r| {
                 r.scene == sc.name
                     && r.engine.engine() == "tetpbd"
@@ -221,9 +227,17 @@ fn all_at_once(s: &mut String, scenes: &[ContactScene], rows: &[ContactRow]) {
                 Some(o) => {
                     let q = t.res.ms_median / o.res.ms_median;
                     ratios.push(q);
-                    (o.describe(), format!("{:.3}", o.res.ms_median), format!("{q:.2}×"))
+                    (
+                        o.describe(),
+                        format!("{:.3}", o.res.ms_median),
+                        format!("{q:.2}×"),
+                    )
                 }
-                None => ("none in the sweep".to_string(), String::new(), String::new()),
+                None => (
+                    "none in the sweep".to_string(),
+                    String::new(),
+                    String::new(),
+                ),
             };
             let _ = writeln!(
                 s,
