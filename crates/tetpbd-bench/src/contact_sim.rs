@@ -18,7 +18,7 @@ use tetpbd_rapier::{
 
 use crate::clock::thread_cpu_ms;
 use crate::contact_scene::{ContactScene, GROUND_HALF_EXTENTS};
-use crate::rapier_setup::{lumped_masses, rapier_material, to_rapier};
+use crate::rapier_setup::{lumped_masses, rapier_label, rapier_material, to_rapier};
 use crate::DT;
 
 /// One engine set-up of the contact scenes, independent of substeps and iterations.
@@ -56,23 +56,7 @@ impl ContactEngine {
                 format!("tetpbd edges+volume α=0, damping {damping}/s")
             }
             ContactEngine::Tetpbd { .. } => "tetpbd edges+volume α=0, undamped".to_string(),
-            ContactEngine::Rapier { cell, solver, hard } => {
-                let c = match cell {
-                    SoftBodyCellModel::Volume => "Volume",
-                    SoftBodyCellModel::Corotational => "Corotational",
-                    SoftBodyCellModel::NeoHookean => "NeoHookean",
-                };
-                let s = match solver {
-                    SoftBodySolver::Constraints => "Constraints",
-                    SoftBodySolver::Fem => "Fem",
-                };
-                let k = match (cell, hard) {
-                    (SoftBodyCellModel::Volume, true) => " hard",
-                    (SoftBodyCellModel::Volume, false) => " 30Hz",
-                    _ => "",
-                };
-                format!("rapier {s} {c}{k}")
-            }
+            ContactEngine::Rapier { cell, solver, hard } => rapier_label(cell, solver, hard),
         }
     }
 }

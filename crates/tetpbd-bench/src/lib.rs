@@ -18,7 +18,8 @@ pub use contact_metrics::{
 pub use contact_scene::{ContactKind, ContactScene, GROUND_HALF_EXTENTS};
 pub use contact_sim::{build_contact, ContactEngine, ContactSim};
 pub use rapier_setup::{
-    lumped_masses, rapier_material, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON, RAPIER_YOUNG,
+    lumped_masses, rapier_label, rapier_material, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON,
+    RAPIER_YOUNG,
 };
 
 /// Frame time step of every benchmark run, s.

@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
-use rapier3d::prelude::{SoftBodyCellModel, SoftBodyMaterial, SpringCoefficients};
+use rapier3d::prelude::{SoftBodyCellModel, SoftBodyMaterial, SoftBodySolver, SpringCoefficients};
 use tetpbd::TetMesh;
 
 /// Young's modulus of rapier's elastic cell models, Pa.
@@ -55,4 +55,24 @@ pub fn lumped_masses(mesh: &TetMesh, density: f32) -> Vec<f32> {
 /// A nalgebra vector as rapier's.
 pub fn to_rapier(v: &Vector3<f32>) -> Vector {
     Vector::new(v.x, v.y, v.z)
+}
+
+/// The label of a rapier set-up in every report: `rapier <solver> <cell model>`, with ` hard`
+/// or ` 30Hz` for the volume model.
+pub fn rapier_label(cell: SoftBodyCellModel, solver: SoftBodySolver, hard: bool) -> String {
+    let c = match cell {
+        SoftBodyCellModel::Volume => "Volume",
+        SoftBodyCellModel::Corotational => "Corotational",
+        SoftBodyCellModel::NeoHookean => "NeoHookean",
+    };
+    let s = match solver {
+        SoftBodySolver::Constraints => "Constraints",
+        SoftBodySolver::Fem => "Fem",
+    };
+    let k = match (cell, hard) {
+        (SoftBodyCellModel::Volume, true) => " hard",
+        (SoftBodyCellModel::Volume, false) => " 30Hz",
+        _ => "",
+    };
+    format!("rapier {s} {c}{k}")
 }

@@ -15,7 +15,8 @@ use tetpbd::{
 };
 
 use tetpbd_bench::{
-    rapier_material, thread_cpu_ms, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON, RAPIER_YOUNG,
+    rapier_label, rapier_material, thread_cpu_ms, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON,
+    RAPIER_YOUNG,
 };
 
 use crate::scenes::{Scene, DT};
@@ -78,23 +79,7 @@ impl Model {
                 };
                 format!("tetpbd {s} {}", if soft { "soft" } else { "α=0" })
             }
-            Model::Rapier { cell, solver, hard } => {
-                let c = match cell {
-                    SoftBodyCellModel::Volume => "Volume",
-                    SoftBodyCellModel::Corotational => "Corotational",
-                    SoftBodyCellModel::NeoHookean => "NeoHookean",
-                };
-                let s = match solver {
-                    SoftBodySolver::Constraints => "Constraints",
-                    SoftBodySolver::Fem => "Fem",
-                };
-                let k = match (cell, hard) {
-                    (SoftBodyCellModel::Volume, true) => " hard",
-                    (SoftBodyCellModel::Volume, false) => " 30Hz",
-                    _ => "",
-                };
-                format!("rapier {s} {c}{k}")
-            }
+            Model::Rapier { cell, solver, hard } => rapier_label(cell, solver, hard),
         }
     }
 

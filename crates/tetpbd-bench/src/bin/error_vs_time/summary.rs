@@ -123,6 +123,20 @@ pub struct Brief {
     pub points: usize,
 }
 
+/// One line of the headline table: by wall time (`b`) and by CPU time (`c`).
+pub fn brief_row(scene: &str, hard: bool, metric: &str, b: &Brief, c: &Brief) -> String {
+    let f = |x: Option<f64>| x.map(sig).unwrap_or_else(|| "n/a".to_string());
+    format!(
+        "| {scene} | {} | {metric} | **{}** | **{}** | {} | {} | {} |",
+        if hard { "hard" } else { "all" },
+        f(b.speed),
+        f(b.gain),
+        b.points,
+        f(c.speed),
+        f(c.gain)
+    )
+}
+
 /// The headline paragraph and table for one scene, one metric and one selection of rows.
 fn headline(
     s: &mut String,
@@ -298,18 +312,7 @@ pub fn markdown(
         for (m, hard) in cases {
             let b = headline(&mut details, rows, scene.name, m, *hard, false);
             let c = headline(&mut String::new(), rows, scene.name, m, *hard, true);
-            let f = |x: Option<f64>| x.map(sig).unwrap_or_else(|| "n/a".to_string());
-            briefs.push(format!(
-                "| {} | {} | {} | **{}** | **{}** | {} | {} | {} |",
-                scene.name,
-                if *hard { "hard" } else { "all" },
-                m.name,
-                f(b.speed),
-                f(b.gain),
-                b.points,
-                f(c.speed),
-                f(c.gain)
-            ));
+            briefs.push(brief_row(scene.name, *hard, m.name, &b, &c));
         }
     }
     briefs.extend(crate::summary_contacts::headlines(

@@ -8,7 +8,7 @@ use tetpbd_bench::{ContactKind, ContactScene, SETTLED_SPEED};
 
 use crate::contacts::ContactRow;
 use crate::pareto::{compare, median, Point};
-use crate::summary::{pareto_text, sig, Brief};
+use crate::summary::{brief_row, pareto_text, sig, Brief};
 
 /// A named error observable of a contact run.
 struct Metric {
@@ -99,18 +99,7 @@ pub fn headlines(
                 }
                 let b = one(details, rows, sc.name, m, hard, false);
                 let c = one(&mut String::new(), rows, sc.name, m, hard, true);
-                let f = |x: Option<f64>| x.map(sig).unwrap_or_else(|| "n/a".to_string());
-                out.push(format!(
-                    "| {} | {} | {} | **{}** | **{}** | {} | {} | {} |",
-                    sc.name,
-                    if hard { "hard" } else { "all" },
-                    m.name,
-                    f(b.speed),
-                    f(b.gain),
-                    b.points,
-                    f(c.speed),
-                    f(c.gain)
-                ));
+                out.push(brief_row(sc.name, hard, m.name, &b, &c));
             }
         }
     }
