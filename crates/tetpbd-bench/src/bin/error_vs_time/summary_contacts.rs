@@ -17,11 +17,11 @@ struct Metric {
 }
 
 const SPEED: Metric = Metric {
-    name: "settled max |v| (m/s, last 0.5 s)",
+    name: "settled max \\|v\\| (m/s, last 0.5 s)",
     f: |r| f64::from(r.res.settled_speed),
 };
 const VOLUME: Metric = Metric {
-    name: "largest |volume error| of a body at rest (%)",
+    name: "largest \\|volume error\\| of a body at rest (%)",
     f: |r| f64::from(r.res.rest_volume_err_pct),
 };
 const INTER: Metric = Metric {
