@@ -14,8 +14,9 @@
 //! tetpbd undamped and with `DeformationDamping` 5/s (rapier's springs are critically damped)
 //! at 5 to 80; per rapier run: the ratio at the same substeps, tetpbd's cheapest run at least
 //! as accurate as rapier's on every one of those observables, and the cheapest at equal or
-//! better volume error alone: the speed-ups at equal or better error. Interpenetration: depth of a surface particle of one body inside
-//! another's tetrahedra; settled max |v| from positions (displacement over a frame / dt).
+//! better volume error alone: the speed-ups at equal or better error. Interpenetration: depth
+//! of a surface particle of one body inside another's tetrahedra; settled max |v| from
+//! positions (displacement over a frame / dt).
 
 use tetpbd_bench::{build_contact, run_contact, ContactEngine, ContactResult, ContactScene, DT};
 
