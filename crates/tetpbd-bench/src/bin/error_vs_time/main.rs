@@ -4,7 +4,8 @@
 //! issue 5: a) a hanging beam settling to static equilibrium, b) a block squashed to 50 %
 //! height and released, c) a soft cube dropped onto rigid ground, d) a pile of nine cubes
 //! (soft–soft contacts). Writes `docs/error-vs-time/` (results.csv, contacts.csv,
-//! squash_volume.csv, plot.png, plot.svg, squash_volume.png, squash_volume.svg, summary.md);
+//! squash_volume.csv, plot.png, plot.svg, contacts.png, contacts.svg, squash_volume.png,
+//! squash_volume.svg, summary.md);
 //! `--quick` (a smoke run) writes `target/error-vs-time-quick/`. With `--features parallel`
 //! the contact sweep adds a 12³-cell drop run by tetpbd on 1 and 2 threads.
 
@@ -13,6 +14,7 @@ mod engines;
 mod metrics;
 mod pareto;
 mod plot;
+mod plot_contacts;
 mod plot_volume;
 mod report;
 mod scenes;

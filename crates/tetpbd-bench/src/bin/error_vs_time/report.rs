@@ -256,6 +256,7 @@ pub fn write_all(
     )?;
     crate::plot::draw(out, scenes, rows).map_err(io::Error::other)?;
     crate::plot_volume::draw(out, rows, squash).map_err(io::Error::other)?;
+    crate::plot_contacts::draw(out, contacts.0, contacts.1).map_err(io::Error::other)?;
     let md = crate::summary::markdown(scenes, rows, references, contacts, info);
     fs::write(out.join("summary.md"), md)
 }

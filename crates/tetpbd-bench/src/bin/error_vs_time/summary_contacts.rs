@@ -109,7 +109,10 @@ pub fn headlines(
 /// The section on scenes c and d: set-up, model differences, every-observable comparison and
 /// every run.
 pub fn section(s: &mut String, scenes: &[ContactScene], rows: &[ContactRow]) {
-    let _ = writeln!(s, "## Contact scenes c) and d)\n");
+    let _ = writeln!(
+        s,
+        "## Contact scenes c) and d)\n\n![contact scenes](contacts.png)\n"
+    );
     for sc in scenes {
         let what = match sc.kind {
             ContactKind::Drop => format!("one 1 m cube (`generators::box_grid`, {c}×{c}×{c} cells, six tetrahedra per cell), its bottom 5 cm above a fixed rigid ground cuboid (top face at y = 0), released at rest under gravity −9.81 m/s²", c = sc.cells),
