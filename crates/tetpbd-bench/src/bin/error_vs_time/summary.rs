@@ -324,6 +324,7 @@ pub fn markdown(
     for b in &briefs {
         let _ = writeln!(s, "{b}");
     }
+    crate::summary_contacts::unsettled(&mut s, contacts.1);
     let mut spread: Vec<f64> = rows
         .iter()
         .map(|r| r.timing_spread)

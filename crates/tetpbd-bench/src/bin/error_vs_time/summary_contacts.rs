@@ -293,3 +293,37 @@ fn parallel(s: &mut String, rows: &[ContactRow]) {
     }
     let _ = writeln!(s);
 }
+
+/// The contact runs that did not come to rest: settled max |v| at or above
+/// [`SETTLED_SPEED`], a particle below the ground in the resting phase, or a non-finite
+/// position. Their errors enter the Pareto comparisons as they are (a blown-up run is a
+/// large error), which makes the accuracy ratios there very large.
+pub fn unsettled(s: &mut String, rows: &[ContactRow]) {
+    let bad: Vec<String> = rows
+        .iter()
+        .filter(|r| {
+            !r.res.finite || r.res.settled_speed >= SETTLED_SPEED || r.res.rest_penetration > 0.0
+        })
+        .map(|r| {
+            format!(
+                "{} {} (max \\|v\\| {:.2e} m/s, ground penetration {:.2e} m, volume error {:.3} %)",
+                r.scene,
+                r.describe(),
+                r.res.settled_speed,
+                r.res.rest_penetration,
+                r.res.rest_volume_err_pct
+            )
+        })
+        .collect();
+    if bad.is_empty() {
+        let _ = writeln!(s, "\nEvery contact run came to rest (settled max |v| below {SETTLED_SPEED} m/s, no particle below the ground).");
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "\nContact runs that did not come to rest (settled max |v| at or above {SETTLED_SPEED} m/s, a particle below the ground at rest, or non-finite), {} of {}; their errors count as they are, so where rapier's front holds such a run the accuracy ratio is very large: {}.",
+        bad.len(),
+        rows.len(),
+        bad.join("; ")
+    );
+}
