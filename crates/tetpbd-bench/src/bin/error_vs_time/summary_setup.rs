@@ -157,7 +157,7 @@ fn convergence(s: &mut String, references: &[(&'static str, Model, u32, f32)]) {
             hi.2
         );
     }
-    let _ = writeln!(s, "\nWhy 1e-6 is not reached: both engines compute in f32, whose spacing at 1 m is 1.2e-7 m (2.4e-7 m at the beam's 2 m), so 1e-6 of the body size is a handful of ulps; doubling the substeps changes every rounding of a run of thousands of substeps, and the sums of those roundings alone move the answer by about that much. Below about 1e-5 a change between two references is rounding, not discretisation. Dynamic runs drift further than static ones, because a released soft block's oscillation phase keeps moving with the substep count (XPBD's discretisation error shrinks only like 1/substeps), and the doubling stops at its cap; the per-scene ranges below come from this run. The hard models need no numerical reference: their exact answer is known.\n");
+    let _ = writeln!(s, "\nWhy 1e-6 is not reached: both engines compute in f32, whose spacing at 1 m is 1.2e-7 m (2.4e-7 m at the beam's 2 m), so 1e-6 of the body size is a handful of ulps; doubling the substeps changes every rounding of a run of thousands of substeps, and the sums of those roundings alone move the answer by about that much. A change near 1e-6 therefore cannot be told apart from rounding. Dynamic runs drift further than static ones, because a released soft block's oscillation phase keeps moving with the substep count (XPBD's discretisation error shrinks only like 1/substeps), and the doubling stops at its cap; the per-scene ranges below come from this run. The hard models need no numerical reference: their exact answer is known.\n");
     let mut scenes: Vec<&str> = Vec::new();
     for r in &numeric {
         if !scenes.contains(&r.0) {
