@@ -1,33 +1,29 @@
-//! Command-line helpers shared by the benchmark binaries.
+//! Code shared by the tetpbd-bench binaries: command-line helpers (`projections`, `scaling`)
+//! and, for `error_vs_time` and `vs_rapier`, how rapier's built-in soft bodies are set up next
+//! to tetpbd's, the contact scenes (a soft cube dropped on rigid ground, a pile of nine cubes)
+//! in both engines, and the observables measured the same way from either engine's particle
+//! positions.
 #![warn(missing_docs)]
 
-/// The value after `name` on the command line parsed as a number, or `default`.
-pub fn arg(name: &str, default: usize) -> usize {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+mod args;
+mod clock;
+mod contact_metrics;
+mod contact_scene;
+mod contact_sim;
+mod rapier_setup;
 
-/// `true` when `name` is on the command line.
-pub fn flag(name: &str) -> bool {
-    std::env::args().any(|a| a == name)
-}
+pub use args::{arg, flag, orders};
+pub use clock::thread_cpu_ms;
+pub use contact_metrics::{
+    interpenetration, observe_contact, run_contact, ContactObservables, ContactResult,
+    SETTLED_SPEED,
+};
+pub use contact_scene::{ContactKind, ContactScene, GROUND_HALF_EXTENTS};
+pub use contact_sim::{build_contact, ContactEngine, ContactSim};
+pub use rapier_setup::{
+    lumped_masses, rapier_label, rapier_material, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON,
+    RAPIER_YOUNG,
+};
 
-/// The particle orders to measure, from `--spatial-order on|off|both` (default: the
-/// builder's default, [`tetpbd::SoftBodyBuilder::DEFAULT_SPATIAL_ORDER`]).
-pub fn orders() -> Vec<bool> {
-    let args: Vec<String> = std::env::args().collect();
-    let value = args
-        .iter()
-        .position(|a| a == "--spatial-order")
-        .and_then(|i| args.get(i + 1));
-    match value.map(String::as_str) {
-        Some("on") => vec![true],
-        Some("off") => vec![false],
-        Some("both") => vec![false, true],
-        _ => vec![tetpbd::SoftBodyBuilder::DEFAULT_SPATIAL_ORDER],
-    }
-}
+/// Frame time step of every benchmark run, s.
+pub const DT: f32 = 1.0 / 60.0;

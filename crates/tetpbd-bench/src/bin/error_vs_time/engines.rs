@@ -7,14 +7,17 @@ use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{
     PhysicsWorld, SoftBodyBuilder as RapierBuilder, SoftBodyCellModel, SoftBodyHandle,
-    SoftBodyMaterial, SoftBodySolver, SpringCoefficients,
+    SoftBodySolver,
 };
 use tetpbd::systems::{self, Measured};
 use tetpbd::{
     hecs, ErrorStats, Family, Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats,
 };
 
-use crate::clock::thread_cpu_ms;
+use tetpbd_bench::{
+    rapier_label, rapier_material, thread_cpu_ms, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON,
+    RAPIER_YOUNG,
+};
 
 use crate::scenes::{Scene, DT};
 
@@ -22,13 +25,6 @@ use crate::scenes::{Scene, DT};
 pub const SOFT_LENGTH_COMPLIANCE: f32 = 1e-7;
 /// Soft compliance of the volume constraints, m⁵/N.
 pub const SOFT_VOLUME_COMPLIANCE: f32 = 1e-11;
-/// Young's modulus of rapier's elastic cell models, Pa.
-pub const RAPIER_YOUNG: f32 = 1e8;
-/// Poisson's ratio of rapier's elastic cell models.
-pub const RAPIER_POISSON: f32 = 0.3;
-/// Natural frequency standing for "hard" in rapier's frequency-based softness, Hz (rapier's own
-/// default for joints; a frequency above the substep rate saturates instead of exploding).
-pub const RAPIER_HARD_HZ: f32 = 1.0e6;
 
 /// The constraint sets of tetpbd that are swept.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -83,23 +79,7 @@ impl Model {
                 };
                 format!("tetpbd {s} {}", if soft { "soft" } else { "α=0" })
             }
-            Model::Rapier { cell, solver, hard } => {
-                let c = match cell {
-                    SoftBodyCellModel::Volume => "Volume",
-                    SoftBodyCellModel::Corotational => "Corotational",
-                    SoftBodyCellModel::NeoHookean => "NeoHookean",
-                };
-                let s = match solver {
-                    SoftBodySolver::Constraints => "Constraints",
-                    SoftBodySolver::Fem => "Fem",
-                };
-                let k = match (cell, hard) {
-                    (SoftBodyCellModel::Volume, true) => " hard",
-                    (SoftBodyCellModel::Volume, false) => " 30Hz",
-                    _ => "",
-                };
-                format!("rapier {s} {c}{k}")
-            }
+            Model::Rapier { cell, solver, hard } => rapier_label(cell, solver, hard),
         }
     }
 
@@ -286,31 +266,13 @@ impl Rapier {
         world.gravity = Vector::new(0.0, scene.gravity, 0.0);
         world.integration_parameters.dt = DT;
         world.integration_parameters.num_solver_iterations = substeps as usize;
-        let to_rapier = |v: &Vector3<f32>| Vector::new(v.x, v.y, v.z);
-        let material = match (cell, hard) {
-            (SoftBodyCellModel::Volume, true) => {
-                let k = SpringCoefficients::new(RAPIER_HARD_HZ, 1.0);
-                SoftBodyMaterial {
-                    edge_softness: k,
-                    volume_softness: k,
-                    ..Default::default()
-                }
-            }
-            (SoftBodyCellModel::Volume, false) => SoftBodyMaterial::default(),
-            _ => SoftBodyMaterial {
-                young_modulus: RAPIER_YOUNG,
-                poisson_ratio: RAPIER_POISSON,
-                elastic_damping_ratio: 1.0,
-                ..Default::default()
-            },
-        };
         let mut b = RapierBuilder::new(scene.mesh.vertices.iter().map(to_rapier).collect())
             .cells(scene.mesh.tets.clone())
-            .masses(scene.masses())
+            .masses(tetpbd_bench::lumped_masses(&scene.mesh, scene.density))
             .pinned_particles(scene.pinned.iter().copied())
             .cell_model(cell)
             .solver(solver)
-            .material(material)
+            .material(rapier_material(cell, hard))
             .linear_damping(scene.damping)
             .no_surface_collider()
             .can_sleep(false);

@@ -1,20 +1,25 @@
 //! `cargo run --release -p tetpbd-bench --bin error_vs_time [-- [--quick] [--out DIR]]`
 //!
 //! Error against run time, tetpbd next to rapier 0.36's built-in soft bodies, on the scenes of
-//! issue 5 that need no contacts: a) a hanging beam settling to static equilibrium, b) a block
-//! squashed to 50 % height and released. Writes `docs/error-vs-time/` (results.csv,
-//! squash_volume.csv, plot.png, plot.svg, squash_volume.png, squash_volume.svg,
-//! summary.md); `--quick` (a smoke run of about 10 s) writes `target/error-vs-time-quick/`.
+//! issue 5: a) a hanging beam settling to static equilibrium, b) a block squashed to 50 %
+//! height and released, c) a soft cube dropped onto rigid ground, d) a pile of nine cubes
+//! (soft–soft contacts). Writes `docs/error-vs-time/` (results.csv, contacts.csv,
+//! squash_volume.csv, plot.png, plot.svg, contacts.png, contacts.svg, squash_volume.png,
+//! squash_volume.svg, summary.md);
+//! `--quick` (a smoke run) writes `target/error-vs-time-quick/`. With `--features parallel`
+//! the contact sweep adds a 12³-cell drop run by tetpbd on 1 and 2 threads.
 
-mod clock;
+mod contacts;
 mod engines;
 mod metrics;
 mod pareto;
 mod plot;
+mod plot_contacts;
 mod plot_volume;
 mod report;
 mod scenes;
 mod summary;
+mod summary_contacts;
 mod summary_setup;
 
 use std::path::PathBuf;
@@ -209,6 +214,20 @@ fn main() {
             references.push((scene.name, model, r.substeps, r.change));
         }
     }
+    let contact_scenes = match contacts::scenes(args.quick) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("contact scenes: {e}");
+            std::process::exit(1);
+        }
+    };
+    let contact_rows = match contacts::sweep(&contact_scenes, args.quick) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("contact sweep: {e}");
+            std::process::exit(1);
+        }
+    };
     let elapsed = started.elapsed().as_secs_f64();
     let info = report::RunInfo {
         quick: args.quick,
@@ -216,7 +235,14 @@ fn main() {
         load_start,
         load_end: report::load_average(),
     };
-    if let Err(e) = report::write_all(&args.out, &scenes, &rows, &references, &info) {
+    if let Err(e) = report::write_all(
+        &args.out,
+        &scenes,
+        &rows,
+        &references,
+        (&contact_scenes, &contact_rows),
+        &info,
+    ) {
         eprintln!("writing {}: {e}", args.out.display());
         std::process::exit(1);
     }

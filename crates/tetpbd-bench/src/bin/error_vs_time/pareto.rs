@@ -46,10 +46,12 @@ impl Match {
         self.at_equal_error.map(|o| self.theirs.ms / o.ms)
     }
 
-    /// How many times smaller our error is at equal time.
+    /// How many times smaller our error is at equal time (1 when both are exactly 0).
     pub fn accuracy_gain(&self) -> Option<f64> {
-        self.at_equal_time
-            .map(|o| self.theirs.err / o.err.max(f64::MIN_POSITIVE))
+        self.at_equal_time.map(|o| match (self.theirs.err, o.err) {
+            (t, e) if t == 0.0 && e == 0.0 => 1.0,
+            (t, e) => t / e.max(f64::MIN_POSITIVE),
+        })
     }
 }
 
@@ -120,5 +122,7 @@ mod tests {
         assert_eq!(m[1].speedup(), Some(2.0));
         assert!((m[1].accuracy_gain().unwrap() - 2.0).abs() < 1e-12);
         assert_eq!(median(vec![3.0, 1.0, 2.0, f64::NAN]), Some(2.0));
+        let zero = compare(&[p(1.0, 0.0, 0)], &[p(2.0, 0.0, 1)]);
+        assert_eq!(zero[0].accuracy_gain(), Some(1.0));
     }
 }

@@ -166,7 +166,8 @@ fn value(panel: &Panel, r: &Row) -> Option<(f64, f64)> {
     (r.ms.is_finite() && r.ms > 0.0 && y.is_finite()).then(|| (r.ms, y.max(FLOOR)))
 }
 
-fn bounds(points: &[(f64, f64)]) -> ((f64, f64), (f64, f64)) {
+/// Log-axis ranges around `points` (padded by 1.6× each way).
+pub fn bounds(points: &[(f64, f64)]) -> ((f64, f64), (f64, f64)) {
     let fold = |f: fn(&(f64, f64)) -> f64| {
         points
             .iter()

@@ -1,4 +1,5 @@
-//! The rows of the report and the files written from them: results.csv, squash_volume.csv,
+//! The rows of the report and the files written from them: results.csv, contacts.csv (see
+//! [`crate::contacts`]), squash_volume.csv,
 //! the plot (see [`crate::plot`]) and summary.md (see [`crate::summary`]).
 
 use std::fmt::Write as _;
@@ -6,6 +7,9 @@ use std::fs;
 use std::io;
 use std::path::Path;
 
+use tetpbd_bench::ContactScene;
+
+use crate::contacts::{contacts_csv, ContactRow};
 use crate::engines::Model;
 use crate::metrics::{Deviation, Reference, RunResult};
 use crate::scenes::{Scene, DT};
@@ -235,10 +239,12 @@ pub fn write_all(
     scenes: &[Scene],
     rows: &[Row],
     references: &[(&'static str, Model, u32, f32)],
+    contacts: (&[ContactScene], &[ContactRow]),
     info: &RunInfo,
 ) -> io::Result<()> {
     fs::create_dir_all(out)?;
     fs::write(out.join("results.csv"), results_csv(rows))?;
+    fs::write(out.join("contacts.csv"), contacts_csv(contacts.1))?;
     let squash = scenes
         .iter()
         .find(|s| s.kind == crate::scenes::SceneKind::Squash)
@@ -250,6 +256,7 @@ pub fn write_all(
     )?;
     crate::plot::draw(out, scenes, rows).map_err(io::Error::other)?;
     crate::plot_volume::draw(out, rows, squash).map_err(io::Error::other)?;
-    let md = crate::summary::markdown(scenes, rows, references, info);
+    crate::plot_contacts::draw(out, contacts.0, contacts.1).map_err(io::Error::other)?;
+    let md = crate::summary::markdown(scenes, rows, references, contacts, info);
     fs::write(out.join("summary.md"), md)
 }

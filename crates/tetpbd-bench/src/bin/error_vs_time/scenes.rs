@@ -47,8 +47,7 @@ pub struct Scene {
     pub rest_volumes: Vec<f32>,
 }
 
-/// Frame time step of every run, s.
-pub const DT: f32 = 1.0 / 60.0;
+pub use tetpbd_bench::DT;
 
 impl Scene {
     /// a) A 2 m × 0.2 m × 0.2 m beam, 20 × 2 × 2 cells of six tetrahedra, pinned at x = 0,
@@ -132,17 +131,6 @@ impl Scene {
             rest_lengths,
             rest_volumes,
         }
-    }
-
-    /// Lumped particle masses, kg: `density · |V| / 4` per tetrahedron corner.
-    pub fn masses(&self) -> Vec<f32> {
-        let mut m = vec![0.0; self.mesh.vertices.len()];
-        for (t, v) in self.mesh.tets.iter().zip(&self.rest_volumes) {
-            for &i in t {
-                m[i as usize] += self.density * v.abs() / 4.0;
-            }
-        }
-        m
     }
 }
 

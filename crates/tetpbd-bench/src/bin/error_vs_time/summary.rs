@@ -4,8 +4,11 @@
 use std::fmt::Write as _;
 use std::process::Command;
 
+use tetpbd_bench::ContactScene;
+
+use crate::contacts::ContactRow;
 use crate::engines::Model;
-use crate::pareto::{compare, median, Point};
+use crate::pareto::{compare, median, Match, Point};
 use crate::report::{Row, RunInfo};
 use crate::scenes::{Scene, SceneKind};
 
@@ -97,7 +100,7 @@ fn points(rows: &[Row], idx: &[usize], m: &Metric, cpu: bool) -> Vec<Point> {
 }
 
 /// Three significant digits, without an exponent for ordinary ratios.
-fn sig(x: f64) -> String {
+pub fn sig(x: f64) -> String {
     match x.abs() {
         a if a >= 1e5 || (a < 1e-2 && a > 0.0) => format!("{x:.2e}"),
         a if a >= 100.0 => format!("{x:.0}"),
@@ -110,17 +113,31 @@ fn describe(r: &Row) -> String {
     format!("{} {}", r.model.label(), r.budget())
 }
 
-/// The headline paragraph and table for one scene, one metric and one selection of rows.
 /// The medians of one headline comparison.
-struct Brief {
+pub struct Brief {
     /// Median of rapier ms / tetpbd ms at equal error.
-    speed: Option<f64>,
+    pub speed: Option<f64>,
     /// Median of rapier error / tetpbd error at equal time.
-    gain: Option<f64>,
+    pub gain: Option<f64>,
     /// rapier Pareto points.
-    points: usize,
+    pub points: usize,
 }
 
+/// One line of the headline table: by wall time (`b`) and by CPU time (`c`).
+pub fn brief_row(scene: &str, hard: bool, metric: &str, b: &Brief, c: &Brief) -> String {
+    let f = |x: Option<f64>| x.map(sig).unwrap_or_else(|| "n/a".to_string());
+    format!(
+        "| {scene} | {} | {metric} | **{}** | **{}** | {} | {} | {} |",
+        if hard { "hard" } else { "all" },
+        f(b.speed),
+        f(b.gain),
+        b.points,
+        f(c.speed),
+        f(c.gain)
+    )
+}
+
+/// The headline paragraph and table for one scene, one metric and one selection of rows.
 fn headline(
     s: &mut String,
     rows: &[Row],
@@ -145,13 +162,6 @@ fn headline(
         &points(rows, &sel("tetpbd"), m, cpu),
         &points(rows, &sel("rapier"), m, cpu),
     );
-    let speed: Vec<f64> = matches.iter().filter_map(|x| x.speedup()).collect();
-    let gain: Vec<f64> = matches.iter().filter_map(|x| x.accuracy_gain()).collect();
-    let range = |v: &[f64]| {
-        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        format!("{}–{}", sig(lo), sig(hi))
-    };
     let which = if hard_only {
         "hard models only"
     } else {
@@ -178,6 +188,19 @@ fn headline(
             );
         }
     }
+    pareto_text(s, &matches, &|i| describe(&rows[i]))
+}
+
+/// The medians and the table of one comparison at rapier's Pareto points; `describe(i)` names
+/// the run behind point row `i`.
+pub fn pareto_text(s: &mut String, matches: &[Match], describe: &dyn Fn(usize) -> String) -> Brief {
+    let speed: Vec<f64> = matches.iter().filter_map(|x| x.speedup()).collect();
+    let gain: Vec<f64> = matches.iter().filter_map(|x| x.accuracy_gain()).collect();
+    let range = |v: &[f64]| {
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        format!("{}–{}", sig(lo), sig(hi))
+    };
     match median(speed.clone()) {
         Some(x) => {
             let _ = writeln!(
@@ -217,11 +240,10 @@ fn headline(
     }
     let _ = writeln!(s, "| rapier Pareto point | ms | error | tetpbd at equal error | ms | speed-up | tetpbd at equal time | error | gain |");
     let _ = writeln!(s, "|---|---:|---:|---|---:|---:|---|---:|---:|");
-    for x in &matches {
-        let t = &rows[x.theirs.row];
+    for x in matches {
         let (ee, ee_ms, sp) = match x.at_equal_error {
             Some(p) => (
-                describe(&rows[p.row]),
+                describe(p.row),
                 format!("{:.3}", p.ms),
                 format!("{:.2}×", x.theirs.ms / p.ms),
             ),
@@ -229,16 +251,16 @@ fn headline(
         };
         let (et, et_err, g) = match x.at_equal_time {
             Some(p) => (
-                describe(&rows[p.row]),
+                describe(p.row),
                 format!("{:.2e}", p.err),
-                format!("{}×", sig(x.theirs.err / p.err.max(f64::MIN_POSITIVE))),
+                format!("{}×", sig(x.accuracy_gain().unwrap_or(f64::NAN))),
             ),
             None => ("—".into(), String::new(), String::new()),
         };
         let _ = writeln!(
             s,
             "| {} | {:.3} | {:.2e} | {ee} | {ee_ms} | {sp} | {et} | {et_err} | {g} |",
-            describe(t),
+            describe(x.theirs.row),
             x.theirs.ms,
             x.theirs.err
         );
@@ -256,6 +278,7 @@ pub fn markdown(
     scenes: &[Scene],
     rows: &[Row],
     references: &[(&'static str, Model, u32, f32)],
+    contacts: (&[ContactScene], &[ContactRow]),
     info: &RunInfo,
 ) -> String {
     let (quick, elapsed_s) = (info.quick, info.elapsed_s);
@@ -266,12 +289,12 @@ pub fn markdown(
         s,
         "# Error against run time: tetpbd vs rapier 0.36 soft bodies\n"
     );
-    let _ = writeln!(s, "Regenerate: `cargo run --release -p tetpbd-bench --bin error_vs_time{}` (this run took {elapsed_s:.0} s).\n", if quick { " -- --quick" } else { "" });
+    let _ = writeln!(s, "Regenerate: `cargo run --release -p tetpbd-bench{} --bin error_vs_time{}` (this run took {elapsed_s:.0} s).\n", if cfg!(feature = "parallel") { " --features parallel" } else { "" }, if quick { " -- --quick" } else { "" });
     if quick {
         let _ = writeln!(s, "**This is a `--quick` smoke run: fewer models, budgets, frames and a cheaper reference. Do not quote it.**\n");
     }
-    let _ = writeln!(s, "- Machine: {}\n- Date: {date}\n- Commit: {}\n- Load average (1/5/15 min) at start: {}, at end: {} (the machine is shared; a load above 1 on 2 cores inflates the times of both engines alike).\n- Every run single-threaded, one after the other. rapier is built without its `parallel` feature. tetpbd's `parallel` feature (colour-class Gauss–Seidel on rayon) only parallelises a family with at least 4096 constraints, more than these meshes have (at most 1920 per family), so a parallel column would repeat the serial one; large bodies on 2 threads are measured by the `scaling` binary instead.\n", machine(), commit(), info.load_start, info.load_end);
-    let _ = writeln!(s, "![error vs time](plot.png)\n\nData: [results.csv](results.csv) (one row per run), [squash_volume.csv](squash_volume.csv) (volume error per frame of every squash run), drawn for one budget in [squash_volume.png](squash_volume.png).\n");
+    let _ = writeln!(s, "- Machine: {}\n- Date: {date}\n- Commit: {}\n- Load average (1/5/15 min) at start: {}, at end: {} (the machine is shared; a load above 1 on 2 cores inflates the times of both engines alike).\n- Every run one after the other, single-threaded unless marked '2 threads'. rapier is built without its `parallel` feature. tetpbd's `parallel` feature (colour-class Gauss–Seidel on rayon) only parallelises a family with at least 4096 constraints, more than the meshes of scenes a, b, c and d have (at most 1920 per family per body), so for those a parallel column would repeat the serial one; {}\n", machine(), commit(), info.load_start, info.load_end, if cfg!(feature = "parallel") { "this run was built with it and adds a 12³-cell drop (c_drop_12, 10 368 tetrahedra) run by tetpbd on 1 and 2 threads (see 'Parallel' below)." } else { "this run was built without it (see 'Parallel' below); large bodies on 2 threads are also measured by the `scaling` binary." });
+    let _ = writeln!(s, "![error vs time](plot.png)\n\nData: [results.csv](results.csv) (one row per run of scenes a and b), [contacts.csv](contacts.csv) (one row per run of scenes c and d), [squash_volume.csv](squash_volume.csv) (volume error per frame of every squash run), drawn for one budget in [squash_volume.png](squash_volume.png).\n");
     let _ = writeln!(s, "## Headline (Pareto fronts)\n");
     let _ = writeln!(s, "Each engine's Pareto front is the set of its runs that no other run of the same engine beats in both median ms per frame and error. At each rapier front point we take tetpbd's cheapest run with an error at most rapier's (equal error) and tetpbd's most accurate run costing at most rapier's (equal time), and quote the medians over rapier's front: **speed** = rapier ms / tetpbd ms at equal error, **accuracy** = rapier error / tetpbd error at equal time; above 1 favours tetpbd. The hard models are the like-for-like comparison (same exact answer in both engines); 'all models' mixes materials that differ between the engines, each measured against its own reference.\n");
     let mut details = String::new();
@@ -289,24 +312,19 @@ pub fn markdown(
         for (m, hard) in cases {
             let b = headline(&mut details, rows, scene.name, m, *hard, false);
             let c = headline(&mut String::new(), rows, scene.name, m, *hard, true);
-            let f = |x: Option<f64>| x.map(sig).unwrap_or_else(|| "n/a".to_string());
-            briefs.push(format!(
-                "| {} | {} | {} | **{}** | **{}** | {} | {} | {} |",
-                scene.name,
-                if *hard { "hard" } else { "all" },
-                m.name,
-                f(b.speed),
-                f(b.gain),
-                b.points,
-                f(c.speed),
-                f(c.gain)
-            ));
+            briefs.push(brief_row(scene.name, *hard, m.name, &b, &c));
         }
     }
+    briefs.extend(crate::summary_contacts::headlines(
+        &mut details,
+        contacts.0,
+        contacts.1,
+    ));
     let _ = writeln!(s, "| scene | models | error | speed at equal error | accuracy at equal time | rapier front points | speed, by CPU time | accuracy, by CPU time |\n|---|---|---|---:|---:|---:|---:|---:|");
     for b in &briefs {
         let _ = writeln!(s, "{b}");
     }
+    crate::summary_contacts::unsettled(&mut s, contacts.1);
     let mut spread: Vec<f64> = rows
         .iter()
         .map(|r| r.timing_spread)
@@ -319,5 +337,6 @@ pub fn markdown(
     let _ = writeln!(s, "\nThe last two columns repeat the comparison with each run's median thread CPU time per frame instead of its wall time (both engines run on the calling thread): on a loaded machine they show how much of the wall-time figure is contention.");
     let _ = writeln!(s, "\n### Details\n\n{details}");
     crate::summary_setup::setup(&mut s, scenes, rows, references);
+    crate::summary_contacts::section(&mut s, contacts.0, contacts.1);
     s
 }

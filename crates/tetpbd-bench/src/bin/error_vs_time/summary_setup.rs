@@ -35,7 +35,7 @@ pub fn setup(
             sc.warmup
         );
     }
-    let _ = writeln!(s, "\nScenes c) drop on rigid ground and d) pile of nine cubes are not in this report yet: they need the tetpbd–rapier coupling crate (contacts), which is being built.\n");
+    let _ = writeln!(s);
     let _ = writeln!(s, "## Configurations\n");
     let _ = writeln!(s, "| model | set-up | budgets (substeps×iterations) | reference substeps (last change / size), per scene |\n|---|---|---|---|");
     let mut models: Vec<Model> = Vec::new();
@@ -74,8 +74,9 @@ pub fn setup(
         ..Default::default()
     };
     let _ = writeln!(s, "tetpbd's solver settings in every run, apart from substeps, iterations, gravity and damping set per run and scene: `{settings:?}`.\n");
+    convergence(s, references);
     let _ = writeln!(s, "## Metrics\n");
-    let _ = writeln!(s, "- **deviation from converged reference**: for the hard models the exact answer, the rest shape (every edge, height and volume held; rapier's 1e6 Hz springs sag by about g/ω² ≈ 2.5e-13 m); for the soft models the same model and mesh run by the same solver with one iteration and doubled substeps until the answer changes by < 1e-6 of the body size or the cap is reached (the table gives the substeps kept and the last change, which bounds how far the reference itself is from converged). Reported as the largest particle distance to the reference divided by the body size (beam length 2 m, cube 1 m): after the last frame for the beam; over every frame for the squash, after the best rigid alignment (Kabsch) of each frame onto the reference, so that the shape is compared and not where the free block drifted or turned. A beam that has not settled by the last frame (see `final_speed_m_s` in results.csv) counts its remaining motion as error. Each engine is compared with its own reference, because the two engines' soft models are not the same material.\n- **RMS edge strain** `|l/l₀ − 1|` over the mesh edges, and **total-volume error** (Σ signed volumes / Σ rest volumes − 1), computed from positions in the same way for both engines. For the hard models (tetpbd α = 0; rapier's volume model at {:e} Hz) the exact answer keeps every edge and volume at rest, so every strain and volume error is solver error: this is the like-for-like comparison.\n- tetpbd's own per-family RMS and max |C| (`systems::measure`, as `StepStats` with `measure_error` reports it), inverted tetrahedra, ns per projection: in results.csv.\n- **time to recover** (squash): the first time after which the total volume stays within 1 % of rest and the RMS edge strain below 1 %.\n- **time**: median wall ms per frame over the measured frames of two runs of each configuration (pooled); the median thread CPU ms per frame over the same frames is in results.csv and in the last two headline columns.\n", crate::engines::RAPIER_HARD_HZ);
+    let _ = writeln!(s, "- **deviation from converged reference**: for the hard models the exact answer, the rest shape (every edge, height and volume held; rapier's 1e6 Hz springs sag by about g/ω² ≈ 2.5e-13 m); for the soft models the same model and mesh run by the same solver with one iteration and doubled substeps until the answer changes by < 1e-6 of the body size or the cap is reached (the table gives the substeps kept and the last change, which bounds how far the reference itself is from converged). Reported as the largest particle distance to the reference divided by the body size (beam length 2 m, cube 1 m): after the last frame for the beam; over every frame for the squash, after the best rigid alignment (Kabsch) of each frame onto the reference, so that the shape is compared and not where the free block drifted or turned. A beam that has not settled by the last frame (see `final_speed_m_s` in results.csv) counts its remaining motion as error. Each engine is compared with its own reference, because the two engines' soft models are not the same material.\n- **RMS edge strain** `|l/l₀ − 1|` over the mesh edges, and **total-volume error** (Σ signed volumes / Σ rest volumes − 1), computed from positions in the same way for both engines. For the hard models (tetpbd α = 0; rapier's volume model at {:e} Hz) the exact answer keeps every edge and volume at rest, so every strain and volume error is solver error: this is the like-for-like comparison.\n- tetpbd's own per-family RMS and max |C| (`systems::measure`, as `StepStats` with `measure_error` reports it), inverted tetrahedra, ns per projection: in results.csv.\n- **time to recover** (squash): the first time after which the total volume stays within 1 % of rest and the RMS edge strain below 1 %.\n- **time**: median wall ms per frame over the measured frames of two runs of each configuration (pooled); the median thread CPU ms per frame over the same frames is in results.csv and in the last two headline columns.\n", tetpbd_bench::RAPIER_HARD_HZ);
     let _ = writeln!(s, "## Where the models differ\n");
     let _ = writeln!(s, "tetpbd's soft compliances (α per constraint, XPBD) and rapier's materials (frequency-normalised softness for the volume model, Young's modulus for the corotational and Neo-Hookean cells) are different materials: a soft tetpbd beam and a rapier corotational beam do not sag the same amount, so their errors are measured against their own references and only the shared observables (volume kept, edge stretch, shape against the reference) are compared. rapier's 'hard' volume model is a 1e6 Hz spring, which rapier saturates at the substep rate rather than treating as rigid.\n");
     let _ = writeln!(s, "## Per model\n");
@@ -118,4 +119,60 @@ pub fn setup(
             );
         }
     }
+}
+
+/// How far the numerical references got towards the issue's "until the answer stops changing
+/// at 1e-6", from the references themselves.
+fn convergence(s: &mut String, references: &[(&'static str, Model, u32, f32)]) {
+    let numeric: Vec<&(&'static str, Model, u32, f32)> =
+        references.iter().filter(|r| r.2 > 0).collect();
+    let exact = references.len() - numeric.len();
+    let reached = numeric.iter().filter(|r| r.3 < 1e-6).count();
+    let quoted = numeric
+        .iter()
+        .filter(|r| r.3 <= crate::report::REFERENCE_TOLERANCE)
+        .count();
+    let _ = writeln!(s, "### Convergence of the references\n");
+    let _ = writeln!(
+        s,
+        "The issue asks for references run \"until the answer stops changing at 1e-6\". Of the {} references, {exact} are exact (hard models: the rest shape) and {} are numerical; {reached} of those reached a change below 1e-6 of the body size when their substeps were last doubled, {quoted} a change of at most {:e} (the tolerance under which their deviations are quoted in the headline and drawn), the rest are left out of the deviation comparisons and named there.",
+        references.len(),
+        numeric.len(),
+        crate::report::REFERENCE_TOLERANCE
+    );
+    if let (Some(lo), Some(hi)) = (
+        numeric.iter().min_by(|a, b| a.3.total_cmp(&b.3)),
+        numeric.iter().max_by(|a, b| a.3.total_cmp(&b.3)),
+    ) {
+        let _ = writeln!(
+            s,
+            "Closest: {} on {} ({:.1e} at {} substeps); farthest: {} on {} ({:.1e} at {} substeps).",
+            lo.1.label(),
+            lo.0,
+            lo.3,
+            lo.2,
+            hi.1.label(),
+            hi.0,
+            hi.3,
+            hi.2
+        );
+    }
+    let _ = writeln!(s, "\nWhy 1e-6 is not reached: both engines compute in f32, whose spacing at 1 m is 1.2e-7 m (2.4e-7 m at the beam's 2 m), so 1e-6 of the body size is a handful of ulps; doubling the substeps changes every rounding of a run of thousands of substeps, and the sums of those roundings alone move the answer by about that much. A change near 1e-6 therefore cannot be told apart from rounding. Dynamic runs drift further than static ones, because a released soft block's oscillation phase keeps moving with the substep count (XPBD's discretisation error shrinks only like 1/substeps), and the doubling stops at its cap; the per-scene ranges below come from this run. The hard models need no numerical reference: their exact answer is known.\n");
+    let mut scenes: Vec<&str> = Vec::new();
+    for r in &numeric {
+        if !scenes.contains(&r.0) {
+            scenes.push(r.0);
+        }
+    }
+    for sc in scenes {
+        let c: Vec<f32> = numeric.iter().filter(|r| r.0 == sc).map(|r| r.3).collect();
+        let lo = c.iter().copied().fold(f32::INFINITY, f32::min);
+        let hi = c.iter().copied().fold(0.0, f32::max);
+        let _ = writeln!(
+            s,
+            "- {sc}: last change of the {} numerical references between {lo:.1e} and {hi:.1e} of the body size.",
+            c.len()
+        );
+    }
+    let _ = writeln!(s);
 }
