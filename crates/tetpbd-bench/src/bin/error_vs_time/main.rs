@@ -26,6 +26,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use rapier3d::prelude::{SoftBodyCellModel, SoftBodySolver};
+use tetpbd_viz::Progress;
 
 use engines::{build, ConstraintSet, Model};
 use metrics::{converged, deviation, exact_rest, run};
@@ -181,6 +182,12 @@ fn main() {
     let scenes = [Scene::hanging_beam(args.quick), Scene::squash(args.quick)];
     let mut rows = Vec::new();
     let mut references = Vec::new();
+    // A bar on a terminal, plain periodic lines otherwise (CI); the per-run lines go through
+    // `suspend` so they do not tear the bar.
+    let mut progress = Progress::new(
+        "scenes a-b: references and budgets",
+        (scenes.len() * models(args.quick).len()) as u64,
+    );
     for scene in &scenes {
         for model in models(args.quick) {
             let (lo, hi) = reference_range(&model, args.quick);
@@ -190,14 +197,16 @@ fn main() {
             } else {
                 converged(model, scene, lo, hi)
             };
-            eprintln!(
-                "{:<18} {:<36} reference {:>5} substeps, change {:.2e} ({:.1} s)",
-                scene.name,
-                model.label(),
-                r.substeps,
-                r.change,
-                t.elapsed().as_secs_f64()
-            );
+            progress.suspend(|| {
+                eprintln!(
+                    "{:<18} {:<36} reference {:>5} substeps, change {:.2e} ({:.1} s)",
+                    scene.name,
+                    model.label(),
+                    r.substeps,
+                    r.change,
+                    t.elapsed().as_secs_f64()
+                )
+            });
             for (substeps, iterations) in budgets(&model, args.quick) {
                 let mut res = run(build(model, scene, substeps, iterations).as_mut(), scene);
                 for _ in 1..repeats(args.quick) {
@@ -205,15 +214,19 @@ fn main() {
                     res.pool_timing(&again);
                 }
                 let dev = deviation(scene, &res.trajectory, &r.trajectory);
-                eprintln!(
-                    "    {substeps:>3}x{iterations:<3} {:>9.3} ms  dev max {:.2e} rms {:.2e}  vol {:+.3}%  strain {:.2e}",
-                    res.ms_median, dev.max, dev.rms, res.last.volume_err_pct, res.last.edge_strain_rms
-                );
+                progress.suspend(|| {
+                    eprintln!(
+                        "    {substeps:>3}x{iterations:<3} {:>9.3} ms  dev max {:.2e} rms {:.2e}  vol {:+.3}%  strain {:.2e}",
+                        res.ms_median, dev.max, dev.rms, res.last.volume_err_pct, res.last.edge_strain_rms
+                    )
+                });
                 rows.push(Row::new(scene, model, substeps, iterations, &res, dev, &r));
             }
             references.push((scene.name, model, r.substeps, r.change));
+            progress.inc(1);
         }
     }
+    progress.finish();
     let contact_scenes = match contacts::scenes(args.quick) {
         Ok(s) => s,
         Err(e) => {
