@@ -27,7 +27,9 @@ use crate::convert::{inertia_to_na, pose_to_glam, to_glam, to_na};
 pub(crate) enum BodyKind {
     Fixed,
     Kinematic,
-    /// Dynamic, touched only by soft bodies: takes part with its generalized inverse mass.
+    /// Dynamic, touched only by soft bodies, or *anchored* (supported and carrying an
+    /// attachment, its rigid contacts kept as constraints: `support` module docs): takes
+    /// part with its generalized inverse mass.
     Dynamic,
     /// Dynamic and in contact with other rigid colliders: infinitely heavy inside the soft
     /// substeps; the soft reaction is summed as an impulse and handed to rapier.

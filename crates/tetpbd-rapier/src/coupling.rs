@@ -19,6 +19,7 @@ use crate::frame::Frame;
 use crate::hook::CouplingHook;
 use crate::material::SoftCollider;
 use crate::report::{ContactReport, CouplingStats};
+use crate::support::{apply_reaction, support_reaction};
 
 /// Settings of a [`Coupling`].
 #[derive(Clone, Debug, PartialEq)]
@@ -313,6 +314,14 @@ impl Coupling {
                 if b.write_back(rb) {
                     stats.bodies_written += 1;
                 } else {
+                    stats.non_finite_bodies += 1;
+                }
+            }
+        }
+        // The reaction of the anchored bodies' pushes on their dynamic supports.
+        for (handle, j, l) in self.frame.supports.iter().filter_map(support_reaction) {
+            if let Some(rb) = ctx.bodies.get_mut(handle) {
+                if !apply_reaction(rb, &j, &l) {
                     stats.non_finite_bodies += 1;
                 }
             }

@@ -12,12 +12,13 @@ use rapier3d::pipeline::QueryPipeline;
 use tetpbd::{Particles, Surface};
 
 use crate::attachment::{AttachTarget, Attachments};
-use crate::bodies::BodyProxy;
+use crate::bodies::{BodyKind, BodyProxy};
 use crate::convert::{pose_to_glam, pose_to_na, to_glam};
 use crate::corner::{gather_corners, CornerContact, Corners};
 use crate::material::SoftCollider;
 use crate::report::CouplingStats;
 use crate::shape_query::InsideRule;
+use crate::support::{gather_supports, Support};
 
 /// A body's pose (m, rad) and linear velocity (m/s) before rapier's step.
 pub(crate) type StartState = (Isometry3<f32>, Vector3<f32>);
@@ -132,6 +133,8 @@ pub(crate) struct Frame {
     pub contacts: Vec<ParticleContact>,
     pub corners: Vec<CornerContact>,
     pub attachments: Vec<AttachRun>,
+    /// Rigid contacts of anchored bodies (`support` module docs).
+    pub supports: Vec<Support>,
     near: Vec<ColliderHandle>,
     /// Colliders of fast bodies with their swept AABB over the frame (`sweep` module docs).
     fast: Vec<(ColliderHandle, Aabb)>,
@@ -270,6 +273,7 @@ impl Frame {
         self.contacts.clear();
         self.corners.clear();
         self.attachments.clear();
+        self.supports.clear();
         self.substep = 0;
         let qp = input.qp;
         crate::sweep::fast_colliders(
@@ -442,6 +446,24 @@ impl Frame {
                 corners: k0..self.corners.len(),
                 attachments: a0..self.attachments.len(),
             });
+        }
+        // A supported body holding a soft body by an attachment is anchored: it takes part
+        // with its own mass, its rigid contacts kept as constraints (`support` module docs).
+        for k in 0..self.attachments.len() {
+            let Some(b) = self.attachments[k].body else {
+                continue;
+            };
+            if self.bodies[b].kind == BodyKind::Supported {
+                self.bodies[b].kind = BodyKind::Dynamic;
+                gather_supports(
+                    &mut self.supports,
+                    b,
+                    &self.bodies[b],
+                    qp.bodies,
+                    qp.colliders,
+                    input.narrow_phase,
+                );
+            }
         }
         self.stats.candidates = self.contacts.len();
         self.stats.corner_candidates = self.corners.len();

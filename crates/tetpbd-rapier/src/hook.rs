@@ -14,6 +14,7 @@ use crate::material::SoftCollider;
 use crate::report::{ContactReport, SoftFeature};
 use crate::restitution::{com_velocity, end_episodes, restitution_pass};
 use crate::shape_query::surface_point;
+use crate::support::{end_substep_supports, project_supports};
 
 /// Borrows the frame state and rapier's query pipeline for one soft step.
 pub(crate) struct CouplingHook<'q, 'a> {
@@ -68,6 +69,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             contacts,
             corners,
             attachments,
+            supports,
             stats,
             ..
         } = &mut *self.frame;
@@ -106,6 +108,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             );
             project_attachments(&mut attachments[s.attachments.clone()], p, bodies, frac, h);
         }
+        project_supports(supports, bodies);
     }
 
     fn end_substep(&mut self, world: &mut World, h: f32) {
@@ -118,11 +121,13 @@ impl SubstepHook for CouplingHook<'_, '_> {
             corners,
             episodes,
             active_colliders,
+            supports,
             ..
         } = &mut *self.frame;
         for b in bodies.iter_mut() {
             b.end_substep(h);
         }
+        end_substep_supports(supports, h);
         for s in soft.iter() {
             let Ok((p, damping)) =
                 world.query_one_mut::<(&mut Particles, Option<&DeformationDamping>)>(s.entity)

@@ -70,6 +70,7 @@ mod soft_gather;
 mod soft_project;
 mod soft_restitution;
 mod soft_separation;
+mod support;
 mod sweep;
 
 pub use attachment::{AttachTarget, Attachment, Attachments};

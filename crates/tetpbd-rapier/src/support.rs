@@ -1,0 +1,171 @@
+//! Rigid supports of an *anchored* body inside the soft substeps.
+//!
+//! A dynamic body that rapier reports in contact with other rigid colliders is normally
+//! *supported*: infinitely heavy inside the substeps, its summed soft reaction handed to
+//! rapier as a velocity change (`bodies` module docs). That is an explicit coupling with a
+//! frame of lag, stable for contacts, which mostly press a body onto its supports. An
+//! attachment is two-way and bilateral: rapier moves the body by the reaction, the body drags
+//! the attached soft body along, whose reaction moves the body further. The gain of that loop
+//! is the mass ratio soft/rigid, so a light body holding a heavy soft body diverged within a
+//! few frames (issue 3).
+//!
+//! A supported body that carries an attachment is therefore *anchored*: it takes part in the
+//! substeps with its generalized inverse mass like a body touched only by soft bodies
+//! (implicit, two-way, the same projections), and rapier's contacts of the body, as they
+//! stood after rapier's step, are kept inside the substeps as unilateral XPBD constraints
+//! against an immovable other side: `C = n·(x − y) − min(0, C₁) ≥ 0` for the body's material
+//! point `x` of each contact point, `y` the other collider's point and `n` the contact normal
+//! towards the body; `C₁` is the value at rapier's end pose, so an overlap rapier left is
+//! neither pushed out nor deepened here. The body is then written back like any body that
+//! took part (pose and velocity), without being pushed into its supports.
+//!
+//! The reaction of a dynamic support is summed over the frame and applied to it as an
+//! impulse (its velocity at rapier's next step), as for a supported body; a fixed or
+//! kinematic support takes none.
+//!
+//! Limits: the supports carry no friction inside the substeps (rapier's friction acts at its
+//! next step on the written-back velocity); the contact points are those of rapier's
+//! manifolds at the start of its step, in the collider's own frame (contacts with a part of a
+//! compound shape are placed in the compound's frame without the part's pose).
+
+use nalgebra::{Point3, Vector3};
+use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
+use rapier3d::geometry::{ColliderSet, NarrowPhase};
+
+use crate::bodies::BodyProxy;
+use crate::convert::{pose_to_na, to_glam, to_na};
+
+/// One contact point of an anchored body with a rigid support.
+#[derive(Clone, Debug)]
+pub(crate) struct Support {
+    /// The anchored body's proxy.
+    pub body: usize,
+    /// The contact point on the body, in the body's frame, m.
+    local: Vector3<f32>,
+    /// The contact point on the support (world, at rapier's end pose), m.
+    point: Vector3<f32>,
+    /// Unit contact normal from the support towards the body (world).
+    normal: Vector3<f32>,
+    /// Lowest value the constraint may take, m (≤ 0).
+    floor: f32,
+    /// The support's body when it is dynamic, and its world centre of mass, m.
+    other: Option<(RigidBodyHandle, Vector3<f32>)>,
+    /// Positional impulse on the anchored body in the current substep, kg·m.
+    sub: Vector3<f32>,
+    /// Impulse on the anchored body over the frame, N·s.
+    impulse: Vector3<f32>,
+}
+
+/// Appends the contact points of proxy `b` (an anchored body) with other rigid colliders.
+pub(crate) fn gather_supports(
+    out: &mut Vec<Support>,
+    b: usize,
+    proxy: &BodyProxy,
+    bodies: &RigidBodySet,
+    colliders: &ColliderSet,
+    narrow_phase: &NarrowPhase,
+) {
+    let Some(rb) = bodies.get(proxy.handle) else {
+        return;
+    };
+    let end = proxy.frame_poses().1;
+    for &ch in rb.colliders() {
+        let Some(co) = colliders.get(ch) else {
+            continue;
+        };
+        let in_body = co.position_wrt_parent().map(pose_to_na).unwrap_or_default();
+        for pair in narrow_phase.contact_pairs_with(ch) {
+            if !pair.has_any_active_contact() {
+                continue;
+            }
+            let first = pair.collider1 == ch;
+            let other_handle = if first {
+                pair.collider2
+            } else {
+                pair.collider1
+            };
+            let Some(other) = colliders.get(other_handle) else {
+                continue;
+            };
+            let other_pose = pose_to_na(other.position());
+            let other_body = other
+                .parent()
+                .and_then(|h| bodies.get(h).map(|o| (h, o)))
+                .filter(|(_, o)| o.is_dynamic())
+                .map(|(h, o)| (h, to_na(o.center_of_mass())));
+            for m in pair.manifolds() {
+                if m.data.solver_contacts.is_empty() {
+                    continue;
+                }
+                let n1 = to_na(m.data.normal);
+                let normal = if first { -n1 } else { n1 };
+                for pt in &m.points {
+                    let (ours, theirs) = if first {
+                        (pt.local_p1, pt.local_p2)
+                    } else {
+                        (pt.local_p2, pt.local_p1)
+                    };
+                    let local = in_body * Point3::from(to_na(ours));
+                    let point = other_pose * Point3::from(to_na(theirs));
+                    let c_end = normal.dot(&((end * local) - point));
+                    out.push(Support {
+                        body: b,
+                        local: local.coords,
+                        point: point.coords,
+                        normal,
+                        floor: c_end.min(0.0),
+                        other: other_body,
+                        sub: Vector3::zeros(),
+                        impulse: Vector3::zeros(),
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// One sweep over the supports: keeps each anchored body's contact points out of its
+/// supports (the support immovable).
+pub(crate) fn project_supports(supports: &mut [Support], bodies: &mut [BodyProxy]) {
+    for s in supports {
+        let body = &mut bodies[s.body];
+        let x = (body.pose * Point3::from(s.local)).coords;
+        let c = s.normal.dot(&(x - s.point)) - s.floor;
+        if c.is_nan() || c >= 0.0 {
+            continue;
+        }
+        let w = body.inv_mass_at(&x, &s.normal);
+        if w.is_nan() || w <= 0.0 {
+            continue;
+        }
+        let p = s.normal * (-c / w);
+        body.apply_position_impulse(&p, &x);
+        s.sub += p;
+    }
+}
+
+/// Ends a substep of `h` seconds: the substep's positional impulses become impulses.
+pub(crate) fn end_substep_supports(supports: &mut [Support], h: f32) {
+    for s in supports {
+        s.impulse += s.sub / h;
+        s.sub = Vector3::zeros();
+    }
+}
+
+/// The dynamic support of `s` and the impulse (N·s) and angular impulse about its centre of
+/// mass (N·m·s) it takes over the frame (the reaction of the anchored body's push).
+pub(crate) fn support_reaction(s: &Support) -> Option<(RigidBodyHandle, Vector3<f32>, Vector3<f32>)> {
+    let (h, com) = s.other?;
+    let j = -s.impulse;
+    (j != Vector3::zeros()).then(|| (h, j, (s.point - com).cross(&j)))
+}
+
+/// Applies a support's reaction to its rapier body; `false` when it is not finite.
+pub(crate) fn apply_reaction(body: &mut RigidBody, j: &Vector3<f32>, l: &Vector3<f32>) -> bool {
+    if !(j.iter().chain(l.iter()).all(|c| c.is_finite())) {
+        return false;
+    }
+    body.apply_impulse(to_glam(j), true);
+    body.apply_torque_impulse(to_glam(l), true);
+    true
+}

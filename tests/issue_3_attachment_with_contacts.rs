@@ -1,0 +1,186 @@
+//! Issue 3, item 5 (two-way attachments): a soft body attached to a dynamic rigid body that
+//! also has soft contacts, or rigid contacts, stays bounded and the attachment holds.
+
+use hecs::Entity;
+use nalgebra::Vector3;
+use rapier3d::math::Vector;
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
+use tetpbd::generators::{self, CellSplit};
+use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
+use tetpbd_rapier::convert::to_na;
+use tetpbd_rapier::{Attachments, CoupledWorld, CouplingSettings};
+
+fn scene() -> CoupledWorld {
+    let solver = SolverSettings {
+        substeps: 10,
+        ..SolverSettings::default()
+    };
+    let mut scene = CoupledWorld::new(solver, CouplingSettings::default()).expect("settings");
+    scene.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
+        ColliderBuilder::cuboid(5.0, 0.5, 5.0),
+    );
+    scene
+}
+
+/// A 1 m soft cube of `cells`³ cells centred at `at`, stiff edges and volume.
+fn soft_cube(scene: &mut CoupledWorld, cells: u32, at: Vector3<f32>, density: f32) -> Entity {
+    let mesh =
+        generators::box_grid(Vector3::repeat(1.0), [cells; 3], CellSplit::Six).expect("mesh");
+    SoftBodyBuilder::new(mesh)
+        .density(density)
+        .edges(0.0)
+        .volume(0.0)
+        .translation(at)
+        .build()
+        .expect("body")
+        .spawn(&mut scene.soft)
+}
+
+/// A dynamic rigid box of half extent 0.25 m (rapier's default density) at `at`.
+fn rigid_box(scene: &mut CoupledWorld, at: Vector3<f32>) -> RigidBodyHandle {
+    scene
+        .physics
+        .insert(
+            RigidBodyBuilder::dynamic().translation(Vector::new(at.x, at.y, at.z)),
+            ColliderBuilder::cuboid(0.25, 0.25, 0.25),
+        )
+        .0
+}
+
+/// The particle of `e` nearest to `x`.
+fn nearest(scene: &CoupledWorld, e: Entity, x: Vector3<f32>) -> u32 {
+    let p = scene.soft.get::<&Particles>(e).expect("particles");
+    (0..p.len() as u32)
+        .min_by(|&a, &b| {
+            let da = (p.positions()[a as usize] - x).norm();
+            let db = (p.positions()[b as usize] - x).norm();
+            da.total_cmp(&db)
+        })
+        .expect("particles")
+}
+
+/// Attaches particle `i` of `e` to `body` where it stands, with `compliance` (m/N).
+fn attach(scene: &mut CoupledWorld, e: Entity, i: u32, body: RigidBodyHandle, compliance: f32) {
+    let mut att = Attachments::new();
+    {
+        let p = scene.soft.get::<&Particles>(e).expect("particles");
+        att.attach_to_body(&p, i, &scene.physics.bodies, body, compliance)
+            .expect("attach");
+    }
+    scene.soft.insert_one(e, att).expect("entity");
+}
+
+/// What a frame ends with.
+#[derive(Clone, Copy, Debug)]
+struct Sample {
+    /// Largest particle speed over the given soft bodies, m/s.
+    particle_speed: f32,
+    /// Speed of the box's centre of mass, m/s.
+    box_speed: f32,
+    /// Angular speed of the box, rad/s.
+    box_spin: f32,
+    /// Distance between the attached particle and its anchor, m.
+    gap: f32,
+    /// Box centre, m.
+    box_at: Vector3<f32>,
+    /// Cosine of the angle between the box's up axis and world up.
+    upright: f32,
+    /// Whether every particle position and velocity is finite.
+    finite: bool,
+}
+
+fn sample(
+    scene: &CoupledWorld,
+    soft: &[Entity],
+    hanging: (Entity, u32),
+    body: RigidBodyHandle,
+    anchor_local: Vector3<f32>,
+) -> Sample {
+    let rb = &scene.physics.bodies[body];
+    let pose = tetpbd_rapier::convert::pose_to_na(rb.position());
+    let mut particle_speed = 0.0f32;
+    let mut finite = true;
+    for &e in soft {
+        let p = scene.soft.get::<&Particles>(e).expect("particles");
+        finite &= p
+            .positions()
+            .iter()
+            .chain(p.velocities())
+            .all(|x| x.iter().all(|c| c.is_finite()));
+        particle_speed = particle_speed.max(p.max_speed());
+    }
+    let p = scene.soft.get::<&Particles>(hanging.0).expect("particles");
+    let anchor = pose * nalgebra::Point3::from(anchor_local);
+    Sample {
+        particle_speed,
+        box_speed: to_na(rb.linvel()).norm(),
+        box_spin: to_na(rb.angvel()).norm(),
+        gap: (p.positions()[hanging.1 as usize] - anchor.coords).norm(),
+        box_at: pose.translation.vector,
+        upright: (pose.rotation * Vector3::y()).y,
+        finite,
+    }
+}
+
+/// Runs `frames` frames; returns every frame's sample.
+fn run(
+    scene: &mut CoupledWorld,
+    frames: usize,
+    soft: &[Entity],
+    hanging: (Entity, u32),
+    body: RigidBodyHandle,
+) -> Vec<Sample> {
+    let anchor_local = {
+        let p = scene.soft.get::<&Particles>(hanging.0).expect("particles");
+        let pose = tetpbd_rapier::convert::pose_to_na(scene.physics.bodies[body].position());
+        pose.inverse_transform_point(&p.positions()[hanging.1 as usize].into())
+            .coords
+    };
+    (0..frames)
+        .map(|_| {
+            scene.step().expect("step");
+            sample(scene, soft, hanging, body, anchor_local)
+        })
+        .collect()
+}
+
+fn print(name: &str, samples: &[Sample]) {
+    for (f, s) in samples.iter().enumerate() {
+        if f < 30 || f % 30 == 29 {
+            println!(
+                "{name} frame {f:3}: particle {:.3e} m/s, box {:.3e} m/s {:.3e} rad/s at ({:.3}, {:.3}, {:.3}) up {:.4}, gap {:.2e} m",
+                s.particle_speed, s.box_speed, s.box_spin, s.box_at.x, s.box_at.y, s.box_at.z, s.upright, s.gap
+            );
+        }
+    }
+}
+
+/// Scene (a): a 2-cell soft cube standing on a dynamic box that rests on the ground, its
+/// bottom-centre particle attached to the box.
+#[test]
+fn soft_cube_attached_to_a_box_on_the_ground() {
+    let mut s = scene();
+    let b = rigid_box(&mut s, Vector3::new(2.0, 0.25, 0.0));
+    let e = soft_cube(&mut s, 2, Vector3::new(2.0, 1.01, 0.0), 100.0);
+    let i = nearest(&s, e, Vector3::new(2.0, 0.51, 0.0));
+    attach(&mut s, e, i, b, 0.0);
+    let samples = run(&mut s, 240, &[e], (e, i), b);
+    print("a", &samples);
+}
+
+/// Scene (b): a dynamic box resting on a soft cube, a second soft cube hanging from the box
+/// by its top particle.
+#[test]
+fn soft_cube_hanging_from_a_box_on_a_soft_cube() {
+    for (compliance, density) in [(0.0, 20.0), (0.0, 1000.0), (1e-5, 100.0)] {
+        let mut s = scene();
+        let under = soft_cube(&mut s, 3, Vector3::new(0.0, 0.5, 0.0), 1000.0);
+        let b = rigid_box(&mut s, Vector3::new(0.0, 1.26, 0.0));
+        let e = soft_cube(&mut s, 2, Vector3::new(2.0, 1.0, 0.0), density);
+        let i = nearest(&s, e, Vector3::new(2.0, 1.5, 0.0));
+        attach(&mut s, e, i, b, compliance);
+        let samples = run(&mut s, 240, &[under, e], (e, i), b);
+        print(&format!("b α {compliance:e} ρ {density}"), &samples);
+    }
+}
