@@ -147,7 +147,7 @@ fn run(
 
 fn print(name: &str, samples: &[Sample]) {
     for (f, s) in samples.iter().enumerate() {
-        if f < 30 || f % 30 == 29 {
+        if f < 10 || f % 30 == 29 {
             println!(
                 "{name} frame {f:3}: particle {:.3e} m/s, box {:.3e} m/s {:.3e} rad/s at ({:.3}, {:.3}, {:.3}) up {:.4}, gap {:.2e} m",
                 s.particle_speed, s.box_speed, s.box_spin, s.box_at.x, s.box_at.y, s.box_at.z, s.upright, s.gap
@@ -165,7 +165,7 @@ fn soft_cube_attached_to_a_box_on_the_ground() {
     let e = soft_cube(&mut s, 2, Vector3::new(2.0, 1.01, 0.0), 100.0);
     let i = nearest(&s, e, Vector3::new(2.0, 0.51, 0.0));
     attach(&mut s, e, i, b, 0.0);
-    let samples = run(&mut s, 240, &[e], (e, i), b);
+    let samples = run(&mut s, 600, &[e], (e, i), b);
     print("a", &samples);
 }
 
@@ -180,7 +180,7 @@ fn soft_cube_hanging_from_a_box_on_a_soft_cube() {
         let e = soft_cube(&mut s, 2, Vector3::new(2.0, 1.0, 0.0), density);
         let i = nearest(&s, e, Vector3::new(2.0, 1.5, 0.0));
         attach(&mut s, e, i, b, compliance);
-        let samples = run(&mut s, 240, &[under, e], (e, i), b);
+        let samples = run(&mut s, 600, &[under, e], (e, i), b);
         print(&format!("b α {compliance:e} ρ {density}"), &samples);
     }
 }

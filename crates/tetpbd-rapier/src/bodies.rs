@@ -74,6 +74,10 @@ pub(crate) struct BodyProxy {
     sub_angular: Vector3<f32>,
     impulse: Vector3<f32>,
     angular: Vector3<f32>,
+    /// Mean contact normal of an anchored body's rigid supports (unit, towards the body;
+    /// zero for any other body): an impulse pressing the body into them is summed like a
+    /// supported body's instead of moving it (`support` module docs).
+    support_normal: Vector3<f32>,
     /// Linear and angular velocity at the start of the current substep (before any soft
     /// correction), and the centre of mass they refer to.
     pre: (Vector3<f32>, Vector3<f32>, Vector3<f32>),
@@ -159,8 +163,34 @@ impl BodyProxy {
             sub_angular: Vector3::zeros(),
             impulse: Vector3::zeros(),
             angular: Vector3::zeros(),
+            support_normal: Vector3::zeros(),
             pre: (Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
         }
+    }
+
+    /// Makes a supported body *anchored* (`support` module docs): it takes part with its
+    /// generalized inverse mass, except against impulses pressing it into its supports,
+    /// whose mean contact normal (towards the body) is `normal`.
+    pub fn anchor(&mut self, normal: Vector3<f32>) {
+        if self.kind == BodyKind::Supported {
+            self.kind = BodyKind::Dynamic;
+            self.support_normal = normal.try_normalize(1e-6).unwrap_or_default();
+        }
+    }
+
+    /// Whether an impulse along `push` presses an anchored body into its supports (more
+    /// than 60° against their mean normal).
+    fn pressed(&self, push: &Vector3<f32>) -> bool {
+        self.support_normal.dot(push) < -0.5 * push.norm()
+    }
+
+    /// [`Self::inv_mass_at`] for a constraint that pushes the body along `push`: 0 when the
+    /// push presses an anchored body into its supports.
+    pub fn inv_mass_pushed(&self, q: &Vector3<f32>, push: &Vector3<f32>) -> f32 {
+        if self.pressed(push) {
+            return 0.0;
+        }
+        self.inv_mass_at(q, &push.try_normalize(1e-12).unwrap_or_default())
     }
 
     /// `true` for a dynamic body (finite mass in rapier).
@@ -249,7 +279,7 @@ impl BodyProxy {
 
     /// Applies a positional impulse `p` (kg·m: direction × Δλ) at the world point `q`.
     pub fn apply_position_impulse(&mut self, p: &Vector3<f32>, q: &Vector3<f32>) {
-        if self.kind == BodyKind::Supported {
+        if self.kind == BodyKind::Supported || (self.kind == BodyKind::Dynamic && self.pressed(p)) {
             self.sub_impulse += p;
             self.sub_angular += (q - self.com()).cross(p);
             self.touched = true;
@@ -269,7 +299,7 @@ impl BodyProxy {
 
     /// Ends a substep: the offset velocities follow from the offset motion.
     pub fn end_substep(&mut self, h: f32) {
-        if self.kind == BodyKind::Supported {
+        if self.kind != BodyKind::Fixed {
             self.impulse += self.sub_impulse / h;
             self.angular += self.sub_angular / h;
             self.sub_impulse = Vector3::zeros();
@@ -297,7 +327,7 @@ impl BodyProxy {
 
     /// Applies a velocity impulse `j` (N·s) at the world point `q`.
     pub fn apply_velocity_impulse(&mut self, j: &Vector3<f32>, q: &Vector3<f32>) {
-        if self.kind == BodyKind::Supported {
+        if self.kind == BodyKind::Supported || (self.kind == BodyKind::Dynamic && self.pressed(j)) {
             self.impulse += j;
             self.angular += (q - self.com()).cross(j);
             self.touched = true;
@@ -311,36 +341,55 @@ impl BodyProxy {
         self.touched = true;
     }
 
-    /// Writes the result back to rapier: for a body touched only by soft bodies its final
-    /// pose and velocity (`v₁` plus the offset's); for a supported body the
-    /// summed soft impulse as a velocity change. Returns `false` (and writes nothing) when the
-    /// result is not finite.
+    /// Force (N) and torque about the centre of mass (N·m) that carry the summed soft
+    /// impulse on a supported body, or the part pressing an anchored body into its supports,
+    /// through rapier's next step (the impulse of this frame spread over `dt`); `None` when
+    /// there is none.
+    pub fn load(&self) -> Option<(Vector3<f32>, Vector3<f32>)> {
+        (self.kind == BodyKind::Supported
+            && self.touched
+            && (self.impulse != Vector3::zeros() || self.angular != Vector3::zeros()))
+            .then(|| (self.impulse / self.dt, self.angular / self.dt))
+    }
+
+    /// Writes the result back to rapier: for a body that took part with its mass its final
+    /// pose and velocity (`v₁` plus the offset's); the [`Self::load`] of a supported or
+    /// anchored body as a force and torque added for rapier's next step (the caller takes
+    /// them off again after that step). A force, not a velocity change: rapier's solver
+    /// applies it in its substeps together with the rigid contacts, as it does gravity, where
+    /// a velocity change of the same impulse is an impact (a 100 kg soft body resting on a
+    /// 0.125 kg box hands it about 100 m/s per frame, which rapier's contacts do not cancel
+    /// cleanly). Returns `false` (and writes nothing) when the result is not finite.
     pub fn write_back(&self, body: &mut RigidBody) -> bool {
         if !self.touched {
             return true;
         }
-        let (v, w, pose) = match self.kind {
-            BodyKind::Dynamic => (self.v_end + self.dv, self.w_end + self.dw, Some(self.pose)),
-            BodyKind::Supported => (
-                self.v_end + self.inv_mass.component_mul(&self.impulse),
-                self.w_end + self.inv_inertia * self.angular,
-                None,
-            ),
-            BodyKind::Fixed | BodyKind::Kinematic => return true,
-        };
-        let finite = [v, w].iter().all(|x| x.iter().all(|c| c.is_finite()))
-            && pose.is_none_or(|p| {
-                p.translation.vector.iter().all(|c| c.is_finite())
-                    && p.rotation.coords.iter().all(|c| c.is_finite())
-            });
-        if !finite {
+        let finite = |x: &Vector3<f32>| x.iter().all(|c| c.is_finite());
+        let load = self.load();
+        if load.is_some_and(|(f, t)| !(finite(&f) && finite(&t))) {
             return false;
         }
-        if let Some(p) = pose {
-            body.set_position(pose_to_glam(&p), true);
+        match self.kind {
+            BodyKind::Dynamic => {
+                let (v, w, p) = (self.v_end + self.dv, self.w_end + self.dw, self.pose);
+                if !(finite(&v)
+                    && finite(&w)
+                    && finite(&p.translation.vector)
+                    && p.rotation.coords.iter().all(|c| c.is_finite()))
+                {
+                    return false;
+                }
+                body.set_position(pose_to_glam(&p), true);
+                body.set_linvel(to_glam(&v), true);
+                body.set_angvel(to_glam(&w), true);
+            }
+            BodyKind::Supported => {}
+            BodyKind::Fixed | BodyKind::Kinematic => return true,
         }
-        body.set_linvel(to_glam(&v), true);
-        body.set_angvel(to_glam(&w), true);
+        if let Some((force, torque)) = load {
+            body.add_force(to_glam(&force), true);
+            body.add_torque(to_glam(&torque), true);
+        }
         true
     }
 }

@@ -103,7 +103,7 @@ pub(crate) fn project_contacts(
             continue;
         }
         let w_p = p.inv_masses()[i];
-        let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_at(&q, &n));
+        let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_pushed(&q, &-n));
         let wsum = w_p + w_b;
         if wsum.is_nan() || wsum <= 0.0 {
             continue;

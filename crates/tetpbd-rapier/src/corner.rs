@@ -437,7 +437,7 @@ fn sweep_corners(
         let sum: f32 = clamped.iter().sum();
         let beta = clamped.map(|w| w / sum);
         let w = idx.map(|i| p.inv_masses()[i]);
-        let w_body = cp.body.map_or(0.0, |bi| bodies[bi].inv_mass_at(&v, &n));
+        let w_body = cp.body.map_or(0.0, |bi| bodies[bi].inv_mass_pushed(&v, &n));
         let denom: f32 = (0..3).map(|j| w[j] * beta[j] * beta[j]).sum::<f32>() + w_body;
         if denom.is_nan() || denom <= 0.0 {
             continue;

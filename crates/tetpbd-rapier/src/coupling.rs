@@ -13,7 +13,7 @@ use rapier3d::math::Vector;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline, PhysicsWorld, QueryFilter};
 use tetpbd::{Solver, SolverSettings, SubstepHook};
 
-use crate::convert::to_na;
+use crate::convert::{to_glam, to_na};
 use crate::error::CouplingError;
 use crate::frame::Frame;
 use crate::hook::CouplingHook;
@@ -278,6 +278,13 @@ impl Coupling {
             ctx.events,
         );
         let rigid_time = t.elapsed();
+        // The soft load of the previous frame has acted over that step: take it off again.
+        for (handle, force, torque) in self.frame.loads.drain(..) {
+            if let Some(rb) = ctx.bodies.get_mut(handle) {
+                rb.add_force(to_glam(&-force), false);
+                rb.add_torque(to_glam(&-torque), false);
+            }
+        }
 
         self.frame.dt = dt;
         self.frame.substeps = self.solver.settings.substeps;
@@ -313,6 +320,9 @@ impl Coupling {
             if let Some(rb) = ctx.bodies.get_mut(b.handle) {
                 if b.write_back(rb) {
                     stats.bodies_written += 1;
+                    if let Some((force, torque)) = b.load() {
+                        self.frame.loads.push((b.handle, force, torque));
+                    }
                 } else {
                     stats.non_finite_bodies += 1;
                 }

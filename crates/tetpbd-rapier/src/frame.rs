@@ -135,6 +135,9 @@ pub(crate) struct Frame {
     pub attachments: Vec<AttachRun>,
     /// Rigid contacts of anchored bodies (`support` module docs).
     pub supports: Vec<Support>,
+    /// Force (N) and torque (N·m) added to bodies for rapier's next step (the load of the
+    /// previous frame, `BodyProxy::load`), taken off again after that step.
+    pub loads: Vec<(RigidBodyHandle, Vector3<f32>, Vector3<f32>)>,
     near: Vec<ColliderHandle>,
     /// Colliders of fast bodies with their swept AABB over the frame (`sweep` module docs).
     fast: Vec<(ColliderHandle, Aabb)>,
@@ -454,7 +457,7 @@ impl Frame {
                 continue;
             };
             if self.bodies[b].kind == BodyKind::Supported {
-                self.bodies[b].kind = BodyKind::Dynamic;
+                let first = self.supports.len();
                 gather_supports(
                     &mut self.supports,
                     b,
@@ -463,6 +466,8 @@ impl Frame {
                     qp.colliders,
                     input.narrow_phase,
                 );
+                let normal = self.supports[first..].iter().map(|s| s.normal).sum();
+                self.bodies[b].anchor(normal);
             }
         }
         self.stats.candidates = self.contacts.len();

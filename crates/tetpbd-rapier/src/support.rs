@@ -45,7 +45,7 @@ pub(crate) struct Support {
     /// The contact point on the support (world, at rapier's end pose), m.
     point: Vector3<f32>,
     /// Unit contact normal from the support towards the body (world).
-    normal: Vector3<f32>,
+    pub normal: Vector3<f32>,
     /// Lowest value the constraint may take, m (≤ 0).
     floor: f32,
     /// The support's body when it is dynamic, and its world centre of mass, m.
