@@ -240,7 +240,9 @@ pub(crate) fn project_attachments(
         let w_p = p.inv_masses()[i];
         // The body is pulled towards the particle unless the compliant spring pushes back.
         let push = if -len - alpha * a.lambda < 0.0 { n } else { -n };
-        let w_b = a.body.map_or(0.0, |b| bodies[b].inv_mass_pushed(&anchor, &push));
+        let w_b = a
+            .body
+            .map_or(0.0, |b| bodies[b].inv_mass_pushed(&anchor, &push));
         let denom = w_p + w_b + alpha;
         if denom.is_nan() || denom <= 0.0 {
             continue;

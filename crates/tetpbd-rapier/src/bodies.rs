@@ -16,6 +16,11 @@
 //! gravity at once, and the soft impulse balances exactly `m·g·dt` per frame at rest. The end
 //! position differs from rapier's `c₀ + v₁dt` by `½a·dt(dt − h)`; only bodies a soft body
 //! actually touched are written back.
+//!
+//! A dynamic body in contact with other rigid colliders is *supported*: infinitely heavy
+//! inside the substeps, its summed soft reaction handed to rapier as a force for its next
+//! step. One that also carries an attachment is *anchored* (`support` module docs): it
+//! takes part with its mass, except against impulses pressing it into its supports.
 
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
@@ -349,7 +354,7 @@ impl BodyProxy {
         (self.kind == BodyKind::Supported
             && self.touched
             && (self.impulse != Vector3::zeros() || self.angular != Vector3::zeros()))
-            .then(|| (self.impulse / self.dt, self.angular / self.dt))
+        .then(|| (self.impulse / self.dt, self.angular / self.dt))
     }
 
     /// Writes the result back to rapier: for a body that took part with its mass its final

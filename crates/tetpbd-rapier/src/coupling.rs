@@ -140,16 +140,29 @@ impl<'a> RapierContext<'a> {
 ///    and gets its final pose and velocity (`P₁` plus offset; the velocity of the last
 ///    substep). A body that rapier's narrow phase reports in contact with other rigid
 ///    colliders is *supported*: inside the substeps it is infinitely heavy (it stays on its
-///    `P₀ → P₁` path), and the summed soft impulse and its moment become a velocity change
-///    that rapier's solver carries through the rigid contacts at the next step. Moving such
-///    a body by the offset would push it into its rigid neighbours, which rapier only pushes
-///    out again over several frames (a soft body on a stack of boxes would squash the
-///    stack).
+///    `P₀ → P₁` path), and the summed soft impulse and its moment become a force and torque
+///    added to the body for rapier's next step (and taken off again after it), which rapier's
+///    solver applies in its substeps together with the rigid contacts, as it does gravity.
+///    (A velocity change of the same impulse is an impact: a 100 kg soft body resting on a
+///    0.125 kg box handed the box about 100 m/s per frame, which rapier's contacts did not
+///    cancel cleanly.) Moving such a body by the offset would push it into its rigid
+///    neighbours, which rapier only pushes out again over several frames (a soft body on a
+///    stack of boxes would squash the stack).
+///    A supported body that a soft body is attached to is *anchored* instead (`support`
+///    module docs): an attachment is bilateral, and handing its reaction over a frame late
+///    feeds back with the soft/rigid mass ratio as gain (a soft body attached to a light box
+///    on the ground threw the box away within two frames, issue 3). An anchored body takes
+///    part in the substeps with its generalized inverse mass like a body touched only by
+///    soft bodies, and is written back the same way; rapier's contacts of the body, as they
+///    stood after rapier's step, are kept inside the substeps as unilateral constraints
+///    against immovable supports, and against an impulse pressing it into its supports it
+///    is infinitely heavy (shock propagation), so the soft body cannot push it into them.
 ///
 /// Who integrates what: rapier integrates rigid bodies under gravity, rigid contacts and
 /// joints; the coupling integrates the soft bodies and the *reaction* of soft contacts and
 /// attachments on rigid bodies, which rapier sees at its next step as an already-moved pose
-/// and/or changed velocity. Rapier steps first so that the soft bodies see where the rigid
+/// and changed velocity (bodies touched only by soft bodies, anchored bodies) or as a force
+/// and torque acting over that step (supported bodies). Rapier steps first so that the soft bodies see where the rigid
 /// bodies really are this frame (kinematic platforms carry soft bodies without a frame of
 /// lag); the price is that a soft push on a rigid body reaches rigid–rigid contacts one
 /// frame later.
@@ -179,6 +192,13 @@ impl<'a> RapierContext<'a> {
 ///   body 1000× heavier than the soft body under it needs a few iterations per substep.
 /// * A heavy soft body on a stack of supported rigid bodies keeps a small rocking motion
 ///   (a few cm/s), the one-frame lag between the soft load and rapier's answer.
+/// * The soft load pressing an anchored body onto its supports does not reach rapier: it
+///   neither tips the body over nor weighs on a dynamic support below it (only the body's
+///   own motion into a support is handed to that support, as an impulse).
+/// * The force and torque of a supported body's load stay in rapier's user force and torque
+///   of the body until the coupling takes them off after rapier's next step; calling
+///   `RigidBody::reset_forces`/`reset_torques` on it between two coupled steps leaves their
+///   opposite behind.
 /// * Joints are only enforced by rapier: inside the substeps a jointed dynamic body moves
 ///   freely under soft reactions, and rapier pulls it back at the next step.
 #[derive(Clone, Debug)]

@@ -2,8 +2,8 @@
 //!
 //! A dynamic body that rapier reports in contact with other rigid colliders is normally
 //! *supported*: infinitely heavy inside the substeps, its summed soft reaction handed to
-//! rapier as a velocity change (`bodies` module docs). That is an explicit coupling with a
-//! frame of lag, stable for contacts, which mostly press a body onto its supports. An
+//! rapier as a force for its next step (`bodies` module docs). That is an explicit coupling
+//! with a frame of lag, stable for contacts, which mostly press a body onto its supports. An
 //! attachment is two-way and bilateral: rapier moves the body by the reaction, the body drags
 //! the attached soft body along, whose reaction moves the body further. The gain of that loop
 //! is the mass ratio soft/rigid, so a light body holding a heavy soft body diverged within a
@@ -19,12 +19,23 @@
 //! neither pushed out nor deepened here. The body is then written back like any body that
 //! took part (pose and velocity), without being pushed into its supports.
 //!
-//! The reaction of a dynamic support is summed over the frame and applied to it as an
-//! impulse (its velocity at rapier's next step), as for a supported body; a fixed or
+//! Gauss–Seidel alone would let a heavy soft body sink into a light anchored body: each soft
+//! projection moves mostly the body, the support moves it back, and the soft penetration
+//! stays. So, as in shock propagation, a soft impulse that presses an anchored body into
+//! its supports (more than 60° against their mean normal) finds it infinitely heavy and does
+//! not move it; the soft side takes the whole correction. That impulse is not handed to
+//! rapier either: the supports would take it (a fixed ground cancels it), and a soft load
+//! handed to a light body a frame late is what made it unstable. The cost: such a load
+//! neither tips the body nor weighs on a dynamic support below it.
+//!
+//! The reaction of a dynamic support to the body's own motion into it is summed over the
+//! frame and applied to it as an impulse (its velocity at rapier's next step); a fixed or
 //! kinematic support takes none.
 //!
-//! Limits: the supports carry no friction inside the substeps (rapier's friction acts at its
-//! next step on the written-back velocity); the contact points are those of rapier's
+//! The supports carry static friction (rapier's combined coefficient): the tangential motion
+//! of a contact point over a substep is undone up to μ times the substep's normal impulse.
+//!
+//! Limits: the contact points are those of rapier's
 //! manifolds at the start of its step, in the collider's own frame (contacts with a part of a
 //! compound shape are placed in the compound's frame without the part's pose).
 
@@ -48,6 +59,8 @@ pub(crate) struct Support {
     pub normal: Vector3<f32>,
     /// Lowest value the constraint may take, m (≤ 0).
     floor: f32,
+    /// Friction coefficient of the contact (rapier's combined one).
+    friction: f32,
     /// The support's body when it is dynamic, and its world centre of mass, m.
     other: Option<(RigidBodyHandle, Vector3<f32>)>,
     /// Positional impulse on the anchored body in the current substep, kg·m.
@@ -114,6 +127,7 @@ pub(crate) fn gather_supports(
                         point: point.coords,
                         normal,
                         floor: c_end.min(0.0),
+                        friction: m.data.friction,
                         other: other_body,
                         sub: Vector3::zeros(),
                         impulse: Vector3::zeros(),
@@ -125,7 +139,8 @@ pub(crate) fn gather_supports(
 }
 
 /// One sweep over the supports: keeps each anchored body's contact points out of its
-/// supports (the support immovable).
+/// supports (the support immovable), with static Coulomb friction on the point's motion
+/// over the substep (as the particle contacts, `contact` module docs).
 pub(crate) fn project_supports(supports: &mut [Support], bodies: &mut [BodyProxy]) {
     for s in supports {
         let body = &mut bodies[s.body];
@@ -141,6 +156,29 @@ pub(crate) fn project_supports(supports: &mut [Support], bodies: &mut [BodyProxy
         let p = s.normal * (-c / w);
         body.apply_position_impulse(&p, &x);
         s.sub += p;
+        // Friction: undo the tangential motion of the point over the substep, up to
+        // μ times the normal impulse of the substep.
+        let x = (body.pose * Point3::from(s.local)).coords;
+        let moved = x - (body.prev * Point3::from(s.local)).coords;
+        let slide = moved - s.normal * s.normal.dot(&moved);
+        let len = slide.norm();
+        if !(len > 1e-9) {
+            continue;
+        }
+        let t = slide / len;
+        let w = body.inv_mass_at(&x, &t);
+        if w.is_nan() || w <= 0.0 {
+            continue;
+        }
+        let normal = s.normal.dot(&s.sub);
+        let tangential = (s.sub - s.normal * normal).norm();
+        let room = (s.friction * normal - tangential).max(0.0);
+        let dl = (len / w).min(room);
+        if dl > 0.0 {
+            let p = -t * dl;
+            body.apply_position_impulse(&p, &x);
+            s.sub += p;
+        }
     }
 }
 
@@ -154,7 +192,9 @@ pub(crate) fn end_substep_supports(supports: &mut [Support], h: f32) {
 
 /// The dynamic support of `s` and the impulse (N·s) and angular impulse about its centre of
 /// mass (N·m·s) it takes over the frame (the reaction of the anchored body's push).
-pub(crate) fn support_reaction(s: &Support) -> Option<(RigidBodyHandle, Vector3<f32>, Vector3<f32>)> {
+pub(crate) fn support_reaction(
+    s: &Support,
+) -> Option<(RigidBodyHandle, Vector3<f32>, Vector3<f32>)> {
     let (h, com) = s.other?;
     let j = -s.impulse;
     (j != Vector3::zeros()).then(|| (h, j, (s.point - com).cross(&j)))
