@@ -162,7 +162,7 @@ pub(crate) fn project_supports(supports: &mut [Support], bodies: &mut [BodyProxy
         let moved = x - (body.prev * Point3::from(s.local)).coords;
         let slide = moved - s.normal * s.normal.dot(&moved);
         let len = slide.norm();
-        if !(len > 1e-9) {
+        if len.is_nan() || len <= 1e-9 {
             continue;
         }
         let t = slide / len;
