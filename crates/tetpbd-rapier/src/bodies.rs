@@ -80,8 +80,8 @@ pub(crate) struct BodyProxy {
     impulse: Vector3<f32>,
     angular: Vector3<f32>,
     /// Mean contact normal of an anchored body's rigid supports (unit, towards the body;
-    /// zero for any other body): an impulse pressing the body into them is summed like a
-    /// supported body's instead of moving it (`support` module docs).
+    /// zero for any other body): an impulse pressing the body into them does not move it
+    /// and is left to the supports (`support` module docs).
     support_normal: Vector3<f32>,
     /// Linear and angular velocity at the start of the current substep (before any soft
     /// correction), and the centre of mass they refer to.
@@ -282,9 +282,13 @@ impl BodyProxy {
         n.dot(&self.inv_mass.component_mul(n)) + rn.dot(&(self.inv_inertia * rn))
     }
 
-    /// Applies a positional impulse `p` (kg·m: direction × Δλ) at the world point `q`.
+    /// Applies a positional impulse `p` (kg·m: direction × Δλ) at the world point `q` (an
+    /// anchored body ignores one pressing it into its supports).
     pub fn apply_position_impulse(&mut self, p: &Vector3<f32>, q: &Vector3<f32>) {
-        if self.kind == BodyKind::Supported || (self.kind == BodyKind::Dynamic && self.pressed(p)) {
+        if self.kind == BodyKind::Dynamic && self.pressed(p) {
+            return;
+        }
+        if self.kind == BodyKind::Supported {
             self.sub_impulse += p;
             self.sub_angular += (q - self.com()).cross(p);
             self.touched = true;
@@ -304,7 +308,7 @@ impl BodyProxy {
 
     /// Ends a substep: the offset velocities follow from the offset motion.
     pub fn end_substep(&mut self, h: f32) {
-        if self.kind != BodyKind::Fixed {
+        if self.kind == BodyKind::Supported {
             self.impulse += self.sub_impulse / h;
             self.angular += self.sub_angular / h;
             self.sub_impulse = Vector3::zeros();
@@ -330,9 +334,13 @@ impl BodyProxy {
         }
     }
 
-    /// Applies a velocity impulse `j` (N·s) at the world point `q`.
+    /// Applies a velocity impulse `j` (N·s) at the world point `q` (an anchored body ignores
+    /// one pressing it into its supports).
     pub fn apply_velocity_impulse(&mut self, j: &Vector3<f32>, q: &Vector3<f32>) {
-        if self.kind == BodyKind::Supported || (self.kind == BodyKind::Dynamic && self.pressed(j)) {
+        if self.kind == BodyKind::Dynamic && self.pressed(j) {
+            return;
+        }
+        if self.kind == BodyKind::Supported {
             self.impulse += j;
             self.angular += (q - self.com()).cross(j);
             self.touched = true;
@@ -347,9 +355,8 @@ impl BodyProxy {
     }
 
     /// Force (N) and torque about the centre of mass (N·m) that carry the summed soft
-    /// impulse on a supported body, or the part pressing an anchored body into its supports,
-    /// through rapier's next step (the impulse of this frame spread over `dt`); `None` when
-    /// there is none.
+    /// impulse on a supported body through rapier's next step (the impulse of this frame
+    /// spread over `dt`); `None` for any other body or when there is none.
     pub fn load(&self) -> Option<(Vector3<f32>, Vector3<f32>)> {
         (self.kind == BodyKind::Supported
             && self.touched
@@ -358,8 +365,8 @@ impl BodyProxy {
     }
 
     /// Writes the result back to rapier: for a body that took part with its mass its final
-    /// pose and velocity (`v₁` plus the offset's); the [`Self::load`] of a supported or
-    /// anchored body as a force and torque added for rapier's next step (the caller takes
+    /// pose and velocity (`v₁` plus the offset's); the [`Self::load`] of a supported body
+    /// as a force and torque added for rapier's next step (the caller takes
     /// them off again after that step). A force, not a velocity change: rapier's solver
     /// applies it in its substeps together with the rigid contacts, as it does gravity, where
     /// a velocity change of the same impulse is an impact (a 100 kg soft body resting on a

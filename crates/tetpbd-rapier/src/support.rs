@@ -35,9 +35,11 @@
 //! The supports carry static friction (rapier's combined coefficient): the tangential motion
 //! of a contact point over a substep is undone up to μ times the substep's normal impulse.
 //!
-//! Limits: the contact points are those of rapier's
-//! manifolds at the start of its step, in the collider's own frame (contacts with a part of a
-//! compound shape are placed in the compound's frame without the part's pose).
+//! Limits: the contact points are those of rapier's manifolds, computed at the start of its
+//! step and read as points of each collider's own frame; for a part of a compound shape that
+//! reading is not checked (the part's pose in the compound is not applied). Only rapier's
+//! active contacts count: a support the body only comes to touch inside the substeps is
+//! not there.
 
 use nalgebra::{Point3, Vector3};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
