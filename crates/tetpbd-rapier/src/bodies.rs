@@ -175,10 +175,14 @@ impl BodyProxy {
 
     /// Makes a supported body *anchored* (`support` module docs): it takes part with its
     /// generalized inverse mass, except against impulses pressing it into its supports,
-    /// whose mean contact normal (towards the body) is `normal`.
+    /// whose mean contact normal (towards the body) is `normal`. It is written back every
+    /// frame, which also keeps rapier from putting it to sleep: left at rapier's result in
+    /// a frame where the soft body only pressed it into its supports, the scene of
+    /// `tests/issue_3_attachment_with_contacts.rs` (a) diverged after about 2 s.
     pub fn anchor(&mut self, normal: Vector3<f32>) {
         if self.kind == BodyKind::Supported {
             self.kind = BodyKind::Dynamic;
+            self.touched = true;
             self.support_normal = normal.try_normalize(1e-6).unwrap_or_default();
         }
     }
