@@ -163,6 +163,9 @@ fn print(name: &str, samples: &[Sample]) {
 /// Frames per second of the scenes (rapier's default `dt`).
 const FPS: usize = 60;
 
+/// Length of the runs, s.
+const SECONDS: usize = 10;
+
 /// Checks what every scene must keep: finite state in every frame, the attachment holding
 /// (the particle within 2 cm of its anchor through impacts, within `max_gap` once settled)
 /// and, from `settled` on, particles and box slow.
@@ -186,33 +189,40 @@ fn check_bounded(name: &str, samples: &[Sample], settled: usize, max_gap: f32) {
     }
 }
 
-/// Scene (a): a 2-cell soft cube (100 kg) standing on a 0.125 kg dynamic box that rests on
-/// the ground, its bottom-centre particle attached to the box. The box touches the ground
-/// (rapier contact) and the soft cube: it used to be flung away within two frames.
+/// Scene (a): a 2-cell soft cube (100 kg, or 1000 kg) standing on a 0.125 kg dynamic box
+/// that rests on the ground, its bottom-centre particle pinned to the box. The box touches
+/// the ground (rapier contact) and the soft cube: it used to be flung away within two frames.
+/// Over 10 s the box stays within 5 cm of its place, upright, and the pin holds.
 #[test]
 fn soft_cube_attached_to_a_box_on_the_ground() {
-    let mut s = scene();
-    let start = Vector3::new(2.0, 0.25, 0.0);
-    let b = rigid_box(&mut s, start);
-    let e = soft_cube(&mut s, 2, Vector3::new(2.0, 1.01, 0.0), 100.0);
-    let i = nearest(&s, e, Vector3::new(2.0, 0.51, 0.0));
-    attach(&mut s, e, i, b, 0.0);
-    let samples = run(&mut s, 5 * FPS, &[e], (e, i), b);
-    print("a", &samples);
-    check_bounded("a", &samples, FPS, 5e-3);
-    for (f, x) in samples.iter().enumerate() {
-        assert!(
-            (x.box_at - start).norm() < 0.05 && x.upright > 0.99,
-            "a: the box left its place at frame {f}: at {:?}, up {}",
-            x.box_at,
-            x.upright
-        );
+    // Known limit: with a compliant attachment (1e-5 m/N) the spring lifts the box off
+    // the ground; without a rigid contact it is no longer anchored, the soft cube pushes it
+    // into the ground inside the substeps and it diverges after about 1 s.
+    for (compliance, density) in [(0.0, 100.0), (0.0, 1000.0)] {
+        let name = format!("a (compliance {compliance:e} m/N, density {density} kg/m³)");
+        let mut s = scene();
+        let start = Vector3::new(2.0, 0.25, 0.0);
+        let b = rigid_box(&mut s, start);
+        let e = soft_cube(&mut s, 2, Vector3::new(2.0, 1.01, 0.0), density);
+        let i = nearest(&s, e, Vector3::new(2.0, 0.51, 0.0));
+        attach(&mut s, e, i, b, compliance);
+        let samples = run(&mut s, SECONDS * FPS, &[e], (e, i), b);
+        print(&name, &samples);
+        check_bounded(&name, &samples, FPS, 5e-3);
+        for (f, x) in samples.iter().enumerate() {
+            assert!(
+                (x.box_at - start).norm() < 0.05 && x.upright > 0.99,
+                "{name}: the box left its place at frame {f}: at {:?}, up {}",
+                x.box_at,
+                x.upright
+            );
+        }
+        let creep = (samples[SECONDS * FPS - 1].box_at - samples[2 * FPS - 1].box_at).norm();
+        println!("{name}: box moved {creep:.4} m from 2 s to {SECONDS} s");
+        // The soft cube keeps rocking on the small box top (particle speeds of 0.03–0.2 m/s)
+        // and walks the box about 1 cm/s; that creep is bounded here, not absent.
+        assert!(creep < 0.05, "{name}: the box creeps {creep} m");
     }
-    let creep = (samples[5 * FPS - 1].box_at - samples[2 * FPS - 1].box_at).norm();
-    println!("a: box moved {creep:.4} m from 2 s to 5 s");
-    // The soft cube keeps rocking on the small box top (particle speeds of 0.03–0.2 m/s)
-    // and walks the box about 1 cm/s; that creep is bounded here, not absent.
-    assert!(creep < 0.05, "a: the box creeps {creep} m in 3 s");
 }
 
 /// Scene (b): a 0.125 kg dynamic box resting on a soft cube (soft contacts only), a second
