@@ -1,40 +1,35 @@
 //! Issue 3, item 5 (two-way attachments): a soft body attached to a dynamic rigid body that
 //! also has soft contacts, or rigid contacts, stays bounded and the attachment holds.
 
+mod coupling_common;
+
+use coupling_common::{ground, soft_box_with_density};
 use hecs::Entity;
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
-use tetpbd::generators::{self, CellSplit};
-use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
+use tetpbd::Particles;
 use tetpbd_rapier::convert::to_na;
-use tetpbd_rapier::{AttachTarget, Attachments, CoupledWorld, CouplingSettings};
+use tetpbd_rapier::{AttachTarget, Attachments, CoupledWorld, SoftCollider};
 
+/// A scene at 60 Hz with 10 substeps and the ground cuboid (top face at y = 0).
 fn scene() -> CoupledWorld {
-    let solver = SolverSettings {
-        substeps: 10,
-        ..SolverSettings::default()
-    };
-    let mut scene = CoupledWorld::new(solver, CouplingSettings::default()).expect("settings");
-    scene.physics.insert(
-        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
-        ColliderBuilder::cuboid(5.0, 0.5, 5.0),
-    );
+    let mut scene = coupling_common::scene(10);
+    ground(&mut scene);
     scene
 }
 
 /// A 1 m soft cube of `cells`³ cells centred at `at`, stiff edges and volume.
 fn soft_cube(scene: &mut CoupledWorld, cells: u32, at: Vector3<f32>, density: f32) -> Entity {
-    let mesh =
-        generators::box_grid(Vector3::repeat(1.0), [cells; 3], CellSplit::Six).expect("mesh");
-    SoftBodyBuilder::new(mesh)
-        .density(density)
-        .edges(0.0)
-        .volume(0.0)
-        .translation(at)
-        .build()
-        .expect("body")
-        .spawn(&mut scene.soft)
+    let size = Vector3::repeat(1.0);
+    soft_box_with_density(
+        scene,
+        size,
+        [cells; 3],
+        at,
+        density,
+        SoftCollider::default(),
+    )
 }
 
 /// A dynamic rigid box of half extent 0.25 m (rapier's default density) at `at`.
