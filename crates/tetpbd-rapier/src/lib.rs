@@ -62,6 +62,7 @@ mod hook;
 mod material;
 mod report;
 mod restitution;
+mod rolling;
 mod scene;
 mod shape_query;
 mod soft_bvh;
