@@ -4,8 +4,8 @@
 //! A blob stiff enough to roll like a rigid body rocks with sticking friction, which does no
 //! work; deformation damping only damps deformation. Without rolling resistance the
 //! `bunny_blob` asset still rocked at 0.03–0.07 m/s after 10 s; with the default rolling
-//! resistance of [`tetpbd_rapier::SoftCollider`] it rests within a few seconds
-//! (docs/coupling-contacts.md).
+//! resistance of [`tetpbd_rapier::SoftCollider`] it rests within a few seconds (the
+//! `Coupling` docs of `tetpbd-rapier`).
 
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
@@ -33,7 +33,10 @@ const WINDOW: usize = 30;
 /// Drops the blob from 0.4 m with the `asset_drop` example's settings (10 substeps, friction
 /// 0.6, deformation damping 5/s), the given rolling resistance, for `frames` frames of 1/60 s.
 fn drop_blob(rolling: Option<f32>, frames: usize) -> Rest {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/assets/bunny_blob.obj");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/assets/bunny_blob.obj"
+    );
     let render = SurfaceMesh::read_obj(path).expect("asset");
     let mesh = TetrahedralizeBuilder::new(CELL)
         .smoothing(3)
@@ -99,7 +102,11 @@ fn blob_with_default_rolling_resistance_comes_to_rest() {
     // 7 s: the blob lands at 0.3 s and tumbles; it rests at about 6 s (0.0006 m/s).
     let r = drop_blob(None, 420);
     assert!(r.speed < 0.01, "still moving at {} m/s", r.speed);
-    assert!(r.penetration < 0.01 * CELL, "penetration {} m", r.penetration);
+    assert!(
+        r.penetration < 0.01 * CELL,
+        "penetration {} m",
+        r.penetration
+    );
     assert_eq!(r.inverted, 0, "inverted tetrahedra at rest");
 }
 

@@ -4,8 +4,8 @@
 //! Why: a soft body is stiff enough to roll like a rigid one, and rolling with sticking
 //! friction does no work, so nothing in the contacts takes the energy of a rocking or
 //! rolling body; [`crate::DeformationDamping`] only damps deformation, not the rigid
-//! rotation. A blob dropped on its rounded belly then rocks for tens of seconds (0.03–0.06
-//! m/s after 10 s in the `asset_drop` example; docs/coupling-contacts.md). Real bodies stop
+//! rotation. A blob dropped on its rounded belly then rocks for tens of seconds (0.01–0.07
+//! m/s after 10–15 s in the `asset_drop` example, see [`crate::Coupling`]). Real bodies stop
 //! because the contact patch deforms with hysteresis, which moves the normal force ahead of
 //! the contact point: a resisting couple of at most `c_rr · N · R` (`c_rr` the rolling
 //! resistance coefficient, `N` the normal force, `R` the lever from the centre of mass to the
