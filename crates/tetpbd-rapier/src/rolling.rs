@@ -40,6 +40,10 @@ use crate::corner::CornerContact;
 use crate::damping::RigidFit;
 use crate::frame::{ColliderProxy, ParticleContact};
 
+/// Smallest share of a body's kinetic energy relative to its centre of mass that must be
+/// rigid rotation for the body to count as rolling.
+const ROLLING_SHARE: f32 = 0.5;
+
 /// Applies the rolling resistance of one soft body for a substep of length `h`. `active` is
 /// scratch space (its capacity is reused).
 #[allow(clippy::too_many_arguments)]
@@ -72,6 +76,17 @@ pub(crate) fn rolling_pass(
     let Some(mut fit) = RigidFit::of(p) else {
         return;
     };
+    // Only a body that turns as a whole rolls: when most of its motion relative to its
+    // centre of mass is deformation (a body squashed under a load, wobbling), the fitted ω
+    // is not a rotation to resist.
+    let relative: f32 = (0..p.len())
+        .filter(|&i| p.inv_masses()[i] > 0.0)
+        .map(|i| 0.5 * p.masses()[i] * (p.velocities()[i] - fit.v_cm).norm_squared())
+        .sum();
+    let turning = 0.5 * fit.omega.dot(&(fit.inertia * fit.omega));
+    if turning.is_nan() || turning < ROLLING_SHARE * relative {
+        return;
+    }
     for &ci in active.iter() {
         let mut lambda = 0.0f32;
         let mut q = Vector3::zeros();
