@@ -183,8 +183,9 @@ impl<'a> RapierContext<'a> {
 /// 20 J; once the rocking is stopped by hand (velocities halved every frame for 5 s) the
 /// released body stays at rest (≤ 0.002 m/s), so the contacts do not pump energy into it,
 /// they only fail to take it out. A stiffer body (40 substeps, or 4 iterations) still
-/// reaches 0.01–0.02 m/s after 10 s. With the default 0.01 max |v| is below 0.01 m/s from 4.4 s on and below 0.0003 m/s
-/// after 5 s.
+/// reaches 0.01–0.02 m/s after 10 s. With a coefficient of 0.01 (what the example sets;
+/// the default is 0, off: `rolling` module docs) max |v| is below 0.01 m/s from 4.4 s on
+/// and below 0.0003 m/s after 5 s.
 ///
 /// # Known limits
 ///
@@ -192,9 +193,10 @@ impl<'a> RapierContext<'a> {
 ///   body 1000× heavier than the soft body under it needs a few iterations per substep.
 /// * A heavy soft body on a stack of supported rigid bodies keeps a small rocking motion
 ///   (a few cm/s), the one-frame lag between the soft load and rapier's answer.
-/// * Rolling resistance acts on the rigid fit of a whole body (its centre of mass and
-///   mean angular velocity): a body with pinned particles is skipped, and a soft body lying
-///   over several colliders gets one couple per collider.
+/// * Rolling resistance is off by default and acts on the rigid fit of a whole body (its
+///   centre of mass and mean angular velocity): a body with pinned particles is skipped,
+///   a soft body lying over several colliders gets one couple per collider, and a dynamic
+///   collider's share is estimated from its inverse inertia about the rotation axis only.
 /// * Joints are only enforced by rapier: inside the substeps a jointed dynamic body moves
 ///   freely under soft reactions, and rapier pulls it back at the next step.
 #[derive(Clone, Debug)]

@@ -52,9 +52,10 @@ impl Default for SoftCollider {
 }
 
 impl SoftCollider {
-    /// Default rolling resistance coefficient, dimensionless (see
-    /// [`SoftCollider::rolling_resistance`]).
-    pub const DEFAULT_ROLLING_RESISTANCE: f32 = 0.01;
+    /// Default rolling resistance coefficient, dimensionless: 0, off (see
+    /// [`SoftCollider::rolling_resistance`]; 0.01 brings a rocking body to rest within a few
+    /// seconds).
+    pub const DEFAULT_ROLLING_RESISTANCE: f32 = 0.0;
 
     /// Default contact thickness, m.
     pub const DEFAULT_THICKNESS: f32 = 0.002;
@@ -134,9 +135,8 @@ pub struct SoftColliderBuilder {
 }
 
 impl SoftColliderBuilder {
-    /// Starts from [`SoftCollider::default`] (friction 0.5, restitution 0, rolling resistance 0.01,
-    /// thickness 2 mm,
-    /// default groups, triangle collisions on).
+    /// Starts from [`SoftCollider::default`] (friction 0.5, restitution 0, rolling resistance 0,
+    /// thickness 2 mm, default groups, triangle collisions on).
     pub fn new() -> Self {
         Self::default()
     }
@@ -188,7 +188,8 @@ impl SoftColliderBuilder {
         self
     }
 
-    /// Rolling resistance coefficient, dimensionless (≥ 0; 0 turns it off).
+    /// Rolling resistance coefficient, dimensionless (≥ 0; 0, the default, turns it off;
+    /// about 0.01 stops a rocking or rolling body within seconds).
     pub fn rolling_resistance(mut self, c_rr: f32) -> Self {
         self.inner.rolling_resistance = c_rr;
         self
