@@ -52,6 +52,7 @@ use crate::bodies::BodyProxy;
 use crate::corner::CornerContact;
 use crate::damping::RigidFit;
 use crate::frame::{ColliderProxy, ParticleContact};
+use crate::restitution::active_colliders;
 
 /// Applies the rolling resistance of one soft body for a substep of length `h`. `active` is
 /// scratch space (its capacity is reused).
@@ -69,19 +70,10 @@ pub(crate) fn rolling_pass(
     if coefficient <= 0.0 || p.inv_masses().contains(&0.0) {
         return;
     }
-    active.clear();
-    active.extend(
-        contacts
-            .iter()
-            .filter(|c| c.active && c.solve)
-            .map(|c| c.collider)
-            .chain(corners.iter().filter(|k| k.active).map(|k| k.collider)),
-    );
+    active_colliders(active, contacts, corners);
     if active.is_empty() {
         return;
     }
-    active.sort_unstable();
-    active.dedup();
     let Some(mut fit) = RigidFit::of(p) else {
         return;
     };
