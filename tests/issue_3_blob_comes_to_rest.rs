@@ -7,12 +7,11 @@
 //! of 0.01 ([`tetpbd_rapier::SoftColliderBuilder::rolling_resistance`], off by default) it
 //! rests within a few seconds (the `Coupling` docs of `tetpbd-rapier`).
 
-use nalgebra::Vector3;
-use rapier3d::math::Vector;
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
-use tetpbd::{Particles, SoftBodyBuilder, SolverSettings, Tetrahedra};
-use tetpbd_io::{SurfaceMesh, TetrahedralizeBuilder};
-use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping, SoftColliderBuilder};
+mod asset_drop_common;
+
+use asset_drop_common::{asset_drop, AssetDrop};
+use tetpbd::{Particles, Tetrahedra};
+use tetpbd_rapier::SoftColliderBuilder;
 
 /// Cell size of the tetrahedralization, m (coarser than the example's 0.07 m for speed).
 const CELL: f32 = 0.1;
@@ -31,47 +30,22 @@ struct Rest {
 const WINDOW: usize = 30;
 
 /// Drops the blob from 0.4 m with the `asset_drop` example's settings (10 substeps, friction
-/// 0.6, deformation damping 5/s), the given rolling resistance, for `frames` frames of 1/60 s.
+/// 0.6, deformation damping 5/s), the given rolling resistance (`None`: the default), for
+/// `frames` frames of 1/60 s.
 fn drop_blob(rolling: Option<f32>, frames: usize) -> Rest {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/assets/bunny_blob.obj"
-    );
-    let render = SurfaceMesh::read_obj(path).expect("asset");
-    let mesh = TetrahedralizeBuilder::new(CELL)
-        .smoothing(3)
-        .build(&render)
-        .expect("tetrahedra");
-    let solver = SolverSettings {
-        substeps: 10,
-        ..SolverSettings::default()
-    };
-    let mut scene = CoupledWorld::new(solver, CouplingSettings::default()).expect("scene");
-    scene.physics.insert(
-        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
-        ColliderBuilder::cuboid(5.0, 0.5, 5.0),
-    );
-    let lowest = render.vertices.iter().map(|v| v.y).fold(f32::MAX, f32::min);
-    let e = SoftBodyBuilder::new(mesh)
-        .density(300.0)
-        .edges(1e-6)
-        .volume(0.0)
-        .translation(Vector3::new(0.0, 0.4 - lowest, 0.0))
-        .build()
-        .expect("body")
-        .spawn(&mut scene.soft);
     let mut collider = SoftColliderBuilder::new().friction(0.6);
     if let Some(c) = rolling {
         collider = collider.rolling_resistance(c);
     }
-    scene
-        .soft
-        .insert_one(e, collider.build().expect("collider"))
-        .expect("entity");
-    scene
-        .soft
-        .insert_one(e, DeformationDamping::new(5.0).expect("damping"))
-        .expect("entity");
+    let AssetDrop {
+        mut scene, body: e, ..
+    } = asset_drop(
+        "bunny_blob.obj",
+        CELL,
+        3,
+        0.4,
+        collider.build().expect("collider"),
+    );
     let mut rest = Rest {
         speed: 0.0,
         penetration: 0.0,
