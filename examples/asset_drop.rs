@@ -75,9 +75,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         skin.outside_count()
     );
     let e = body.spawn(&mut scene.soft);
-    scene
-        .soft
-        .insert_one(e, SoftColliderBuilder::new().friction(0.6).build()?)?;
+    scene.soft.insert_one(
+        e,
+        // Rolling resistance: without it the blob rocks on its round belly for tens of
+        // seconds (tetpbd_rapier::Coupling docs).
+        SoftColliderBuilder::new()
+            .friction(0.6)
+            .rolling_resistance(0.01)
+            .build()?,
+    )?;
     scene.soft.insert_one(e, DeformationDamping::new(5.0)?)?;
 
     let mut skinned = vec![Vector3::zeros(); points.len()];

@@ -1,12 +1,13 @@
 //! A committed sample asset, tetrahedralized with `tetpbd-io`, drops on fixed ground and
 //! comes to rest there, with its skinned render mesh following it.
 
+mod asset_drop_common;
+
+use asset_drop_common::{asset_drop, AssetDrop};
 use nalgebra::Vector3;
-use rapier3d::math::Vector;
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
-use tetpbd::{Particles, SoftBodyBuilder, SolverSettings, Tetrahedra};
-use tetpbd_io::{Skin, SurfaceMesh, TetrahedralizeBuilder};
-use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping, SoftColliderBuilder};
+use tetpbd::{Particles, Tetrahedra};
+use tetpbd_io::SurfaceMesh;
+use tetpbd_rapier::SoftColliderBuilder;
 
 /// What one drop measured.
 struct Drop {
@@ -32,58 +33,23 @@ struct Drop {
 }
 
 fn drop_asset(name: &str, cell: f32, smoothing: u32, height: f32, frames: usize) -> Drop {
-    let path = format!("{}/examples/assets/{name}", env!("CARGO_MANIFEST_DIR"));
-    let render = SurfaceMesh::read_obj(path).expect("asset");
-    let mesh = TetrahedralizeBuilder::new(cell)
-        .smoothing(smoothing)
-        .build(&render)
-        .expect("tetrahedra");
-    let solver = SolverSettings {
-        substeps: 10,
-        ..SolverSettings::default()
-    };
-    let mut scene = CoupledWorld::new(solver, CouplingSettings::default()).expect("scene");
-    scene.physics.insert(
-        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
-        ColliderBuilder::cuboid(5.0, 0.5, 5.0),
-    );
-    let lowest = render.vertices.iter().map(|v| v.y).fold(f32::MAX, f32::min);
-    let lift = Vector3::new(0.0, height - lowest, 0.0);
-    let body = SoftBodyBuilder::new(mesh)
-        .density(300.0)
-        .edges(1e-6)
-        .volume(0.0)
-        .translation(lift)
+    let collider = SoftColliderBuilder::new()
+        .friction(0.6)
         .build()
-        .expect("body");
-    let points: Vec<_> = render.vertices.iter().map(|v| v + lift).collect();
-    let skin = Skin::embed(
-        body.particles.positions(),
-        body.tetrahedra.indices(),
-        &points,
-    )
-    .expect("skin");
+        .expect("collider");
+    let AssetDrop {
+        mut scene,
+        body: e,
+        render,
+        points,
+        skin,
+        tets,
+    } = asset_drop(name, cell, smoothing, height, collider);
     assert_eq!(
         skin.outside_count(),
         0,
         "{name}: render vertices outside the tetrahedra"
     );
-    let tets = body.tetrahedra.len();
-    let e = body.spawn(&mut scene.soft);
-    scene
-        .soft
-        .insert_one(
-            e,
-            SoftColliderBuilder::new()
-                .friction(0.6)
-                .build()
-                .expect("collider"),
-        )
-        .expect("entity");
-    scene
-        .soft
-        .insert_one(e, DeformationDamping::new(5.0).expect("damping"))
-        .expect("entity");
     let mut penetration = 0.0f32;
     let mut inverted_peak = 0;
     for frame in 0..frames {

@@ -28,7 +28,9 @@
 //! allowance.
 //!
 //! The velocity pass then removes the separating normal velocity the projection gave each
-//! contact particle; restitution is applied to the whole body by [`crate::restitution`].
+//! contact particle; restitution is applied to the whole body by [`crate::restitution`],
+//! rolling resistance by [`crate::rolling`] (sticking friction alone lets a rounded body
+//! roll and rock without loss).
 
 use nalgebra::{Point3, Vector3};
 use rapier3d::geometry::ColliderSet;

@@ -38,49 +38,72 @@ impl DeformationDamping {
     }
 }
 
+/// The rigid motion that best fits a soft body's free particles (pinned ones excluded):
+/// centre of mass `x_cm` (m), its velocity `v_cm` (m/s), the inertia tensor about it
+/// `I = Σ mᵢ [rᵢ]ₓ[rᵢ]ₓᵀ` (kg·m²) and the angular velocity `ω = I⁻¹ Σ rᵢ × mᵢvᵢ` (rad/s).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RigidFit {
+    pub x_cm: Vector3<f32>,
+    pub v_cm: Vector3<f32>,
+    pub inertia: Matrix3<f32>,
+    pub omega: Vector3<f32>,
+}
+
+impl RigidFit {
+    /// The fit of `p`; `None` without free mass or when the result is not finite.
+    pub fn of(p: &Particles) -> Option<RigidFit> {
+        let mut m = 0.0f32;
+        let mut x_cm = Vector3::zeros();
+        let mut v_cm = Vector3::zeros();
+        for i in 0..p.len() {
+            if p.inv_masses()[i] > 0.0 {
+                let mi = p.masses()[i];
+                m += mi;
+                x_cm += p.positions()[i] * mi;
+                v_cm += p.velocities()[i] * mi;
+            }
+        }
+        if m <= 0.0 {
+            return None;
+        }
+        x_cm /= m;
+        v_cm /= m;
+        let mut l = Vector3::zeros();
+        let mut inertia = Matrix3::zeros();
+        for i in 0..p.len() {
+            if p.inv_masses()[i] > 0.0 {
+                let mi = p.masses()[i];
+                let r = p.positions()[i] - x_cm;
+                l += r.cross(&(p.velocities()[i] * mi));
+                let rx = r.cross_matrix();
+                inertia += rx * rx.transpose() * mi;
+            }
+        }
+        let omega = inertia
+            .try_inverse()
+            .map_or(Vector3::zeros(), |inv| inv * l);
+        omega.iter().all(|c| c.is_finite()).then_some(RigidFit {
+            x_cm,
+            v_cm,
+            inertia,
+            omega,
+        })
+    }
+}
+
 /// Applies the damping to `p` for a substep of length `h`.
 pub(crate) fn damp(p: &mut Particles, rate: f32, h: f32) {
     let k = 1.0 - (-rate * h).exp();
     if k <= 0.0 {
         return;
     }
-    let mut m = 0.0f32;
-    let mut xc = Vector3::zeros();
-    let mut vc = Vector3::zeros();
-    for i in 0..p.len() {
-        if p.inv_masses()[i] > 0.0 {
-            let mi = p.masses()[i];
-            m += mi;
-            xc += p.positions()[i] * mi;
-            vc += p.velocities()[i] * mi;
-        }
-    }
-    if m <= 0.0 {
+    let Some(fit) = RigidFit::of(p) else {
         return;
-    }
-    xc /= m;
-    vc /= m;
-    let mut l = Vector3::zeros();
-    let mut inertia = Matrix3::zeros();
+    };
     for i in 0..p.len() {
         if p.inv_masses()[i] > 0.0 {
-            let mi = p.masses()[i];
-            let r = p.positions()[i] - xc;
-            l += r.cross(&(p.velocities()[i] * mi));
-            let rx = r.cross_matrix();
-            inertia += rx * rx.transpose() * mi;
-        }
-    }
-    let w = inertia
-        .try_inverse()
-        .map_or(Vector3::zeros(), |inv| inv * l);
-    if !w.iter().all(|c| c.is_finite()) {
-        return;
-    }
-    for i in 0..p.len() {
-        if p.inv_masses()[i] > 0.0 {
-            let r = p.positions()[i] - xc;
-            let target = vc + w.cross(&r);
+            let r = p.positions()[i] - fit.x_cm;
+            let target = fit.v_cm + fit.omega.cross(&r);
             let v = &mut p.velocities_mut()[i];
             *v += (target - *v) * k;
         }

@@ -13,6 +13,7 @@ use crate::frame::{Frame, GatherInput};
 use crate::material::SoftCollider;
 use crate::report::{ContactReport, SoftFeature};
 use crate::restitution::{com_velocity, end_episodes, restitution_pass};
+use crate::rolling::rolling_pass;
 use crate::shape_query::surface_point;
 use crate::support::{end_substep_supports, project_supports};
 
@@ -129,11 +130,14 @@ impl SubstepHook for CouplingHook<'_, '_> {
         }
         end_substep_supports(supports, h);
         for s in soft.iter() {
-            let Ok((p, damping)) =
-                world.query_one_mut::<(&mut Particles, Option<&DeformationDamping>)>(s.entity)
-            else {
+            let Ok((p, damping, sc)) = world.query_one_mut::<(
+                &mut Particles,
+                Option<&DeformationDamping>,
+                Option<&SoftCollider>,
+            )>(s.entity) else {
                 continue;
             };
+            let rolling = sc.unwrap_or(&self.default_collider).rolling_resistance();
             if let Some(d) = damping {
                 damp(p, d.rate(), h);
             }
@@ -150,6 +154,16 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 bodies,
                 colliders,
                 threshold,
+            );
+            rolling_pass(
+                active_colliders,
+                &contacts[range.clone()],
+                &corners[s.corners.clone()],
+                p,
+                bodies,
+                colliders,
+                rolling,
+                h,
             );
             finish_substep(&mut contacts[range], h, self.max_depenetration_speed * h);
         }

@@ -14,8 +14,9 @@
 //!   surface triangles).
 //! * Rigid points against soft surface triangles: rigid corners and small shapes do not slip
 //!   between the particles of a coarse soft body.
-//! * Per-body collision properties and groups: the [`SoftCollider`] component; deformation
-//!   damping: the [`DeformationDamping`] component.
+//! * Per-body collision properties (friction, restitution, rolling resistance, thickness)
+//!   and groups: the [`SoftCollider`] component; deformation damping: the
+//!   [`DeformationDamping`] component.
 //! * Attachments: the [`Attachments`] component.
 //! * Contact reports: [`Coupling::contacts`]; statistics: [`CouplingStats`].
 //! * Other hooks (e.g. soft–soft contacts) run in the same substeps through
@@ -62,6 +63,7 @@ mod hook;
 mod material;
 mod report;
 mod restitution;
+mod rolling;
 mod scene;
 mod shape_query;
 mod soft_bvh;

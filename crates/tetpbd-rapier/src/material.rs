@@ -27,6 +27,7 @@ pub struct SoftCollider {
     pub(crate) friction_rule: CoefficientCombineRule,
     pub(crate) restitution: f32,
     pub(crate) restitution_rule: CoefficientCombineRule,
+    pub(crate) rolling_resistance: f32,
     pub(crate) thickness: f32,
     pub(crate) triangles: bool,
     pub(crate) enabled: bool,
@@ -42,6 +43,7 @@ impl Default for SoftCollider {
             friction_rule: CoefficientCombineRule::Average,
             restitution: 0.0,
             restitution_rule: CoefficientCombineRule::Average,
+            rolling_resistance: SoftCollider::DEFAULT_ROLLING_RESISTANCE,
             thickness: SoftCollider::DEFAULT_THICKNESS,
             triangles: true,
             enabled: true,
@@ -50,6 +52,11 @@ impl Default for SoftCollider {
 }
 
 impl SoftCollider {
+    /// Default rolling resistance coefficient, dimensionless: 0, off (see
+    /// [`SoftCollider::rolling_resistance`]; 0.01 brings a rocking body to rest within a few
+    /// seconds).
+    pub const DEFAULT_ROLLING_RESISTANCE: f32 = 0.0;
+
     /// Default contact thickness, m.
     pub const DEFAULT_THICKNESS: f32 = 0.002;
 
@@ -77,6 +84,13 @@ impl SoftCollider {
     /// Restitution coefficient, dimensionless (0 = no bounce, 1 = elastic).
     pub fn restitution(&self) -> f32 {
         self.restitution
+    }
+
+    /// Rolling resistance coefficient, dimensionless: the couple opposing the body's rotation
+    /// relative to a collider it touches is at most this times the normal force times the
+    /// lever from the body's centre of mass to the contact (`rolling` module docs; 0 = none).
+    pub fn rolling_resistance(&self) -> f32 {
+        self.rolling_resistance
     }
 
     /// Contact thickness, m: particles are kept this far outside every collider.
@@ -121,8 +135,8 @@ pub struct SoftColliderBuilder {
 }
 
 impl SoftColliderBuilder {
-    /// Starts from [`SoftCollider::default`] (friction 0.5, restitution 0, thickness 2 mm,
-    /// default groups, triangle collisions on).
+    /// Starts from [`SoftCollider::default`] (friction 0.5, restitution 0, rolling resistance 0,
+    /// thickness 2 mm, default groups, triangle collisions on).
     pub fn new() -> Self {
         Self::default()
     }
@@ -174,6 +188,13 @@ impl SoftColliderBuilder {
         self
     }
 
+    /// Rolling resistance coefficient, dimensionless (≥ 0; 0, the default, turns it off;
+    /// about 0.01 stops a rocking or rolling body within seconds).
+    pub fn rolling_resistance(mut self, c_rr: f32) -> Self {
+        self.inner.rolling_resistance = c_rr;
+        self
+    }
+
     /// Contact thickness, m.
     pub fn thickness(mut self, t: f32) -> Self {
         self.inner.thickness = t;
@@ -198,6 +219,7 @@ impl SoftColliderBuilder {
                 value: c.restitution,
             });
         }
+        check_coefficient("rolling_resistance", c.rolling_resistance)?;
         check_coefficient("thickness", c.thickness)?;
         Ok(c)
     }

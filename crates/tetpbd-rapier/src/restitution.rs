@@ -81,16 +81,7 @@ pub(crate) fn restitution_pass(
     // A body with pinned particles is anchored to the world: its centre of mass takes no
     // share of the restitution impulse.
     let anchored = p.inv_masses().contains(&0.0);
-    active.clear();
-    active.extend(
-        contacts
-            .iter()
-            .filter(|c| c.active && c.solve)
-            .map(|c| c.collider)
-            .chain(corners.iter().filter(|k| k.active).map(|k| k.collider)),
-    );
-    active.sort_unstable();
-    active.dedup();
+    active_colliders(active, contacts, corners);
     for &ci in active.iter() {
         let mut n = Vector3::zeros();
         let mut q = Vector3::zeros();
@@ -185,6 +176,25 @@ pub(crate) fn restitution_pass(
             k.impulse += share;
         }
     }
+}
+
+/// Fills `active` with the sorted, distinct collider indices of the solved particle
+/// contacts and the rigid-point contacts active in the current substep.
+pub(crate) fn active_colliders(
+    active: &mut Vec<usize>,
+    contacts: &[ParticleContact],
+    corners: &[CornerContact],
+) {
+    active.clear();
+    active.extend(
+        contacts
+            .iter()
+            .filter(|c| c.active && c.solve)
+            .map(|c| c.collider)
+            .chain(corners.iter().filter(|k| k.active).map(|k| k.collider)),
+    );
+    active.sort_unstable();
+    active.dedup();
 }
 
 /// Drops the episodes of pairs with no active contact this substep; clears the marks.
