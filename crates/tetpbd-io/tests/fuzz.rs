@@ -5,6 +5,9 @@
 //! must give `Ok` or `Err` without panicking, and every `Ok` mesh must be consistent
 //! (finite coordinates, indices in range).
 
+mod common;
+
+use common::Rng;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use tetpbd::generators::{box_grid, CellSplit};
@@ -21,22 +24,6 @@ const V22: &str = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1
 
 /// Inputs tried per target.
 const INPUTS: usize = 20_000;
-
-/// xorshift64* pseudo-random numbers.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 /// Bytes the formats are made of, so random inputs get past the first check often.
 const ALPHABET: &[u8] = b"0123456789 0 1 2 3 4\n\n\n-+.eE#$\t\rMeshFormatNodesElementsEnd";

@@ -5,6 +5,9 @@
 //! consistent (finite coordinates, indices in range, tetrahedra the builder accepts).
 #![cfg(feature = "mesher")]
 
+mod common;
+
+use common::Rng;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use tetpbd::SoftBodyBuilder;
@@ -16,22 +19,6 @@ f 1 3 2\nf 1//1 2//1 4//1\nf 1/1 4/1 3/1\nf -3 -2 -1\n";
 
 /// Inputs tried.
 const INPUTS: usize = 20_000;
-
-/// xorshift64* pseudo-random numbers.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 /// Bytes OBJ files are made of.
 const ALPHABET: &[u8] = b"0123456789 0 1 2 3\n\n\n-+.eE#/\t\rvfntolgsmtllib usemtl";
