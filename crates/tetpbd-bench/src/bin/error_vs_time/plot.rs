@@ -186,17 +186,18 @@ pub fn bounds(points: &[(f64, f64)]) -> ((f64, f64), (f64, f64)) {
     (pad(fold(|p| p.0)), pad(fold(|p| p.1)))
 }
 
-fn draw_panel<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    panel: &Panel,
-    rows: &[&Row],
-    models: &[Model],
-    colors: &[RGBColor],
-) -> DrawResult<DB> {
-    let points: Vec<(f64, f64)> = rows.iter().filter_map(|r| value(panel, r)).collect();
-    let ((x0, x1), (y0, y1)) = bounds(&points);
+/// A chart with log–log axes.
+pub type LogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// A log–log chart of error against median ms per frame over `points`, axes drawn.
+pub fn error_time_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: impl AsRef<str>,
+    points: &[(f64, f64)],
+) -> Result<LogChart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let ((x0, x1), (y0, y1)) = bounds(points);
     let mut chart = ChartBuilder::on(area)
-        .caption(panel.title, ("sans-serif", 17))
+        .caption(caption.as_ref(), ("sans-serif", 17))
         .margin(12)
         .x_label_area_size(42)
         .y_label_area_size(78)
@@ -211,6 +212,18 @@ fn draw_panel<DB: DrawingBackend>(
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .light_line_style(RGBColor(235, 235, 235))
         .draw()?;
+    Ok(chart)
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+    rows: &[&Row],
+    models: &[Model],
+    colors: &[RGBColor],
+) -> DrawResult<DB> {
+    let points: Vec<(f64, f64)> = rows.iter().filter_map(|r| value(panel, r)).collect();
+    let mut chart = error_time_chart(area, panel.title, &points)?;
     for (model, c) in models.iter().zip(colors) {
         let mine: Vec<&&Row> = rows.iter().filter(|r| r.model == *model).collect();
         let mut line: Vec<(u32, (f64, f64))> = mine

@@ -10,7 +10,7 @@ use plotters::style::{register_font, FontStyle};
 use tetpbd_bench::{ContactEngine, ContactKind, ContactScene};
 
 use crate::contacts::ContactRow;
-use crate::plot::{bounds, FONT};
+use crate::plot::{error_time_chart, FONT};
 
 const SIZE: (u32, u32) = (1800, 1150);
 const FLOOR: f64 = 1e-9;
@@ -141,23 +141,7 @@ fn draw_panel<DB: DrawingBackend>(
             .then(|| (r.res.ms_median, y.max(FLOOR)))
     };
     let points: Vec<(f64, f64)> = rows.iter().filter_map(|r| value(r)).collect();
-    let ((x0, x1), (y0, y1)) = bounds(&points);
-    let mut chart = ChartBuilder::on(area)
-        .caption(format!("{scene}: {}", metric.0), ("sans-serif", 17))
-        .margin(12)
-        .x_label_area_size(42)
-        .y_label_area_size(78)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
-    chart
-        .configure_mesh()
-        .x_desc("median ms per frame")
-        .y_desc("error")
-        .label_style(("sans-serif", 14))
-        .axis_desc_style(("sans-serif", 15))
-        .x_label_formatter(&|v| format!("{v:.1e}"))
-        .y_label_formatter(&|v| format!("{v:.0e}"))
-        .light_line_style(RGBColor(235, 235, 235))
-        .draw()?;
+    let mut chart = error_time_chart(area, format!("{scene}: {}", metric.0), &points)?;
     for (e, c) in engines.iter().zip(colors) {
         let mut line: Vec<(u32, (f64, f64))> = rows
             .iter()
