@@ -19,7 +19,8 @@ use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{
-    Attachments, CoupledWorld, CouplingSettings, SelfCollision, SoftContactSettings, SoftContacts,
+    Attachments, CoupledWorld, CouplingSettings, SelfCollision, SoftColliderBuilder,
+    SoftContactSettings, SoftContacts,
 };
 
 /// Counts the allocations of the current thread while enabled, sorted by who made them.
@@ -248,4 +249,49 @@ fn soft_pile_steps_without_allocating() {
     });
     assert!(candidates > 0, "the pile has soft–soft contact candidates");
     check("pile", &tally, frames as u64);
+}
+
+/// A soft cube rolling over rigid ground with rolling resistance on (off by default, so the
+/// scenes above never run its pass).
+#[test]
+fn rolling_resistance_steps_without_allocating() {
+    let mut scene = scene();
+    let cube = soft_cube(&mut scene, 3, Vector3::new(0.0, 0.5, 0.0));
+    let collider = SoftColliderBuilder::new()
+        .friction(0.8)
+        .rolling_resistance(0.05)
+        .build()
+        .expect("collider");
+    scene.soft.insert_one(cube, collider).expect("entity");
+    {
+        // Spin about z so the cube tips and rolls against the resistance.
+        let mut p = scene.soft.get::<&mut Particles>(cube).expect("body");
+        let centre = p.center_of_mass();
+        for i in 0..p.len() {
+            let r = p.positions()[i] - centre;
+            let v = Vector3::new(0.0, 0.0, -6.0).cross(&r);
+            p.set_velocity(i, v).expect("velocity");
+        }
+    }
+    for _ in 0..20 {
+        scene.step().expect("step");
+    }
+    let spin = |scene: &CoupledWorld| {
+        let p = scene.soft.get::<&Particles>(cube).expect("body");
+        p.angular_momentum().norm()
+    };
+    let spin_before = spin(&scene);
+    let frames = 30;
+    let mut contacts = 0;
+    let tally = counted(frames, || {
+        let stats = scene.step().expect("step");
+        contacts = contacts.max(stats.contacts);
+    });
+    println!(
+        "angular momentum {spin_before:.3} -> {:.3} kg m²/s",
+        spin(&scene)
+    );
+    assert!(contacts > 0, "the cube touches the ground");
+    assert!(spin_before > 0.1, "the cube still rolls: {spin_before}");
+    check("rolling", &tally, frames as u64);
 }
