@@ -160,9 +160,22 @@ pub struct ContactResult {
     pub max_inverted: usize,
     /// `false` when a position became non-finite.
     pub finite: bool,
+    /// The body holding the fastest particle over the last frame: its index in placement
+    /// order, that particle's speed (m/s) and the body's centre (mean particle position, m).
+    /// Says which body keeps a run from coming to rest and where it is (on the ground, on
+    /// another body, beyond the ground's edge). None for a non-finite run.
+    pub fastest_body: Option<(usize, f32, Vector3<f32>)>,
 }
 
 impl ContactResult {
+    /// `true` when the run came to rest: every position finite, settled max |v| below
+    /// [`SETTLED_SPEED`], and no particle below the ground in the resting phase. A run that
+    /// did not is unstable for the comparisons: its errors are those of a run still moving or
+    /// blown up, so it is neither a point to beat nor a candidate in them and is listed apart.
+    pub fn came_to_rest(&self) -> bool {
+        self.finite && self.settled_speed < SETTLED_SPEED && self.rest_penetration <= 0.0
+    }
+
     /// `true` when this run is at least as good as `other` on every error observable
     /// (settled speed, ground penetration, interpenetration, volume error).
     pub fn at_least_as_accurate_as(&self, other: &ContactResult) -> bool {
@@ -201,6 +214,7 @@ pub fn run_contact(
     let mut all = Vec::with_capacity(scene.frames);
     let mut speeds = Vec::with_capacity(scene.frames);
     let mut prev = sim.bodies();
+    let mut older = prev.clone();
     let many = prev.len() > 1;
     let mut worst_inter = 0.0f32;
     for f in 0..scene.frames {
@@ -230,7 +244,7 @@ pub fn run_contact(
             .flatten()
             .map(|p| p.y)
             .fold(f32::INFINITY, f32::min);
-        prev = x;
+        older = std::mem::replace(&mut prev, x);
     }
     r.frame_ms.sort_by(f64::total_cmp);
     r.frame_cpu_ms.sort_by(f64::total_cmp);
@@ -240,6 +254,7 @@ pub fn run_contact(
     r.ms_median_all = median_sorted(&all);
     r.interpenetration = many.then_some(worst_inter);
     if r.finite {
+        r.fastest_body = fastest_body(&prev, &older);
         r.settled_speed = speeds.iter().rev().take(30).copied().fold(0.0, f32::max);
         r.settle_s = speeds
             .iter()
@@ -254,6 +269,27 @@ pub fn run_contact(
         r.interpenetration = many.then_some(f32::INFINITY);
     }
     Ok(r)
+}
+
+/// The body with the fastest particle between frames `before` and `now`: index, speed (m/s),
+/// centre (m).
+fn fastest_body(
+    now: &[Vec<Vector3<f32>>],
+    before: &[Vec<Vector3<f32>>],
+) -> Option<(usize, f32, Vector3<f32>)> {
+    now.iter()
+        .zip(before)
+        .enumerate()
+        .map(|(b, (x, p))| {
+            let v = x
+                .iter()
+                .zip(p)
+                .map(|(a, c)| (a - c).norm() / DT)
+                .fold(0.0, f32::max);
+            let centre = x.iter().sum::<Vector3<f32>>() / x.len().max(1) as f32;
+            (b, v, centre)
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
 #[cfg(test)]

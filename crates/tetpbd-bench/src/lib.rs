@@ -1,8 +1,8 @@
 //! Code shared by the tetpbd-bench binaries: command-line helpers (`projections`, `scaling`)
 //! and, for `error_vs_time` and `vs_rapier`, how rapier's built-in soft bodies are set up next
 //! to tetpbd's, the contact scenes (a soft cube dropped on rigid ground, a pile of nine cubes)
-//! in both engines, and the observables measured the same way from either engine's particle
-//! positions.
+//! in both engines, the observables measured the same way from either engine's particle
+//! positions, and [`Xpbd64`], tetpbd's XPBD model stepped in `f64` for converged references.
 #![warn(missing_docs)]
 
 mod args;
@@ -11,6 +11,7 @@ mod contact_metrics;
 mod contact_scene;
 mod contact_sim;
 mod rapier_setup;
+mod xpbd64;
 
 pub use args::{arg, flag, orders};
 pub use clock::thread_cpu_ms;
@@ -24,6 +25,7 @@ pub use rapier_setup::{
     lumped_masses, rapier_label, rapier_material, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON,
     RAPIER_YOUNG,
 };
+pub use xpbd64::{Xpbd64, Xpbd64Error};
 
 /// Frame time step of every benchmark run, s.
 pub const DT: f32 = 1.0 / 60.0;

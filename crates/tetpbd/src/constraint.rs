@@ -226,20 +226,21 @@ pub fn volume<T: RealField + Copy>(
 ///
 /// `w` are the particles' inverse masses, `lambda` the constraint's multiplier (updated in
 /// place). Returns `false` (and moves nothing) when [`xpbd_delta_lambda`] returns `None`.
+/// Generic like the rest of this module: the solver runs it in `f32`, the f64 reference
+/// stepper of the benchmarks in `f64`.
 #[inline]
-pub fn apply<const N: usize>(
-    positions: &mut [Vector3<f32>],
+pub fn apply<T: RealField + Copy, const N: usize>(
+    positions: &mut [Vector3<T>],
     idx: [usize; N],
-    w: [f32; N],
-    e: &Evaluated<f32, N>,
-    lambda: &mut f32,
-    alpha_tilde: f32,
+    w: [T; N],
+    e: &Evaluated<T, N>,
+    lambda: &mut T,
+    alpha_tilde: T,
 ) -> bool {
-    let w_grad_sq: f32 = w
+    let w_grad_sq = w
         .iter()
         .zip(&e.grad)
-        .map(|(w, g)| w * g.norm_squared())
-        .sum();
+        .fold(T::zero(), |s, (w, g)| s + *w * g.norm_squared());
     match xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
         Some(dl) => {
             *lambda += dl;

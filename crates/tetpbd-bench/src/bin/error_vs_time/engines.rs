@@ -11,7 +11,8 @@ use rapier3d::prelude::{
 };
 use tetpbd::systems::{self, Measured};
 use tetpbd::{
-    hecs, ErrorStats, Family, Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats,
+    hecs, ErrorStats, Family, Particles, SoftBody, SoftBodyBuilder, Solver, SolverSettings,
+    StepStats,
 };
 
 use tetpbd_bench::{
@@ -171,38 +172,49 @@ struct Ours {
     measured: Measured,
 }
 
+/// tetpbd's body for `set` on `scene`, with the scene's start positions set: what both the
+/// `f32` solver and the `f64` reference stepper ([`tetpbd_bench::Xpbd64`]) run.
+pub fn ours_body(set: ConstraintSet, soft: bool, scene: &Scene) -> SoftBody {
+    let (l, v) = if soft {
+        (SOFT_LENGTH_COMPLIANCE, SOFT_VOLUME_COMPLIANCE)
+    } else {
+        (0.0, 0.0)
+    };
+    let b = SoftBodyBuilder::new(scene.mesh.clone())
+        .density(scene.density)
+        .pinned(scene.pinned.iter().copied());
+    let b = match set {
+        ConstraintSet::EdgesVolume => b.edges(l).volume(v),
+        ConstraintSet::VertexFace => b.vertex_face(l),
+        ConstraintSet::VertexFaceEdges => b.vertex_face(l).edges(l),
+    };
+    let mut body = b.build().expect("scene meshes are valid");
+    for (i, x) in scene.start.iter().enumerate() {
+        body.particles
+            .set_position(i, *x)
+            .expect("finite start positions");
+    }
+    body
+}
+
+/// tetpbd's solver settings for `scene` at `substeps × iterations`.
+pub fn ours_settings(scene: &Scene, substeps: u32, iterations: u32) -> SolverSettings {
+    SolverSettings {
+        dt: DT,
+        substeps,
+        iterations,
+        gravity: Vector3::new(0.0, scene.gravity, 0.0),
+        damping: scene.damping,
+        ..Default::default()
+    }
+}
+
 impl Ours {
     fn new(set: ConstraintSet, soft: bool, scene: &Scene, substeps: u32, iterations: u32) -> Ours {
-        let (l, v) = if soft {
-            (SOFT_LENGTH_COMPLIANCE, SOFT_VOLUME_COMPLIANCE)
-        } else {
-            (0.0, 0.0)
-        };
-        let b = SoftBodyBuilder::new(scene.mesh.clone())
-            .density(scene.density)
-            .pinned(scene.pinned.iter().copied());
-        let b = match set {
-            ConstraintSet::EdgesVolume => b.edges(l).volume(v),
-            ConstraintSet::VertexFace => b.vertex_face(l),
-            ConstraintSet::VertexFaceEdges => b.vertex_face(l).edges(l),
-        };
         let mut world = hecs::World::new();
-        let e = b.build().expect("scene meshes are valid").spawn(&mut world);
-        {
-            let mut p = world.get::<&mut Particles>(e).expect("just spawned");
-            for (i, x) in scene.start.iter().enumerate() {
-                p.set_position(i, *x).expect("finite start positions");
-            }
-        }
-        let solver = Solver::new(SolverSettings {
-            dt: DT,
-            substeps,
-            iterations,
-            gravity: Vector3::new(0.0, scene.gravity, 0.0),
-            damping: scene.damping,
-            ..Default::default()
-        })
-        .expect("valid settings");
+        ours_body(set, soft, scene).spawn(&mut world);
+        let solver =
+            Solver::new(ours_settings(scene, substeps, iterations)).expect("valid settings");
         Ours {
             world,
             solver,

@@ -4,7 +4,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::engines::{build, Model, Sim};
+use tetpbd_bench::Xpbd64;
+
+use crate::engines::{build, ours_body, ours_settings, ConstraintSet, Model, Sim};
 use crate::scenes::{tet_volume, Scene, SceneKind, DT};
 
 /// Observables computed the same way from either engine's positions.
@@ -224,20 +226,32 @@ pub struct Deviation {
     pub rms: f32,
 }
 
+/// Positions after every frame, in `f64` (references, and runs widened to compare with them).
+pub type Trajectory64 = Vec<Vec<Vector3<f64>>>;
+
+/// `trajectory` widened to `f64`.
+pub fn widen(trajectory: &[Vec<Vector3<f32>>]) -> Trajectory64 {
+    trajectory
+        .iter()
+        .map(|x| x.iter().map(|p| p.cast::<f64>()).collect())
+        .collect()
+}
+
 /// Compares `run` with `reference`: the last frame for the hanging beam (static
 /// equilibrium; pinned, so no rigid motion to remove), every frame for the squash, each frame
 /// after the best rigid alignment of the run onto the reference (the shape is compared, not
-/// where the free block drifted or turned).
+/// where the free block drifted or turned). In `f64`, so that the change between two `f64`
+/// references is measured below `f32` rounding.
 pub fn deviation(
     scene: &Scene,
-    run: &[Vec<Vector3<f32>>],
-    reference: &[Vec<Vector3<f32>>],
+    run: &[Vec<Vector3<f64>>],
+    reference: &[Vec<Vector3<f64>>],
 ) -> Deviation {
     let frames: Vec<usize> = match scene.kind {
         SceneKind::HangingBeam => vec![run.len().min(reference.len()).saturating_sub(1)],
         SceneKind::Squash => (0..run.len().min(reference.len())).collect(),
     };
-    let (mut max, mut sum_sq, mut n) = (0.0f32, 0.0f64, 0usize);
+    let (mut max, mut sum_sq, mut n) = (0.0f64, 0.0f64, 0usize);
     for f in frames {
         let aligned = match scene.kind {
             SceneKind::HangingBeam => run[f].clone(),
@@ -245,30 +259,31 @@ pub fn deviation(
         };
         for (a, b) in aligned.iter().zip(&reference[f]) {
             let d = (a - b).norm();
-            let d = if d.is_finite() { d } else { f32::INFINITY };
+            let d = if d.is_finite() { d } else { f64::INFINITY };
             max = max.max(d);
-            sum_sq += f64::from(d) * f64::from(d);
+            sum_sq += d * d;
             n += 1;
         }
     }
+    let size = f64::from(scene.size);
     Deviation {
-        max: max / scene.size,
-        rms: (sum_sq / n.max(1) as f64).sqrt() as f32 / scene.size,
+        max: (max / size) as f32,
+        rms: ((sum_sq / n.max(1) as f64).sqrt() / size) as f32,
     }
 }
 
 /// `x` moved by the rotation and translation that best map it onto `target` (least squares,
 /// equal weights; Kabsch). Non-finite input is returned unchanged.
-pub fn align(x: &[Vector3<f32>], target: &[Vector3<f32>]) -> Vec<Vector3<f32>> {
+pub fn align(x: &[Vector3<f64>], target: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
     if x.is_empty() || !x.iter().all(|p| p.iter().all(|c| c.is_finite())) {
         return x.to_vec();
     }
     let n = x.len() as f64;
-    let cx = x.iter().map(|p| p.cast::<f64>()).sum::<Vector3<f64>>() / n;
-    let ct = target.iter().map(|p| p.cast::<f64>()).sum::<Vector3<f64>>() / n;
+    let cx = x.iter().sum::<Vector3<f64>>() / n;
+    let ct = target.iter().sum::<Vector3<f64>>() / n;
     let mut h = Matrix3::<f64>::zeros();
     for (a, b) in x.iter().zip(target) {
-        h += (a.cast::<f64>() - cx) * (b.cast::<f64>() - ct).transpose();
+        h += (a - cx) * (b - ct).transpose();
     }
     let svd = h.svd(true, true);
     let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
@@ -280,9 +295,7 @@ pub fn align(x: &[Vector3<f32>], target: &[Vector3<f32>]) -> Vec<Vector3<f32>> {
         v.column_mut(2).neg_mut();
         r = v * u.transpose();
     }
-    x.iter()
-        .map(|p| (r * (p.cast::<f64>() - cx) + ct).cast::<f32>())
-        .collect()
+    x.iter().map(|p| r * (p - cx) + ct).collect()
 }
 
 /// The reference a model's runs are compared with.
@@ -293,38 +306,73 @@ pub struct Reference {
     /// Max deviation between it and the run with half as many substeps (relative to size);
     /// 0 for the exact answer.
     pub change: f32,
+    /// The change at the doubling before (NaN when there was only one): `prev_change / change`
+    /// shows how fast the doubling converges (about 4 for second order, 2 for first order).
+    pub prev_change: f32,
+    /// `true` when it was run by the `f64` stepper ([`tetpbd_bench::Xpbd64`]), `false` for
+    /// the engine's own `f32` solver (or the exact answer).
+    pub f64: bool,
     /// Its positions after every frame.
-    pub trajectory: Vec<Vec<Vector3<f32>>>,
+    pub trajectory: Trajectory64,
 }
 
 /// The exact answer of a hard model (every edge and volume at rest): the rest shape in every
 /// frame (pinned beam: exactly there; free block: compared after rigid alignment).
 pub fn exact_rest(scene: &Scene) -> Reference {
+    let rest: Vec<Vector3<f64>> = scene.mesh.vertices.iter().map(|p| p.cast()).collect();
     Reference {
         substeps: 0,
         change: 0.0,
-        trajectory: vec![scene.mesh.vertices.clone(); scene.frames],
+        prev_change: f32::NAN,
+        f64: false,
+        trajectory: vec![rest; scene.frames],
     }
 }
 
-/// Doubles the substeps from `start` until the answer changes by less than 1e-6 of the body
-/// size, or `max` is reached.
+/// The converged reference of a numerical model: tetpbd's models in `f64` (same model, see
+/// [`run64`]), rapier's with its own `f32` solver. Doubles the substeps (one iteration each)
+/// from `start` until the answer changes by less than 1e-6 of the body size, or `max` is
+/// reached.
 pub fn converged(model: Model, scene: &Scene, start: u32, max: u32) -> Reference {
+    let trajectory = |s: u32| match model {
+        Model::Ours { set, soft } => run64(set, soft, scene, s),
+        Model::Rapier { .. } => widen(&run(build(model, scene, s, 1).as_mut(), scene).trajectory),
+    };
     let mut s = start;
-    let mut prev = run(build(model, scene, s, 1).as_mut(), scene).trajectory;
+    let mut prev = trajectory(s);
+    let mut prev_change = f32::NAN;
     loop {
         s *= 2;
-        let next = run(build(model, scene, s, 1).as_mut(), scene).trajectory;
+        let next = trajectory(s);
         let change = deviation(scene, &next, &prev).max;
         if change < 1e-6 || s >= max {
             return Reference {
                 substeps: s,
                 change,
+                prev_change,
+                f64: matches!(model, Model::Ours { .. }),
                 trajectory: next,
             };
         }
         prev = next;
+        prev_change = change;
     }
+}
+
+/// tetpbd's model `set` on `scene` run by the `f64` stepper at `substeps × 1`: the same
+/// body and settings the `f32` solver gets ([`ours_body`], [`ours_settings`]).
+pub fn run64(set: ConstraintSet, soft: bool, scene: &Scene, substeps: u32) -> Trajectory64 {
+    let mut sim = Xpbd64::new(
+        &ours_body(set, soft, scene),
+        &ours_settings(scene, substeps, 1),
+    )
+    .expect("valid settings");
+    (0..scene.frames)
+        .map(|_| {
+            sim.step();
+            sim.positions()
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -339,17 +387,18 @@ mod tests {
         let o = observe(&scene, rest);
         assert!(o.volume_err_pct.abs() < 1e-4 && o.edge_strain_max < 1e-6 && o.inverted == 0);
         let r = Rotation3::from_euler_angles(0.3, -0.7, 1.1);
-        let moved: Vec<Vector3<f32>> = rest
+        let rest64: Vec<Vector3<f64>> = rest.iter().map(|p| p.cast()).collect();
+        let moved: Vec<Vector3<f64>> = rest64
             .iter()
             .map(|p| r * p + Vector3::new(0.5, -2.0, 3.0))
             .collect();
-        let aligned = align(&moved, rest);
+        let aligned = align(&moved, &rest64);
         let worst = aligned
             .iter()
-            .zip(rest)
+            .zip(&rest64)
             .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f32::max);
-        assert!(worst < 1e-5, "{worst}");
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-12, "{worst}");
         let squashed = observe(&scene, &scene.start);
         assert!((squashed.volume_err_pct + 50.0).abs() < 1e-3);
     }
@@ -363,5 +412,41 @@ mod tests {
         };
         assert_eq!(recovery_time(&[bad, good, bad, good, good]), Some(4.0 * DT));
         assert_eq!(recovery_time(&[good, bad]), None);
+    }
+
+    /// The f64 stepper is the same model as the f32 solver: at a moderate budget the two
+    /// agree far below the model's own discretisation error, on both scenes and every soft
+    /// constraint set, and the comparison tells a different model (no damping) apart.
+    #[test]
+    fn xpbd64_matches_the_f32_solver() {
+        const SUBSTEPS: u32 = 8;
+        for scene in [Scene::hanging_beam(true), Scene::squash(true)] {
+            let scene = Scene {
+                frames: 30,
+                ..scene
+            };
+            for set in [
+                ConstraintSet::EdgesVolume,
+                ConstraintSet::VertexFace,
+                ConstraintSet::VertexFaceEdges,
+            ] {
+                let model = Model::Ours { set, soft: true };
+                let f32_run =
+                    widen(&run(build(model, &scene, SUBSTEPS, 1).as_mut(), &scene).trajectory);
+                let f64_run = run64(set, true, &scene, SUBSTEPS);
+                let same = deviation(&scene, &f32_run, &f64_run).max;
+                assert!(same < 1e-5, "{} {set:?}: f64 vs f32 {same:e}", scene.name);
+                let other = Scene {
+                    damping: 0.0,
+                    ..scene.clone()
+                };
+                let differs = deviation(&scene, &f32_run, &run64(set, true, &other, SUBSTEPS)).max;
+                assert!(
+                    differs > 100.0 * same,
+                    "{} {set:?}: undamped {differs:e}, same model {same:e}",
+                    scene.name
+                );
+            }
+        }
     }
 }

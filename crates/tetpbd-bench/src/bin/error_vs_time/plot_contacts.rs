@@ -120,6 +120,7 @@ fn draw_on<DB: DrawingBackend>(
         "time: median over the resting phase",
         "values below 1e-9 drawn at 1e-9",
         "runs with non-finite values left out",
+        "×: did not come to rest (unstable)",
     ] {
         legend.draw(&Text::new(n, (10, y + 14), text.clone()))?;
         y += 22;
@@ -143,17 +144,21 @@ fn draw_panel<DB: DrawingBackend>(
     let points: Vec<(f64, f64)> = rows.iter().filter_map(|r| value(r)).collect();
     let mut chart = error_time_chart(area, format!("{scene}: {}", metric.0), &points)?;
     for (e, c) in engines.iter().zip(colors) {
-        let mut line: Vec<(u32, (f64, f64))> = rows
+        let mut line: Vec<(u32, (f64, f64), bool)> = rows
             .iter()
             .filter(|r| r.engine == *e)
-            .filter_map(|r| value(r).map(|p| (r.substeps, p)))
+            .filter_map(|r| value(r).map(|p| (r.substeps, p, r.res.came_to_rest())))
             .collect();
-        line.sort_by_key(|(s, _)| *s);
+        line.sort_by_key(|(s, _, _)| *s);
         chart.draw_series(LineSeries::new(
-            line.iter().map(|(_, p)| *p),
+            line.iter().map(|(_, p, _)| *p),
             c.stroke_width(2),
         ))?;
-        for (_, p) in &line {
+        for (_, p, rest) in &line {
+            if !rest {
+                chart.draw_series([Cross::new(*p, 7, c.stroke_width(3))])?;
+                continue;
+            }
             match e {
                 ContactEngine::Tetpbd { .. } => {
                     chart.draw_series([Circle::new(*p, 4, c.filled())])?

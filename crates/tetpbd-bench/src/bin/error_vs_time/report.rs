@@ -18,6 +18,23 @@ use crate::scenes::{Scene, DT};
 /// are quoted in the headline and drawn in the deviation panels.
 pub const REFERENCE_TOLERANCE: f32 = 1e-3;
 
+/// One model's reference on one scene, as the summary lists it.
+#[derive(Clone, Copy, Debug)]
+pub struct RefInfo {
+    /// Scene name.
+    pub scene: &'static str,
+    /// The model.
+    pub model: Model,
+    /// Substeps of the reference (0: the exact answer).
+    pub substeps: u32,
+    /// Its last change when its substeps were doubled, relative to the body size.
+    pub change: f32,
+    /// The change at the doubling before (NaN when there was only one).
+    pub prev_change: f32,
+    /// Run by the `f64` stepper.
+    pub f64: bool,
+}
+
 /// One run of one configuration, summarised.
 #[derive(Clone, Debug)]
 pub struct Row {
@@ -238,7 +255,7 @@ pub fn write_all(
     out: &Path,
     scenes: &[Scene],
     rows: &[Row],
-    references: &[(&'static str, Model, u32, f32)],
+    references: &[RefInfo],
     contacts: (&[ContactScene], &[ContactRow]),
     info: &RunInfo,
 ) -> io::Result<()> {

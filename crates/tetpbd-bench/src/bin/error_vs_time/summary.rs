@@ -7,7 +7,6 @@ use std::process::Command;
 use tetpbd_bench::ContactScene;
 
 use crate::contacts::ContactRow;
-use crate::engines::Model;
 use crate::pareto::{compare, median, Match, Point};
 use crate::report::{Row, RunInfo};
 use crate::scenes::{Scene, SceneKind};
@@ -277,7 +276,7 @@ pub fn pareto_text(s: &mut String, matches: &[Match], describe: &dyn Fn(usize) -
 pub fn markdown(
     scenes: &[Scene],
     rows: &[Row],
-    references: &[(&'static str, Model, u32, f32)],
+    references: &[crate::report::RefInfo],
     contacts: (&[ContactScene], &[ContactRow]),
     info: &RunInfo,
 ) -> String {
@@ -296,7 +295,7 @@ pub fn markdown(
     let _ = writeln!(s, "- Machine: {}\n- Date: {date}\n- Commit: {}\n- Load average (1/5/15 min) at start: {}, at end: {} (the machine is shared; a load above 1 on 2 cores inflates the times of both engines alike).\n- Every run one after the other, single-threaded unless marked '2 threads'. rapier is built without its `parallel` feature. tetpbd's `parallel` feature (colour-class Gauss–Seidel on rayon) only parallelises a family with at least 4096 constraints, more than the meshes of scenes a, b, c and d have (at most 1920 per family per body), so for those a parallel column would repeat the serial one; {}\n", machine(), commit(), info.load_start, info.load_end, if cfg!(feature = "parallel") { "this run was built with it and adds a 12³-cell drop (c_drop_12, 10 368 tetrahedra) run by tetpbd on 1 and 2 threads (see 'Parallel' below)." } else { "this run was built without it (see 'Parallel' below); large bodies on 2 threads are also measured by the `scaling` binary." });
     let _ = writeln!(s, "![error vs time](plot.png)\n\nData: [results.csv](results.csv) (one row per run of scenes a and b), [contacts.csv](contacts.csv) (one row per run of scenes c and d), [squash_volume.csv](squash_volume.csv) (volume error per frame of every squash run), drawn for one budget in [squash_volume.png](squash_volume.png).\n");
     let _ = writeln!(s, "## Headline (Pareto fronts)\n");
-    let _ = writeln!(s, "Each engine's Pareto front is the set of its runs that no other run of the same engine beats in both median ms per frame and error. At each rapier front point we take tetpbd's cheapest run with an error at most rapier's (equal error) and tetpbd's most accurate run costing at most rapier's (equal time), and quote the medians over rapier's front: **speed** = rapier ms / tetpbd ms at equal error, **accuracy** = rapier error / tetpbd error at equal time; above 1 favours tetpbd. The hard models are the like-for-like comparison (same exact answer in both engines); 'all models' mixes materials that differ between the engines, each measured against its own reference.\n");
+    let _ = writeln!(s, "Each engine's Pareto front is the set of its runs that no other run of the same engine beats in both median ms per frame and error. At each rapier front point we take tetpbd's cheapest run with an error at most rapier's (equal error) and tetpbd's most accurate run costing at most rapier's (equal time), and quote the medians over rapier's front: **speed** = rapier ms / tetpbd ms at equal error, **accuracy** = rapier error / tetpbd error at equal time; above 1 favours tetpbd. The hard models are the like-for-like comparison (same exact answer in both engines); 'all models' mixes materials that differ between the engines, each measured against its own reference. Contact runs (scenes c and d) that did not come to rest are left out of the fronts on both sides and listed under 'Runs that did not come to rest'; scenes a and b leave out non-finite runs (a beam still swinging at the last frame counts its motion as deviation).\n");
     let mut details = String::new();
     let mut briefs: Vec<String> = Vec::new();
     for scene in scenes {
@@ -324,7 +323,6 @@ pub fn markdown(
     for b in &briefs {
         let _ = writeln!(s, "{b}");
     }
-    crate::summary_contacts::unsettled(&mut s, contacts.1);
     let mut spread: Vec<f64> = rows
         .iter()
         .map(|r| r.timing_spread)
@@ -335,6 +333,7 @@ pub fn markdown(
         let _ = writeln!(s, "\nTiming noise: the wall-time medians of the two runs of each configuration differ by {:.1} % (median over all configurations; 90th percentile {:.1} %). Ratios near 1 in the table are within that noise.", m * 100.0, p90 * 100.0);
     }
     let _ = writeln!(s, "\nThe last two columns repeat the comparison with each run's median thread CPU time per frame instead of its wall time (both engines run on the calling thread): on a loaded machine they show how much of the wall-time figure is contention.");
+    crate::summary_contacts::unsettled(&mut s, contacts.1);
     let _ = writeln!(s, "\n### Details\n\n{details}");
     crate::summary_setup::setup(&mut s, scenes, rows, references);
     crate::summary_contacts::section(&mut s, contacts.0, contacts.1);
