@@ -15,7 +15,14 @@ use crate::systems::{Kernel, ProjectionCount};
 use crate::work::{Slot, WorkAccess};
 
 /// Bodies with fewer constraints in a family than this take the serial path.
-pub(crate) const MIN_PARALLEL: usize = 4096;
+const MIN_PARALLEL: usize = 4096;
+
+/// Whether a family of `len` constraints runs on the pool: large enough, and the pool has
+/// more than one thread (on one thread the serial sweep does the same work without the
+/// per-class task overhead; the results are bit-identical either way).
+pub(crate) fn worth_it(len: usize) -> bool {
+    len >= MIN_PARALLEL && rayon::current_num_threads() > 1
+}
 
 /// Items per rayon task (a multiple of the SIMD lanes).
 const CHUNK: usize = 256;

@@ -183,7 +183,7 @@ fn edges_of(
     kernel: Kernel,
 ) -> ProjectionCount {
     #[cfg(feature = "parallel")]
-    if e.edges.len() >= crate::parallel::MIN_PARALLEL {
+    if crate::parallel::worth_it(e.edges.len()) {
         return crate::parallel::edges(acc, e, alpha_tilde, kernel);
     }
     let mut count = ProjectionCount::default();
@@ -207,7 +207,7 @@ fn vertex_faces_of(
     kernel: Kernel,
 ) -> ProjectionCount {
     #[cfg(feature = "parallel")]
-    if tets.len() >= crate::parallel::MIN_PARALLEL {
+    if crate::parallel::worth_it(tets.len()) {
         return crate::parallel::vertex_face(acc, tets, vf, alpha_tilde, kernel);
     }
     let mut count = ProjectionCount::default();
@@ -231,7 +231,7 @@ fn volumes_of(
     kernel: Kernel,
 ) -> ProjectionCount {
     #[cfg(feature = "parallel")]
-    if tets.len() >= crate::parallel::MIN_PARALLEL {
+    if crate::parallel::worth_it(tets.len()) {
         return crate::parallel::volume(acc, tets, vol, alpha_tilde, kernel);
     }
     let mut count = ProjectionCount::default();
