@@ -10,6 +10,7 @@ use crate::locality::{inverse, mean_edge_length, relabel_tets, row_order};
 use crate::mesh::{Surface, Tetrahedra};
 use crate::ordering::colour_order;
 use crate::particles::Particles;
+use crate::work::{Slot, WorkCopy};
 
 /// A tetrahedral mesh: vertex positions (m) and tetrahedra as vertex indices.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -353,6 +354,7 @@ impl SoftBodyBuilder {
                 residuals: vec![Vector3::zeros(); n],
                 vertex_to_particle: inverse(&particle_source),
                 source: particle_source,
+                work: WorkCopy(vec![Slot::default(); n]),
             },
             tetrahedra: Tetrahedra {
                 indices: mesh.tets,

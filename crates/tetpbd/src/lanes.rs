@@ -1,65 +1,38 @@
-//! SIMD kernels: eight constraints of one colour class projected at once, one per lane.
+//! SIMD kernels: four constraints of one colour class projected at once, one per lane.
 //!
-//! Constraints of one colour class share no particle (see [`crate::ordering`]), so eight of
-//! them are independent: their particles are gathered into lanes (`wide::f32x8`), the same
-//! formulas as [`crate::constraint`] run on all lanes, and the corrections are scattered
-//! back with the compensated add. The scalar kernels in [`crate::projection`] are the
-//! reference these are tested against (`tests/lanes.rs`).
+//! Constraints of one colour class share no particle (see [`crate::ordering`]), so four of
+//! them are independent: the `[x, y, z, w]` rows of their particles (see [`crate::work`])
+//! are loaded and transposed into lanes (`wide::f32x4`), the same formulas as
+//! [`crate::constraint`] run on all lanes, and the corrections are transposed back into
+//! rows and added with the compensated update. The scalar kernels in
+//! [`crate::projection`] are the reference these are tested against (`tests/lanes.rs`).
 //!
 //! A chunk whose lanes hit a degenerate configuration (a zero-length edge, a face too close
 //! to collinear) is handed to the scalar kernel, which owns the documented fallbacks.
 
-use nalgebra::Vector3;
-use wide::f32x8;
+use wide::f32x4;
 
 use crate::constraint::VERTEX_FACE_ORDER;
 use crate::projection::{self, ParticleAccess};
 use crate::systems::ProjectionCount;
 
 /// Lanes per chunk.
-pub(crate) const LANES: usize = 8;
+pub(crate) const LANES: usize = 4;
 
-/// Eight 3-vectors, one per lane.
+/// Four 3-vectors, one per lane.
 #[derive(Clone, Copy)]
 struct V3 {
-    x: f32x8,
-    y: f32x8,
-    z: f32x8,
+    x: f32x4,
+    y: f32x4,
+    z: f32x4,
 }
 
 impl V3 {
     const ZERO: V3 = V3 {
-        x: f32x8::ZERO,
-        y: f32x8::ZERO,
-        z: f32x8::ZERO,
+        x: f32x4::ZERO,
+        y: f32x4::ZERO,
+        z: f32x4::ZERO,
     };
-
-    #[inline(always)]
-    fn gather<A: ParticleAccess>(acc: &A, idx: &[usize; LANES]) -> V3 {
-        let mut x = [0.0; LANES];
-        let mut y = [0.0; LANES];
-        let mut z = [0.0; LANES];
-        for l in 0..LANES {
-            let p = acc.x(idx[l]);
-            x[l] = p.x;
-            y[l] = p.y;
-            z[l] = p.z;
-        }
-        V3 {
-            x: x.into(),
-            y: y.into(),
-            z: z.into(),
-        }
-    }
-
-    #[inline(always)]
-    fn lane(&self, l: usize) -> Vector3<f32> {
-        Vector3::new(
-            self.x.as_array()[l],
-            self.y.as_array()[l],
-            self.z.as_array()[l],
-        )
-    }
 
     #[inline(always)]
     fn add(self, o: V3) -> V3 {
@@ -80,7 +53,7 @@ impl V3 {
     }
 
     #[inline(always)]
-    fn scale(self, s: f32x8) -> V3 {
+    fn scale(self, s: f32x4) -> V3 {
         V3 {
             x: self.x * s,
             y: self.y * s,
@@ -98,7 +71,7 @@ impl V3 {
     }
 
     #[inline(always)]
-    fn dot(self, o: V3) -> f32x8 {
+    fn dot(self, o: V3) -> f32x4 {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
@@ -112,49 +85,110 @@ impl V3 {
     }
 }
 
+/// Positions and inverse masses of particles `idx`, one per lane.
 #[inline(always)]
-fn gather_w<A: ParticleAccess>(acc: &A, idx: &[usize; LANES]) -> f32x8 {
-    let mut w = [0.0; LANES];
-    for l in 0..LANES {
-        w[l] = acc.w(idx[l]);
+fn gather<A: ParticleAccess>(acc: &A, idx: [usize; LANES]) -> (V3, f32x4) {
+    let [x, y, z, w] = f32x4::transpose([
+        acc.row(idx[0]),
+        acc.row(idx[1]),
+        acc.row(idx[2]),
+        acc.row(idx[3]),
+    ]);
+    (V3 { x, y, z }, w)
+}
+
+/// The four corners of four tetrahedra: positions and inverse masses per corner.
+#[inline(always)]
+fn gather_corners<A: ParticleAccess>(acc: &A, idx: &[[usize; LANES]; 4]) -> ([V3; 4], [f32x4; 4]) {
+    let (p0, w0) = gather(acc, idx[0]);
+    let (p1, w1) = gather(acc, idx[1]);
+    let (p2, w2) = gather(acc, idx[2]);
+    let (p3, w3) = gather(acc, idx[3]);
+    ([p0, p1, p2, p3], [w0, w1, w2, w3])
+}
+
+/// Four rows of four values, transposed: item `k` of every row as lanes.
+#[inline(always)]
+fn transpose_rows(rows: &[[f32; 4]; LANES]) -> [f32x4; 4] {
+    f32x4::transpose([
+        f32x4::new(rows[0]),
+        f32x4::new(rows[1]),
+        f32x4::new(rows[2]),
+        f32x4::new(rows[3]),
+    ])
+}
+
+/// Moves particle `idx[l]` by lane `l` of `d` (compensated).
+#[inline(always)]
+fn scatter<A: ParticleAccess>(acc: &mut A, idx: [usize; LANES], d: V3) {
+    let rows = f32x4::transpose([d.x, d.y, d.z, f32x4::ZERO]);
+    for (i, row) in idx.into_iter().zip(rows) {
+        acc.add_row(i, row);
     }
-    w.into()
 }
 
 /// `Δλ` on every lane; 0 where the denominator is not positive. Returns the mask of
 /// applied lanes.
 #[inline(always)]
-fn delta_lambda(c: f32x8, lambda: f32x8, alpha_tilde: f32x8, w_grad_sq: f32x8) -> (f32x8, f32x8) {
+fn delta_lambda(c: f32x4, lambda: f32x4, alpha_tilde: f32x4, w_grad_sq: f32x4) -> (f32x4, f32x4) {
     let denom = w_grad_sq + alpha_tilde;
-    let ok = denom.simd_gt(f32x8::splat(f32::EPSILON * f32::EPSILON));
-    let safe = ok.select(denom, f32x8::ONE);
+    let ok = denom.simd_gt(f32x4::splat(f32::EPSILON * f32::EPSILON));
+    let safe = ok.select(denom, f32x4::ONE);
     (
-        ok.select((-c - alpha_tilde * lambda) / safe, f32x8::ZERO),
+        ok.select((-c - alpha_tilde * lambda) / safe, f32x4::ZERO),
         ok,
     )
 }
 
-fn lanes_of<const N: usize>(items: &[[u32; N]], k: usize) -> [usize; LANES] {
-    let mut idx = [0usize; LANES];
-    for (l, item) in items.iter().enumerate().take(LANES) {
-        idx[l] = item[k] as usize;
-    }
-    idx
+/// Corner `k` of each of the `LANES` items.
+#[inline(always)]
+fn corner<const N: usize>(items: &[[u32; N]; LANES], k: usize) -> [usize; LANES] {
+    [
+        items[0][k] as usize,
+        items[1][k] as usize,
+        items[2][k] as usize,
+        items[3][k] as usize,
+    ]
 }
 
-/// Eight edges (`edges.len() == LANES`). See [`projection::edge`].
+/// Four consecutive values as lanes.
+#[inline(always)]
+fn lanes_of(v: &[f32; LANES]) -> f32x4 {
+    f32x4::new(*v)
+}
+
+/// `LANES` items of `s` from `at` (the caller keeps `at + LANES ≤ s.len()`).
+#[inline(always)]
+pub(crate) fn chunk<T>(s: &[T], at: usize) -> &[T; LANES] {
+    s[at..at + LANES]
+        .try_into()
+        .expect("a chunk of LANES items")
+}
+
+/// `LANES` items of `s` from `at`, for writing.
+#[inline(always)]
+pub(crate) fn chunk_mut<T>(s: &mut [T], at: usize) -> &mut [T; LANES] {
+    (&mut s[at..at + LANES])
+        .try_into()
+        .expect("a chunk of LANES items")
+}
+
+/// Four edges. See [`projection::edge`].
+#[inline(always)]
 pub(crate) fn edges<A: ParticleAccess>(
     acc: &mut A,
-    edges: &[[u32; 2]],
-    rest: &[f32],
-    lambdas: &mut [f32],
+    edges: &[[u32; 2]; LANES],
+    rest: &[f32; LANES],
+    lambdas: &mut [f32; LANES],
     alpha_tilde: f32,
 ) -> ProjectionCount {
-    let (ia, ib) = (lanes_of(edges, 0), lanes_of(edges, 1));
-    let d = f32x8::from(<[f32; LANES]>::try_from(rest).unwrap_or([1.0; LANES]));
-    let delta = V3::gather(acc, &ia).sub(V3::gather(acc, &ib));
+    let (ia, ib) = (corner(edges, 0), corner(edges, 1));
+    let d = lanes_of(rest);
+    let (pa, wa) = gather(acc, ia);
+    let (pb, wb) = gather(acc, ib);
+    let delta = pa.sub(pb);
     let len = delta.dot(delta).sqrt();
-    if !len.simd_gt(d * f32x8::splat(1e-6)).all() {
+    if !len.simd_gt(d * f32x4::splat(1e-6)).all() {
         let mut count = ProjectionCount::default();
         for l in 0..LANES {
             count.add(projection::edge(
@@ -167,77 +201,77 @@ pub(crate) fn edges<A: ParticleAccess>(
         }
         return count;
     }
-    let n = delta.scale(f32x8::ONE / len);
-    let (wa, wb) = (gather_w(acc, &ia), gather_w(acc, &ib));
-    let lam = f32x8::from(<[f32; LANES]>::try_from(&*lambdas).unwrap_or([0.0; LANES]));
-    let (dl, ok) = delta_lambda(len - d, lam, f32x8::splat(alpha_tilde), wa + wb);
-    lambdas.copy_from_slice((lam + dl).as_array());
-    let da = n.scale(wa * dl);
-    let db = n.scale(-wb * dl);
-    for l in 0..LANES {
-        acc.add(ia[l], da.lane(l));
-        acc.add(ib[l], db.lane(l));
-    }
+    let n = delta.scale(f32x4::ONE / len);
+    let lam = lanes_of(lambdas);
+    let (dl, ok) = delta_lambda(len - d, lam, f32x4::splat(alpha_tilde), wa + wb);
+    *lambdas = (lam + dl).to_array();
+    scatter(acc, ia, n.scale(wa * dl));
+    scatter(acc, ib, n.scale(-wb * dl));
     ProjectionCount {
         applied: ok.to_bitmask().count_ones() as u64,
         degenerate: 0,
     }
 }
 
-/// Eight volume constraints (`tets.len() == LANES`). See [`projection::volume`].
+/// Four volume constraints. See [`projection::volume`].
+#[inline(always)]
 pub(crate) fn volumes<A: ParticleAccess>(
     acc: &mut A,
-    tets: &[[u32; 4]],
-    rest: &[f32],
-    lambdas: &mut [f32],
+    tets: &[[u32; 4]; LANES],
+    rest: &[f32; LANES],
+    lambdas: &mut [f32; LANES],
     alpha_tilde: f32,
 ) -> ProjectionCount {
-    let idx = [0, 1, 2, 3].map(|k| lanes_of(tets, k));
-    let p = idx.map(|i| V3::gather(acc, &i));
-    let w = idx.map(|i| gather_w(acc, &i));
-    let sixth = f32x8::splat(1.0 / 6.0);
+    let idx = [
+        corner(tets, 0),
+        corner(tets, 1),
+        corner(tets, 2),
+        corner(tets, 3),
+    ];
+    let (p, w) = gather_corners(acc, &idx);
+    let sixth = f32x4::splat(1.0 / 6.0);
     let (a, b, c) = (p[1].sub(p[0]), p[2].sub(p[0]), p[3].sub(p[0]));
-    let g1 = b.cross(c).scale(sixth);
+    let bc = b.cross(c);
+    let g1 = bc.scale(sixth);
     let g2 = c.cross(a).scale(sixth);
     let g3 = a.cross(b).scale(sixth);
     let g0 = g1.add(g2).add(g3).neg();
-    let v0 = f32x8::from(<[f32; LANES]>::try_from(rest).unwrap_or([0.0; LANES]));
-    let cval = a.dot(b.cross(c)) * sixth - v0;
+    let cval = a.dot(bc) * sixth - lanes_of(rest);
     let g = [g0, g1, g2, g3];
-    let w_grad_sq = (0..4).fold(f32x8::ZERO, |s, k| s + w[k] * g[k].dot(g[k]));
-    let lam = f32x8::from(<[f32; LANES]>::try_from(&*lambdas).unwrap_or([0.0; LANES]));
-    let (dl, ok) = delta_lambda(cval, lam, f32x8::splat(alpha_tilde), w_grad_sq);
-    lambdas.copy_from_slice((lam + dl).as_array());
+    let w_grad_sq = (0..4).fold(f32x4::ZERO, |s, k| s + w[k] * g[k].dot(g[k]));
+    let lam = lanes_of(lambdas);
+    let (dl, ok) = delta_lambda(cval, lam, f32x4::splat(alpha_tilde), w_grad_sq);
+    *lambdas = (lam + dl).to_array();
     for k in 0..4 {
-        let d = g[k].scale(w[k] * dl);
-        for (l, &i) in idx[k].iter().enumerate() {
-            acc.add(i, d.lane(l));
-        }
+        scatter(acc, idx[k], g[k].scale(w[k] * dl));
     }
-    let mut count = ProjectionCount {
+    let any_free = (w[0] + w[1] + w[2] + w[3]).simd_gt(f32x4::ZERO);
+    ProjectionCount {
         applied: ok.to_bitmask().count_ones() as u64,
-        degenerate: 0,
-    };
-    let any_free = (w[0] + w[1] + w[2] + w[3]).simd_gt(f32x8::ZERO);
-    count.degenerate = (!ok.to_bitmask() & any_free.to_bitmask() & 0xff).count_ones() as u64;
-    count
+        degenerate: (!ok.to_bitmask() & any_free.to_bitmask() & 0xf).count_ones() as u64,
+    }
 }
 
-/// The four vertex–face constraints of eight tetrahedra (`tets.len() == LANES`), the four
-/// one after another on all lanes, corrections accumulated in registers and scattered once.
-/// See [`projection::vertex_face`]. A chunk with a face near degeneracy (100 × the
-/// kernel's threshold) goes to the scalar kernel.
+/// The four vertex–face constraints of four tetrahedra, the four one after another on all
+/// lanes, corrections accumulated in registers and scattered once. See
+/// [`projection::vertex_face`]. A chunk with a face near degeneracy (100 × the kernel's
+/// threshold) goes to the scalar kernel.
+#[inline(always)]
 pub(crate) fn vertex_faces<A: ParticleAccess>(
     acc: &mut A,
-    tets: &[[u32; 4]],
-    heights: &[[f32; 4]],
-    lambdas: &mut [[f32; 4]],
+    tets: &[[u32; 4]; LANES],
+    heights: &[[f32; 4]; LANES],
+    lambdas: &mut [[f32; 4]; LANES],
     alpha_tilde: f32,
 ) -> ProjectionCount {
-    let idx = [0, 1, 2, 3].map(|k| lanes_of(tets, k));
-    let p0 = idx.map(|i| V3::gather(acc, &i));
-    let w = idx.map(|i| gather_w(acc, &i));
-    let near = f32x8::splat(1e-5);
+    let idx = [
+        corner(tets, 0),
+        corner(tets, 1),
+        corner(tets, 2),
+        corner(tets, 3),
+    ];
+    let (p0, w) = gather_corners(acc, &idx);
+    let near = f32x4::splat(1e-5);
     // Pre-check every face at the start of the chunk.
     for order in VERTEX_FACE_ORDER {
         let (b, c) = (
@@ -262,16 +296,24 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
             return count;
         }
     }
-    let at = f32x8::splat(alpha_tilde);
+    let at = f32x4::splat(alpha_tilde);
+    // Per constraint k, the four tetrahedra's heights and multipliers as lanes.
+    let h = transpose_rows(heights);
+    let mut lam = transpose_rows(lambdas);
     let mut dp = [V3::ZERO; 4];
     let mut count = ProjectionCount::default();
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
-        let q = order.map(|o| p0[o].add(dp[o]));
+        let q = [
+            p0[order[0]].add(dp[order[0]]),
+            p0[order[1]].add(dp[order[1]]),
+            p0[order[2]].add(dp[order[2]]),
+            p0[order[3]].add(dp[order[3]]),
+        ];
         let (a, b, c) = (q[1].sub(q[0]), q[2].sub(q[0]), q[3].sub(q[0]));
         let m = b.cross(c);
         let m_len = m.dot(m).sqrt();
-        let valid = m_len.simd_gt((b.dot(b) + c.dot(c)) * f32x8::splat(1e-7));
-        let inv = valid.select(f32x8::ONE / m_len, f32x8::ZERO);
+        let valid = m_len.simd_gt((b.dot(b) + c.dot(c)) * f32x4::splat(1e-7));
+        let inv = valid.select(f32x4::ONE / m_len, f32x4::ZERO);
         let n = m.scale(inv);
         let na = n.dot(a);
         let g1 = n;
@@ -279,27 +321,24 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
         let g3 = b.cross(a).add(n.cross(b).scale(na)).scale(inv).neg();
         let g0 = g1.add(g2).add(g3).neg();
         let g = [g0, g1, g2, g3];
-        let wo = order.map(|o| w[o]);
-        let w_grad_sq = (0..4).fold(f32x8::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
-        let h = f32x8::from([0, 1, 2, 3, 4, 5, 6, 7].map(|l| heights[l][k]));
-        let lam = f32x8::from([0, 1, 2, 3, 4, 5, 6, 7].map(|l| lambdas[l][k]));
-        let (dl, ok) = delta_lambda(na - h, lam, at, w_grad_sq);
-        let dl = valid.select(dl, f32x8::ZERO);
+        let wo = [w[order[0]], w[order[1]], w[order[2]], w[order[3]]];
+        let w_grad_sq = (0..4).fold(f32x4::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
+        let (dl, ok) = delta_lambda(na - h[k], lam[k], at, w_grad_sq);
+        let dl = valid.select(dl, f32x4::ZERO);
         let ok = ok & valid;
-        let new = (lam + dl).to_array();
-        for l in 0..LANES {
-            lambdas[l][k] = new[l];
-        }
+        lam[k] += dl;
         for s in 0..4 {
             dp[order[s]] = dp[order[s]].add(g[s].scale(wo[s] * dl));
         }
         count.applied += ok.to_bitmask().count_ones() as u64;
-        count.degenerate += (!valid.to_bitmask() & 0xff).count_ones() as u64;
+        count.degenerate += (!valid.to_bitmask() & 0xf).count_ones() as u64;
     }
-    for (corner, d) in idx.iter().zip(&dp) {
-        for (l, &i) in corner.iter().enumerate() {
-            acc.add(i, d.lane(l));
-        }
+    let lam = f32x4::transpose(lam);
+    for (row, l) in lambdas.iter_mut().zip(lam) {
+        *row = l.to_array();
+    }
+    for (corner, d) in idx.into_iter().zip(dp) {
+        scatter(acc, corner, d);
     }
     count
 }

@@ -38,9 +38,11 @@ pub mod ordering;
 mod parallel;
 mod particles;
 mod projection;
+mod runs;
 mod solver;
 mod stats;
 pub mod systems;
+mod work;
 
 pub use builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
 pub use error::{BuildError, SettingsError, StateError};

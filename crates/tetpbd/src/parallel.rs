@@ -5,25 +5,32 @@
 
 use nalgebra::Vector3;
 use rayon::prelude::*;
+use wide::f32x4;
 
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::mesh::Tetrahedra;
-use crate::particles::Particles;
 use crate::projection::ParticleAccess;
-use crate::systems::{edge_run, vertex_face_run, volume_run, Kernel, ProjectionCount};
+use crate::runs::{edge_run, vertex_face_run, volume_run};
+use crate::systems::{Kernel, ProjectionCount};
+use crate::work::{Slot, WorkAccess};
 
 /// Bodies with fewer constraints in a family than this take the serial path.
-pub(crate) const MIN_PARALLEL: usize = 4096;
+const MIN_PARALLEL: usize = 4096;
+
+/// Whether a family of `len` constraints runs on the pool: large enough, and the pool has
+/// more than one thread (on one thread the serial sweep does the same work without the
+/// per-class task overhead; the results are bit-identical either way).
+pub(crate) fn worth_it(len: usize) -> bool {
+    len >= MIN_PARALLEL && rayon::current_num_threads() > 1
+}
 
 /// Items per rayon task (a multiple of the SIMD lanes).
 const CHUNK: usize = 256;
 
-/// Shared access for the projections of one colour class.
+/// Shared access to a body's working copy for the projections of one colour class.
 #[derive(Clone, Copy)]
 struct SharedAccess {
-    x: *mut Vector3<f32>,
-    r: *mut Vector3<f32>,
-    w: *const f32,
+    slots: *mut Slot,
     rest: *const Vector3<f32>,
     len: usize,
 }
@@ -37,42 +44,34 @@ unsafe impl Send for SharedAccess {}
 unsafe impl Sync for SharedAccess {}
 
 impl SharedAccess {
-    fn new(p: &mut Particles) -> SharedAccess {
+    fn new(acc: &mut WorkAccess<'_>) -> SharedAccess {
         SharedAccess {
-            x: p.positions.as_mut_ptr(),
-            r: p.residuals.as_mut_ptr(),
-            w: p.inv_masses.as_ptr(),
-            rest: p.rest_positions.as_ptr(),
-            len: p.positions.len(),
+            slots: acc.slots.as_mut_ptr(),
+            rest: acc.rest.as_ptr(),
+            len: acc.slots.len().min(acc.rest.len()),
         }
     }
 }
 
 impl ParticleAccess for SharedAccess {
     #[inline(always)]
-    fn x(&self, i: usize) -> Vector3<f32> {
+    fn row(&self, i: usize) -> f32x4 {
         assert!(i < self.len);
         // SAFETY: in bounds (checked); no other thread writes particle `i` (colour class).
-        unsafe { *self.x.add(i) }
-    }
-    #[inline(always)]
-    fn w(&self, i: usize) -> f32 {
-        assert!(i < self.len);
-        // SAFETY: in bounds (checked); inverse masses are not written during a sweep.
-        unsafe { *self.w.add(i) }
+        unsafe { (*self.slots.add(i)).xw }
     }
     #[inline(always)]
     fn rest(&self, i: usize) -> Vector3<f32> {
         assert!(i < self.len);
-        // SAFETY: in bounds (checked); rest positions are never written during a sweep.
+        // SAFETY: in bounds (checked, `rest` has `len` items); never written during a sweep.
         unsafe { *self.rest.add(i) }
     }
     #[inline(always)]
-    fn add(&mut self, i: usize, d: Vector3<f32>) {
+    fn add_row(&mut self, i: usize, d: f32x4) {
         assert!(i < self.len);
         // SAFETY: in bounds (checked); particle `i` belongs to this item alone within the
-        // running colour class, so these are the only references to it.
-        unsafe { crate::systems::add_compensated(&mut *self.x.add(i), &mut *self.r.add(i), d) }
+        // running colour class, so this is the only reference to it.
+        unsafe { (*self.slots.add(i)).add(d) }
     }
 }
 
@@ -106,7 +105,7 @@ fn sweep<T: Send>(
 }
 
 pub(crate) fn edges(
-    p: &mut Particles,
+    p: &mut WorkAccess<'_>,
     e: &mut EdgeConstraints,
     alpha_tilde: f32,
     kernel: Kernel,
@@ -128,7 +127,7 @@ pub(crate) fn edges(
 }
 
 pub(crate) fn volume(
-    p: &mut Particles,
+    p: &mut WorkAccess<'_>,
     tets: &Tetrahedra,
     vol: &mut VolumeConstraints,
     alpha_tilde: f32,
@@ -143,7 +142,7 @@ pub(crate) fn volume(
 }
 
 pub(crate) fn vertex_face(
-    p: &mut Particles,
+    p: &mut WorkAccess<'_>,
     tets: &Tetrahedra,
     vf: &mut VertexFaceConstraints,
     alpha_tilde: f32,

@@ -31,6 +31,9 @@ pub struct Particles {
     pub(crate) source: Vec<u32>,
     /// Particle of each input vertex (the inverse of `source`).
     pub(crate) vertex_to_particle: Vec<u32>,
+    /// The projections' working copy (scratch, see [`crate::work`]).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub(crate) work: crate::work::WorkCopy,
 }
 
 impl Particles {

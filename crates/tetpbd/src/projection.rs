@@ -2,45 +2,35 @@
 //! parallel sweeps through a [`ParticleAccess`].
 
 use nalgebra::Vector3;
+use wide::f32x4;
 
 use crate::constraint::{self, Evaluated, VERTEX_FACE_ORDER};
 
-/// How a projection reads and moves particles.
+/// How a projection reads and moves particles (see [`crate::work`] for the layout).
 pub(crate) trait ParticleAccess {
-    /// Position of particle `i`.
-    fn x(&self, i: usize) -> Vector3<f32>;
-    /// Inverse mass of particle `i`.
-    fn w(&self, i: usize) -> f32;
+    /// `[x, y, z, w]`: position (m) and inverse mass (1/kg) of particle `i`.
+    fn row(&self, i: usize) -> f32x4;
     /// Rest position of particle `i`.
     fn rest(&self, i: usize) -> Vector3<f32>;
-    /// Moves particle `i` by `d` (compensated, see [`crate::systems::add_compensated`]).
-    fn add(&mut self, i: usize, d: Vector3<f32>);
-}
+    /// Moves particle `i` by `d = [dx, dy, dz, 0]`, compensated (see
+    /// [`crate::systems::add_compensated`]).
+    fn add_row(&mut self, i: usize, d: f32x4);
 
-/// Serial access through the body's own slices.
-pub(crate) struct SliceAccess<'a> {
-    pub x: &'a mut [Vector3<f32>],
-    pub r: &'a mut [Vector3<f32>],
-    pub w: &'a [f32],
-    pub rest: &'a [Vector3<f32>],
-}
-
-impl ParticleAccess for SliceAccess<'_> {
+    /// Position of particle `i`.
     #[inline(always)]
     fn x(&self, i: usize) -> Vector3<f32> {
-        self.x[i]
+        let [x, y, z, _] = self.row(i).to_array();
+        Vector3::new(x, y, z)
     }
+    /// Inverse mass of particle `i`.
     #[inline(always)]
     fn w(&self, i: usize) -> f32 {
-        self.w[i]
+        self.row(i).to_array()[3]
     }
-    #[inline(always)]
-    fn rest(&self, i: usize) -> Vector3<f32> {
-        self.rest[i]
-    }
+    /// Moves particle `i` by `d`.
     #[inline(always)]
     fn add(&mut self, i: usize, d: Vector3<f32>) {
-        crate::systems::add_compensated(&mut self.x[i], &mut self.r[i], d);
+        self.add_row(i, f32x4::new([d.x, d.y, d.z, 0.0]));
     }
 }
 

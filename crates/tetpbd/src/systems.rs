@@ -10,11 +10,12 @@ use nalgebra::Vector3;
 
 use crate::constraint::{self, VERTEX_FACE_ORDER};
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-use crate::lanes;
 use crate::mesh::Tetrahedra;
 use crate::particles::{ExternalAcceleration, Particles};
-use crate::projection::{self, ParticleAccess, SliceAccess};
+use crate::projection;
+use crate::runs::{edge_run, vertex_face_run, volume_run};
 use crate::stats::{ErrorAccumulator, ErrorStats};
+use crate::work::{self, WorkAccess};
 
 /// Projections done and skipped by one call of a family system.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -106,131 +107,11 @@ pub fn reset_lambdas(world: &mut World) {
 pub enum Kernel {
     /// One constraint at a time: the reference.
     Scalar,
-    /// Eight independent constraints of a colour class at once (`wide::f32x8`), the rest
+    /// Four independent constraints of a colour class at once (`wide::f32x4`), the rest
     /// and the overflow class on the scalar kernel. Agrees with [`Kernel::Scalar`] to
     /// rounding.
     #[default]
     Simd,
-}
-
-/// Projects a run of constraints of one colour class: in chunks of eight lanes when the
-/// class is independent and the kernel is SIMD, the rest one by one.
-macro_rules! run_class {
-    ($kernel:expr, $independent:expr, $len:expr, |$s:ident, $e:ident| $lanes:expr, |$k:ident| $scalar:expr) => {{
-        let mut count = ProjectionCount::default();
-        let mut start = 0;
-        if $kernel == Kernel::Simd && $independent {
-            while start + lanes::LANES <= $len {
-                let ($s, $e) = (start, start + lanes::LANES);
-                count += $lanes;
-                start += lanes::LANES;
-            }
-        }
-        for $k in start..$len {
-            count += $scalar;
-        }
-        count
-    }};
-}
-
-/// Edges `edges[i]` with their rest lengths and multipliers, all of one colour class.
-pub(crate) fn edge_run<A: ParticleAccess>(
-    acc: &mut A,
-    edges: &[[u32; 2]],
-    rest: &[f32],
-    lambdas: &mut [f32],
-    alpha_tilde: f32,
-    kernel: Kernel,
-    independent: bool,
-) -> ProjectionCount {
-    run_class!(
-        kernel,
-        independent,
-        edges.len(),
-        |s, e| lanes::edges(
-            acc,
-            &edges[s..e],
-            &rest[s..e],
-            &mut lambdas[s..e],
-            alpha_tilde
-        ),
-        |k| one(projection::edge(
-            acc,
-            edges[k],
-            rest[k],
-            &mut lambdas[k],
-            alpha_tilde
-        ))
-    )
-}
-
-/// Volume constraints of a run of tetrahedra of one colour class.
-pub(crate) fn volume_run<A: ParticleAccess>(
-    acc: &mut A,
-    tets: &[[u32; 4]],
-    rest: &[f32],
-    lambdas: &mut [f32],
-    alpha_tilde: f32,
-    kernel: Kernel,
-    independent: bool,
-) -> ProjectionCount {
-    run_class!(
-        kernel,
-        independent,
-        tets.len(),
-        |s, e| lanes::volumes(
-            acc,
-            &tets[s..e],
-            &rest[s..e],
-            &mut lambdas[s..e],
-            alpha_tilde
-        ),
-        |k| one(projection::volume(
-            acc,
-            tets[k],
-            rest[k],
-            &mut lambdas[k],
-            alpha_tilde
-        ))
-    )
-}
-
-/// Vertex–face constraints of a run of tetrahedra of one colour class.
-pub(crate) fn vertex_face_run<A: ParticleAccess>(
-    acc: &mut A,
-    tets: &[[u32; 4]],
-    heights: &[[f32; 4]],
-    lambdas: &mut [[f32; 4]],
-    alpha_tilde: f32,
-    kernel: Kernel,
-    independent: bool,
-) -> ProjectionCount {
-    run_class!(
-        kernel,
-        independent,
-        tets.len(),
-        |s, e| lanes::vertex_faces(
-            acc,
-            &tets[s..e],
-            &heights[s..e],
-            &mut lambdas[s..e],
-            alpha_tilde
-        ),
-        |k| {
-            let (a, d) =
-                projection::vertex_face(acc, tets[k], &heights[k], &mut lambdas[k], alpha_tilde);
-            ProjectionCount {
-                applied: u64::from(a),
-                degenerate: u64::from(d),
-            }
-        }
-    )
-}
-
-fn one(o: projection::Outcome) -> ProjectionCount {
-    let mut c = ProjectionCount::default();
-    c.add(o);
-    c
 }
 
 /// One Gauss–Seidel sweep over every body's [`EdgeConstraints`] with the default kernel.
@@ -248,28 +129,7 @@ pub fn project_edges_with(world: &mut World, h: f32, kernel: Kernel) -> Projecti
     let mut count = ProjectionCount::default();
     for (p, e) in world.query_mut::<(&mut Particles, &mut EdgeConstraints)>() {
         let alpha_tilde = e.compliance / (h * h);
-        #[cfg(feature = "parallel")]
-        if e.edges.len() >= crate::parallel::MIN_PARALLEL {
-            count += crate::parallel::edges(p, e, alpha_tilde, kernel);
-            continue;
-        }
-        let mut acc = access(p);
-        for (r, independent) in e.classes.ranges() {
-            let (edges, rest, lambdas) = (
-                &e.edges[r.clone()],
-                &e.rest_lengths[r.clone()],
-                &mut e.lambdas[r],
-            );
-            count += edge_run(
-                &mut acc,
-                edges,
-                rest,
-                lambdas,
-                alpha_tilde,
-                kernel,
-                independent,
-            );
-        }
+        count += work::with_access(p, |acc| edges_of(acc, e, alpha_tilde, kernel));
     }
     count
 }
@@ -292,20 +152,7 @@ pub fn project_vertex_face_with(world: &mut World, h: f32, kernel: Kernel) -> Pr
         world.query_mut::<(&mut Particles, &Tetrahedra, &mut VertexFaceConstraints)>()
     {
         let alpha_tilde = vf.compliance / (h * h);
-        #[cfg(feature = "parallel")]
-        if tets.len() >= crate::parallel::MIN_PARALLEL {
-            count += crate::parallel::vertex_face(p, tets, vf, alpha_tilde, kernel);
-            continue;
-        }
-        let mut acc = access(p);
-        for (r, independent) in tets.classes.ranges() {
-            let (t, hgt, lam) = (
-                &tets.indices[r.clone()],
-                &vf.rest_heights[r.clone()],
-                &mut vf.lambdas[r],
-            );
-            count += vertex_face_run(&mut acc, t, hgt, lam, alpha_tilde, kernel, independent);
-        }
+        count += work::with_access(p, |acc| vertex_faces_of(acc, tets, vf, alpha_tilde, kernel));
     }
     count
 }
@@ -323,31 +170,80 @@ pub fn project_volume_with(world: &mut World, h: f32, kernel: Kernel) -> Project
     for (p, tets, vol) in world.query_mut::<(&mut Particles, &Tetrahedra, &mut VolumeConstraints)>()
     {
         let alpha_tilde = vol.compliance / (h * h);
-        #[cfg(feature = "parallel")]
-        if tets.len() >= crate::parallel::MIN_PARALLEL {
-            count += crate::parallel::volume(p, tets, vol, alpha_tilde, kernel);
-            continue;
-        }
-        let mut acc = access(p);
-        for (r, independent) in tets.classes.ranges() {
-            let (t, rest, lam) = (
-                &tets.indices[r.clone()],
-                &tets.rest_volumes[r.clone()],
-                &mut vol.lambdas[r],
-            );
-            count += volume_run(&mut acc, t, rest, lam, alpha_tilde, kernel, independent);
-        }
+        count += work::with_access(p, |acc| volumes_of(acc, tets, vol, alpha_tilde, kernel));
     }
     count
 }
 
-fn access(p: &mut Particles) -> SliceAccess<'_> {
-    SliceAccess {
-        x: &mut p.positions,
-        r: &mut p.residuals,
-        w: &p.inv_masses,
-        rest: &p.rest_positions,
+/// One sweep of one body's edges on its working copy.
+fn edges_of(
+    acc: &mut WorkAccess<'_>,
+    e: &mut EdgeConstraints,
+    alpha_tilde: f32,
+    kernel: Kernel,
+) -> ProjectionCount {
+    #[cfg(feature = "parallel")]
+    if crate::parallel::worth_it(e.edges.len()) {
+        return crate::parallel::edges(acc, e, alpha_tilde, kernel);
     }
+    let mut count = ProjectionCount::default();
+    for (r, independent) in e.classes.ranges() {
+        let (edges, rest, lambdas) = (
+            &e.edges[r.clone()],
+            &e.rest_lengths[r.clone()],
+            &mut e.lambdas[r],
+        );
+        count += edge_run(acc, edges, rest, lambdas, alpha_tilde, kernel, independent);
+    }
+    count
+}
+
+/// One sweep of one body's vertex–face constraints on its working copy.
+fn vertex_faces_of(
+    acc: &mut WorkAccess<'_>,
+    tets: &Tetrahedra,
+    vf: &mut VertexFaceConstraints,
+    alpha_tilde: f32,
+    kernel: Kernel,
+) -> ProjectionCount {
+    #[cfg(feature = "parallel")]
+    if crate::parallel::worth_it(tets.len()) {
+        return crate::parallel::vertex_face(acc, tets, vf, alpha_tilde, kernel);
+    }
+    let mut count = ProjectionCount::default();
+    for (r, independent) in tets.classes.ranges() {
+        let (t, hgt, lam) = (
+            &tets.indices[r.clone()],
+            &vf.rest_heights[r.clone()],
+            &mut vf.lambdas[r],
+        );
+        count += vertex_face_run(acc, t, hgt, lam, alpha_tilde, kernel, independent);
+    }
+    count
+}
+
+/// One sweep of one body's volume constraints on its working copy.
+fn volumes_of(
+    acc: &mut WorkAccess<'_>,
+    tets: &Tetrahedra,
+    vol: &mut VolumeConstraints,
+    alpha_tilde: f32,
+    kernel: Kernel,
+) -> ProjectionCount {
+    #[cfg(feature = "parallel")]
+    if crate::parallel::worth_it(tets.len()) {
+        return crate::parallel::volume(acc, tets, vol, alpha_tilde, kernel);
+    }
+    let mut count = ProjectionCount::default();
+    for (r, independent) in tets.classes.ranges() {
+        let (t, rest, lam) = (
+            &tets.indices[r.clone()],
+            &tets.rest_volumes[r.clone()],
+            &mut vol.lambdas[r],
+        );
+        count += volume_run(acc, t, rest, lam, alpha_tilde, kernel, independent);
+    }
+    count
 }
 
 /// What [`update_velocities`] did besides the plain update.
