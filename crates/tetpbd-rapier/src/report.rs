@@ -68,6 +68,9 @@ pub struct CouplingStats {
     /// Contact evaluations skipped because parry gave no usable normal (point exactly on the
     /// surface with no previous normal).
     pub degenerate_contacts: u64,
+    /// Stacking passes run (one per stacked soft body and iteration; `stacking` module
+    /// docs, [`crate::CouplingSettings::stacking_mass_ratio`]).
+    pub stacking_passes: u64,
     /// Rigid bodies whose pose/velocity was written back.
     pub bodies_written: usize,
     /// Rigid bodies not written back because their result was not finite.

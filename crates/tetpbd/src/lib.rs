@@ -39,6 +39,7 @@ mod parallel;
 mod particles;
 mod projection;
 mod solver;
+mod stacking;
 mod stats;
 pub mod systems;
 
@@ -48,6 +49,7 @@ pub use families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 pub use mesh::{Surface, Tetrahedra};
 pub use particles::{ExternalAcceleration, Particles};
 pub use solver::{Solver, SolverSettings, SubstepHook};
+pub use stacking::{project_stacked, BodyConstraints, StackingLayers};
 pub use stats::{ErrorAccumulator, ErrorStats, Family, FamilyStats, StepStats};
 
 pub use hecs;
