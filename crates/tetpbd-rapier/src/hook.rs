@@ -127,6 +127,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 h,
                 max_push: self.max_depenetration_speed * h,
             };
+            let t = std::time::Instant::now();
             if stacking_pass(
                 world,
                 s.entity,
@@ -137,6 +138,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 stats.stacking_passes += 1;
                 s.stacked = true;
             }
+            stats.stacking_time += t.elapsed();
         }
         project_supports(supports, bodies);
     }
@@ -152,6 +154,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             episodes,
             active_colliders,
             supports,
+            stats,
             ..
         } = &mut *self.frame;
         for b in bodies.iter_mut() {
@@ -173,6 +176,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             }
             let range = s.contacts.clone();
             if s.stacked {
+                let t = std::time::Instant::now();
                 stacked_velocity_pass(
                     &contacts[range.clone()],
                     &corners[s.corners.clone()],
@@ -181,6 +185,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                     bodies,
                     colliders,
                 );
+                stats.stacking_time += t.elapsed();
             }
             velocity_pass(&mut contacts[range.clone()], p, bodies, colliders);
             restitution_pass(
