@@ -140,8 +140,9 @@ pub(crate) struct Frame {
     /// Force (N) and torque (N·m) added to bodies for rapier's next step (the load of the
     /// previous frame, `BodyProxy::load`), taken off again after that step.
     pub loads: Vec<(RigidBodyHandle, Vector3<f32>, Vector3<f32>)>,
-    /// Scratch of the stacking pass (`stacking` module docs).
-    pub layers: tetpbd::StackingLayers,
+    /// Levels of the stacking pass (`stacking` module docs), one per soft body (by its
+    /// index in `soft`), kept across frames.
+    pub layers: Vec<(Option<Entity>, tetpbd::StackingLayers)>,
     /// Scratch of the stacking pass: which particles were pinned before it froze them.
     pub pinned: Vec<bool>,
     near: Vec<ColliderHandle>,

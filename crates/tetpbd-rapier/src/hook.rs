@@ -82,7 +82,10 @@ impl SubstepHook for CouplingHook<'_, '_> {
             pinned,
             ..
         } = &mut *self.frame;
-        for s in soft.iter_mut() {
+        if layers.len() < soft.len() {
+            layers.resize_with(soft.len(), Default::default);
+        }
+        for (s, cache) in soft.iter_mut().zip(layers.iter_mut()) {
             let Ok((p, surface)) = world.query_one_mut::<(&mut Particles, &Surface)>(s.entity)
             else {
                 continue;
@@ -120,7 +123,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 bodies,
                 colliders,
                 set: self.qp.colliders,
-                layers,
+                layers: cache,
                 pinned,
                 order: self.order,
                 ratio: self.stacking_mass_ratio,

@@ -20,7 +20,7 @@
 //! through a stack of rigid bodies:
 //!
 //! 1. the particles in an active contact with an immovable support, and pinned particles,
-//!    are the roots;
+//!    are the roots (the levels are kept while the roots stay the same);
 //! 2. the body's own constraints are projected level by level away from the roots with the
 //!    lower particles frozen ([`tetpbd::project_stacked`]): the body takes its shape back
 //!    by moving the particles further from the ground, as a stack resting on the ground
@@ -65,7 +65,9 @@ pub(crate) struct Stacking<'a> {
     pub bodies: &'a mut [BodyProxy],
     pub colliders: &'a [ColliderProxy],
     pub set: &'a ColliderSet,
-    pub layers: &'a mut StackingLayers,
+    /// Levels of this soft body, kept across substeps and frames (rebuilt when the entity
+    /// or its mesh size changes).
+    pub layers: &'a mut (Option<Entity>, StackingLayers),
     /// Scratch: which particles were pinned before freezing.
     pub pinned: &'a mut Vec<bool>,
     pub order: [Family; 3],
@@ -120,6 +122,16 @@ fn carries_heavy(
         })
 }
 
+/// End of the run of items with the same collider as `items[start]`.
+fn run_end<T>(items: &[T], start: usize, collider: impl Fn(&T) -> usize) -> usize {
+    let key = collider(&items[start]);
+    start
+        + items[start..]
+            .iter()
+            .take_while(|t| collider(t) == key)
+            .count()
+}
+
 /// Runs the stacking pass (module docs) on one soft body if it is stacked; returns whether
 /// it ran.
 pub(crate) fn stacking_pass(
@@ -142,14 +154,21 @@ pub(crate) fn stacking_pass(
     if !carries_heavy(contacts, corners, p, surface, s) {
         return false;
     }
+    // Roots: particles in contact with an immovable support in this substep. (Those in
+    // contact at any time in the frame would change less often, but keep particles frozen
+    // that already left the support: the slab jumping out of the ground's contact skin at
+    // the start then reached 1.6–3.1 m/s instead of 0.7–2.2.)
     let supported = contacts
         .iter()
         .filter(|c| c.active && c.solve && immovable(&s.colliders[c.collider], s.bodies))
         .map(|c| c.particle);
     let pinned = (0..p.len() as u32).filter(|&i| p.inv_masses()[i as usize] == 0.0);
-    let top = s
-        .layers
-        .compute(p.len(), tets, edges.as_deref(), supported.chain(pinned));
+    let (owner, layers) = &mut *s.layers;
+    if *owner != Some(entity) || !layers.fits(p.len(), tets) {
+        *layers = StackingLayers::new(p.len(), tets);
+        *owner = Some(entity);
+    }
+    let top = layers.set_roots(tets, edges.as_deref(), supported.chain(pinned));
     if top == 0 {
         return false;
     }
@@ -158,7 +177,7 @@ pub(crate) fn stacking_pass(
         vertex_face,
         volume,
     };
-    project_stacked(p, tets, families, s.order, s.h, s.layers);
+    project_stacked(p, tets, families, s.order, s.h, layers);
     // The dynamic bodies against the frozen soft surface.
     s.pinned.clear();
     s.pinned.extend((0..p.len()).map(|i| p.is_pinned(i)));
@@ -166,17 +185,40 @@ pub(crate) fn stacking_pass(
         // In range by construction.
         let _ = p.set_pinned(i, true);
     }
-    project_contacts(contacts, p, s.bodies, s.colliders, s.set, s.max_push);
-    project_corners(
-        corners,
-        contacts,
-        p,
-        surface,
-        s.bodies,
-        s.colliders,
-        s.set,
-        CornerPass::Frozen,
-    );
+    // Only the runs of dynamic colliders (candidates are gathered collider by collider):
+    // against a frozen surface nothing else can move.
+    let mut i = 0;
+    while i < contacts.len() {
+        let end = run_end(contacts, i, |c| c.collider);
+        if dynamic(&s.colliders[contacts[i].collider], s.bodies).is_some() {
+            project_contacts(
+                &mut contacts[i..end],
+                p,
+                s.bodies,
+                s.colliders,
+                s.set,
+                s.max_push,
+            );
+        }
+        i = end;
+    }
+    let mut i = 0;
+    while i < corners.len() {
+        let end = run_end(corners, i, |k| k.collider);
+        if dynamic(&s.colliders[corners[i].collider], s.bodies).is_some() {
+            project_corners(
+                &mut corners[i..end],
+                contacts,
+                p,
+                surface,
+                s.bodies,
+                s.colliders,
+                s.set,
+                CornerPass::Frozen,
+            );
+        }
+        i = end;
+    }
     for (i, &was) in s.pinned.iter().enumerate() {
         if !was {
             let _ = p.set_pinned(i, false);

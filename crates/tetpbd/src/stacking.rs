@@ -39,7 +39,8 @@ use crate::systems::ProjectionCount;
 const UNREACHED: u32 = u32::MAX;
 
 /// Levels of one body's particles and the constraint order of a ground-up sweep
-/// ([`project_stacked`]); keeps its allocations between calls.
+/// ([`project_stacked`]). Built for one body ([`StackingLayers::new`]); keeps its
+/// allocations, and its levels while the roots stay the same.
 #[derive(Clone, Debug, Default)]
 pub struct StackingLayers {
     /// Per particle: distance from the roots in tetrahedra, [`UNREACHED`] when none.
@@ -47,7 +48,12 @@ pub struct StackingLayers {
     /// Per particle, the tetrahedra it belongs to (compressed rows).
     first: Vec<u32>,
     incident: Vec<u32>,
+    /// Number of tetrahedra of the body the rows were built for.
+    tet_count: usize,
     queue: Vec<u32>,
+    /// The roots of the current levels (sorted, unique) and the next call's candidates.
+    roots: Vec<u32>,
+    candidates: Vec<u32>,
     /// Edges and tetrahedra sorted by level, with the start of each level.
     edge_order: Vec<u32>,
     edge_starts: Vec<u32>,
@@ -58,27 +64,51 @@ pub struct StackingLayers {
 }
 
 impl StackingLayers {
-    /// Gives every particle of a body with `n` particles and tetrahedra `tets` its level
-    /// below the `roots` (particle indices; out-of-range ones are ignored), and orders the
-    /// body's tetrahedra and `edges` by level. Returns the highest level reached (0 when
-    /// there are no roots).
-    pub fn compute(
+    /// Layers of a body with `n` particles and tetrahedra `tets`, with no roots yet.
+    pub fn new(n: usize, tets: &Tetrahedra) -> Self {
+        let mut s = StackingLayers {
+            level: vec![UNREACHED; n],
+            ..StackingLayers::default()
+        };
+        s.incidence(n, tets.indices());
+        s
+    }
+
+    /// Whether these layers were built for a body with `n` particles and tetrahedra `tets`
+    /// (by their counts).
+    pub fn fits(&self, n: usize, tets: &Tetrahedra) -> bool {
+        self.level.len() == n && self.first.len() == n + 1 && self.tet_count == tets.len()
+    }
+
+    /// Gives every particle its level below the `roots` (particle indices; out-of-range ones
+    /// are ignored) and orders the body's tetrahedra and `edges` by level. `tets` and
+    /// `edges` are those of the body the layers were built for. The levels are only
+    /// recomputed when the set of roots differs from the previous call's. Returns the
+    /// highest level reached (0 when there are no roots, or the layers do not fit `tets`).
+    pub fn set_roots(
         &mut self,
-        n: usize,
         tets: &Tetrahedra,
         edges: Option<&EdgeConstraints>,
         roots: impl IntoIterator<Item = u32>,
     ) -> u32 {
-        self.level.clear();
-        self.level.resize(n, UNREACHED);
+        let n = self.level.len();
+        if !self.fits(n, tets) {
+            return 0;
+        }
+        self.candidates.clear();
+        self.candidates
+            .extend(roots.into_iter().filter(|&r| (r as usize) < n));
+        self.candidates.sort_unstable();
+        self.candidates.dedup();
+        if self.candidates == self.roots && !self.roots.is_empty() {
+            return self.top;
+        }
+        std::mem::swap(&mut self.candidates, &mut self.roots);
+        self.level.fill(UNREACHED);
         self.queue.clear();
-        for r in roots {
-            if let Some(l) = self.level.get_mut(r as usize) {
-                if *l != 0 {
-                    *l = 0;
-                    self.queue.push(r);
-                }
-            }
+        for &r in &self.roots {
+            self.level[r as usize] = 0;
+            self.queue.push(r);
         }
         self.top = 0;
         self.edge_order.clear();
@@ -88,7 +118,6 @@ impl StackingLayers {
         if self.queue.is_empty() {
             return 0;
         }
-        self.incidence(n, tets.indices());
         // Breadth first through the tetrahedra.
         let mut head = 0;
         while head < self.queue.len() {
@@ -151,6 +180,7 @@ impl StackingLayers {
         }
         self.incident.clear();
         self.incident.resize(self.first[n] as usize, 0);
+        self.tet_count = tets.len();
         let mut fill: Vec<u32> = self.first[..n].to_vec();
         for (k, t) in tets.iter().enumerate() {
             for &i in t {
@@ -234,7 +264,7 @@ pub struct BodyConstraints<'a> {
 }
 
 /// One ground-up sweep over a body's constraints (module docs), with the levels of the
-/// last [`StackingLayers::compute`] for this body: for each level `L ≥ 1`, the constraints
+/// last [`StackingLayers::set_roots`] for this body: for each level `L ≥ 1`, the constraints
 /// of level `L` in the family `order`, particles below `L` frozen. XPBD with the families'
 /// compliances and the substep length `h` (s); multipliers accumulate with the substep's
 /// other projections. Scalar kernels.

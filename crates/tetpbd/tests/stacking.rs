@@ -35,16 +35,27 @@ fn levels_count_cells_from_the_roots() {
     let (p, tets, edges) = world
         .query_one_mut::<(&Particles, &Tetrahedra, &EdgeConstraints)>(e)
         .unwrap();
-    let mut layers = StackingLayers::default();
-    let top = layers.compute(p.len(), tets, Some(edges), bottom.iter().copied());
+    let mut layers = StackingLayers::new(p.len(), tets);
+    assert!(layers.fits(p.len(), tets));
+    let top = layers.set_roots(tets, Some(edges), bottom.iter().copied());
     assert_eq!(top, 3);
     for (i, x) in p.positions().iter().enumerate() {
         let expected = (x.y / 0.2).round() as u32;
         assert_eq!(layers.level(i), Some(expected), "particle {i} at {x:?}");
     }
+    // The same roots again (in another order): the same levels.
+    let again = layers.set_roots(tets, Some(edges), bottom.iter().rev().copied());
+    assert_eq!(again, 3);
+    // One root: the column is reached from one corner.
+    let one = layers.set_roots(tets, Some(edges), [bottom[0]]);
+    assert!(one >= 3, "{one}");
+    assert_eq!(layers.level(bottom[0] as usize), Some(0));
     // No roots: nothing reached.
-    assert_eq!(layers.compute(p.len(), tets, Some(edges), []), 0);
+    assert_eq!(layers.set_roots(tets, Some(edges), []), 0);
     assert_eq!(layers.level(0), None);
+    // Built for another body.
+    assert!(!StackingLayers::new(p.len() + 1, tets).fits(p.len(), tets));
+    assert!(!StackingLayers::default().fits(p.len(), tets));
 }
 
 /// The top of the column pushed down by 5 cm: one ground-up sweep with hard constraints
@@ -72,8 +83,8 @@ fn a_squashed_column_is_restored_from_the_ground_up() {
         }
         let before: Vec<Vector3<f32>> = p.positions().to_vec();
         let height = |p: &Particles| p.positions().iter().map(|x| x.y).fold(f32::MIN, f32::max);
-        let mut layers = StackingLayers::default();
-        layers.compute(p.len(), tets, edges.as_deref(), bottom.iter().copied());
+        let mut layers = StackingLayers::new(p.len(), tets);
+        layers.set_roots(tets, edges.as_deref(), bottom.iter().copied());
         let count = project_stacked(
             p,
             tets,

@@ -45,7 +45,7 @@ fn run(cells: [u32; 3], ratio: f32, frames: usize) -> Result<Run, Box<dyn std::e
     );
     let size = Vector3::new(2.0, 0.4, 2.0);
     let mesh = box_grid(size, cells, CellSplit::Six)?;
-    let tets = mesh.tetrahedra.len();
+    let tets = mesh.tets.len();
     let body = SoftBodyBuilder::new(mesh)
         .density(1.0 / (size.x * size.y * size.z))
         .edges(0.0)
