@@ -65,6 +65,25 @@ fn bad_settings_are_rejected_before_anything_moves() {
         CoupledWorld::new(SolverSettings::default(), bad_margin),
         Err(CouplingError::BadSetting { .. })
     ));
+    for ratio in [f32::NAN, -1.0] {
+        let bad_ratio = CouplingSettings {
+            stacking_mass_ratio: ratio,
+            ..CouplingSettings::default()
+        };
+        assert!(matches!(
+            CoupledWorld::new(SolverSettings::default(), bad_ratio),
+            Err(CouplingError::BadSetting {
+                name: "stacking mass ratio",
+                ..
+            })
+        ));
+    }
+    // Infinity turns the stacking pass off: a valid setting.
+    let off = CouplingSettings {
+        stacking_mass_ratio: f32::INFINITY,
+        ..CouplingSettings::default()
+    };
+    assert!(CoupledWorld::new(SolverSettings::default(), off).is_ok());
     let no_substeps = SolverSettings {
         substeps: 0,
         ..SolverSettings::default()

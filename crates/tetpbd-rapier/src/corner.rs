@@ -75,6 +75,8 @@ pub(crate) struct CornerContact {
     pub depth: f32,
     pub normal: Vector3<f32>,
     pub point: Vector3<f32>,
+    /// Barycentric weights of `point` on the triangle at its last projection.
+    pub beta: [f32; 3],
     pub sub_impulse: Vector3<f32>,
     pub impulse: Vector3<f32>,
 }
@@ -258,6 +260,7 @@ pub(crate) fn gather_corners(
                 depth: 0.0,
                 normal: Vector3::zeros(),
                 point: Vector3::zeros(),
+                beta: [0.0; 3],
                 sub_impulse: Vector3::zeros(),
                 impulse: Vector3::zeros(),
             });
@@ -269,10 +272,22 @@ pub(crate) fn gather_corners(
     }
 }
 
-/// One Gauss–Seidel sweep over a soft body's corner contacts. With `crossing_only`, only
-/// points of moving (non-fixed) bodies that crossed their triangle within the substep are
-/// projected: this pass runs before the particle contacts, so a fast body is stopped by the
-/// surface it hits first rather than by a particle poking into it from the side.
+/// Which rigid points a sweep over the corner contacts projects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum CornerPass {
+    /// Only points of moving (non-fixed) bodies that crossed their triangle within the
+    /// substep: this pass runs before the particle contacts, so a fast body is stopped by
+    /// the surface it hits first rather than by a particle poking into it from the side.
+    Crossing,
+    /// Every point, except on triangles with a vertex touching the same collider.
+    Ordinary,
+    /// Every point, on every triangle: the soft surface is frozen (the `stacking` pass), so
+    /// a particle contact and a triangle on the same spot cannot fight; they both push the
+    /// rigid body out.
+    Frozen,
+}
+
+/// One Gauss–Seidel sweep over a soft body's corner contacts (see [`CornerPass`]).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn project_corners(
     corners: &mut [CornerContact],
@@ -282,9 +297,9 @@ pub(crate) fn project_corners(
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
     set: &ColliderSet,
-    crossing_only: bool,
+    pass: CornerPass,
 ) {
-    if crossing_only {
+    if pass == CornerPass::Crossing {
         // Only the runs of moving colliders.
         let mut i = 0;
         while i < corners.len() {
@@ -301,13 +316,13 @@ pub(crate) fn project_corners(
                     bodies,
                     colliders,
                     set,
-                    true,
+                    pass,
                 );
             }
             i += run;
         }
     } else {
-        sweep_corners(corners, contacts, p, surface, bodies, colliders, set, false);
+        sweep_corners(corners, contacts, p, surface, bodies, colliders, set, pass);
     }
 }
 
@@ -320,8 +335,9 @@ fn sweep_corners(
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
     set: &ColliderSet,
-    crossing_only: bool,
+    pass: CornerPass,
 ) {
+    let crossing_only = pass == CornerPass::Crossing;
     for k in corners {
         // The crossing pass only sees moving bodies; a fixed one cannot cross by itself.
         let moved = match colliders[k.collider].body {
@@ -342,9 +358,9 @@ fn sweep_corners(
             .iter()
             .flatten()
             .any(|&c| contacts.get(c).is_some_and(|c| c.active));
-        // Outside the crossing pass a touching vertex rules the triangle out (a crossing
-        // there is only taken in the crossing pass).
-        if vertex_touches && !crossing_only {
+        // In the ordinary pass a touching vertex rules the triangle out (a crossing there is
+        // only taken in the crossing pass).
+        if vertex_touches && pass == CornerPass::Ordinary {
             continue;
         }
         let idx = tri.map(|i| i as usize);
@@ -455,6 +471,7 @@ fn sweep_corners(
         k.depth = k.depth.max(-c_val);
         k.normal = -n;
         k.point = v;
+        k.beta = beta;
         k.sub_impulse -= n * dl;
         k.lambda_n += dl;
         friction(k, p, idx, beta, bodies, cp.body, &v, &n);

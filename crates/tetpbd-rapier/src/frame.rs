@@ -32,6 +32,8 @@ pub(crate) struct SoftEntry {
     pub contacts: std::ops::Range<usize>,
     pub corners: std::ops::Range<usize>,
     pub attachments: std::ops::Range<usize>,
+    /// Whether the stacking pass ran on the body in the current substep.
+    pub stacked: bool,
 }
 
 /// A collider near a soft body.
@@ -138,6 +140,11 @@ pub(crate) struct Frame {
     /// Force (N) and torque (N·m) added to bodies for rapier's next step (the load of the
     /// previous frame, `BodyProxy::load`), taken off again after that step.
     pub loads: Vec<(RigidBodyHandle, Vector3<f32>, Vector3<f32>)>,
+    /// Levels of the stacking pass (`stacking` module docs), one per soft body (by its
+    /// index in `soft`), kept across frames.
+    pub layers: Vec<(Option<Entity>, tetpbd::StackingLayers)>,
+    /// Scratch of the stacking pass: which particles were pinned before it froze them.
+    pub pinned: Vec<bool>,
     near: Vec<ColliderHandle>,
     /// Colliders of fast bodies with their swept AABB over the frame (`sweep` module docs).
     fast: Vec<(ColliderHandle, Aabb)>,
@@ -448,6 +455,7 @@ impl Frame {
                 contacts: c0..self.contacts.len(),
                 corners: k0..self.corners.len(),
                 attachments: a0..self.attachments.len(),
+                stacked: false,
             });
         }
         // A supported body holding a soft body by an attachment is anchored: it takes part

@@ -7,7 +7,7 @@ use tetpbd::{Particles, SubstepHook, Surface};
 
 use crate::attachment::{anchor_of, project_attachments, Attachments};
 use crate::contact::{finish_substep, project_contacts, velocity_pass};
-use crate::corner::project_corners;
+use crate::corner::{project_corners, CornerPass};
 use crate::damping::{damp, DeformationDamping};
 use crate::frame::{Frame, GatherInput};
 use crate::material::SoftCollider;
@@ -15,6 +15,7 @@ use crate::report::{ContactReport, SoftFeature};
 use crate::restitution::{com_velocity, end_episodes, restitution_pass};
 use crate::rolling::rolling_pass;
 use crate::shape_query::surface_point;
+use crate::stacking::{stacked_velocity_pass, stacking_pass, Stacking};
 use crate::support::{end_substep_supports, project_supports};
 
 /// Borrows the frame state and rapier's query pipeline for one soft step.
@@ -25,6 +26,10 @@ pub(crate) struct CouplingHook<'q, 'a> {
     pub default_collider: SoftCollider,
     pub margin: f32,
     pub max_depenetration_speed: f32,
+    /// `CouplingSettings::stacking_mass_ratio`.
+    pub stacking_mass_ratio: f32,
+    /// The solver's family order (the stacking pass projects in it).
+    pub order: [tetpbd::Family; 3],
     pub reports: &'q mut Vec<ContactReport>,
 }
 
@@ -48,6 +53,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
     fn begin_substep(&mut self, world: &mut World, h: f32) {
         self.frame.substep += 1;
         for s in &mut self.frame.soft {
+            s.stacked = false;
             if let Ok(p) = world.query_one_mut::<&Particles>(s.entity) {
                 s.v_cm_pre = com_velocity(p).0;
             }
@@ -72,9 +78,14 @@ impl SubstepHook for CouplingHook<'_, '_> {
             attachments,
             supports,
             stats,
+            layers,
+            pinned,
             ..
         } = &mut *self.frame;
-        for s in soft.iter() {
+        if layers.len() < soft.len() {
+            layers.resize_with(soft.len(), Default::default);
+        }
+        for (s, cache) in soft.iter_mut().zip(layers.iter_mut()) {
             let Ok((p, surface)) = world.query_one_mut::<(&mut Particles, &Surface)>(s.entity)
             else {
                 continue;
@@ -87,7 +98,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 bodies,
                 colliders,
                 self.qp.colliders,
-                true,
+                CornerPass::Crossing,
             );
             stats.degenerate_contacts += project_contacts(
                 &mut contacts[s.contacts.clone()],
@@ -105,9 +116,32 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 bodies,
                 colliders,
                 self.qp.colliders,
-                false,
+                CornerPass::Ordinary,
             );
             project_attachments(&mut attachments[s.attachments.clone()], p, bodies, frac, h);
+            let mut stacking = Stacking {
+                bodies,
+                colliders,
+                set: self.qp.colliders,
+                layers: cache,
+                pinned,
+                order: self.order,
+                ratio: self.stacking_mass_ratio,
+                h,
+                max_push: self.max_depenetration_speed * h,
+            };
+            let t = std::time::Instant::now();
+            if stacking_pass(
+                world,
+                s.entity,
+                &mut contacts[s.contacts.clone()],
+                &mut corners[s.corners.clone()],
+                &mut stacking,
+            ) {
+                stats.stacking_passes += 1;
+                s.stacked = true;
+            }
+            stats.stacking_time += t.elapsed();
         }
         project_supports(supports, bodies);
     }
@@ -123,6 +157,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             episodes,
             active_colliders,
             supports,
+            stats,
             ..
         } = &mut *self.frame;
         for b in bodies.iter_mut() {
@@ -130,8 +165,9 @@ impl SubstepHook for CouplingHook<'_, '_> {
         }
         end_substep_supports(supports, h);
         for s in soft.iter() {
-            let Ok((p, damping, sc)) = world.query_one_mut::<(
+            let Ok((p, surface, damping, sc)) = world.query_one_mut::<(
                 &mut Particles,
+                &Surface,
                 Option<&DeformationDamping>,
                 Option<&SoftCollider>,
             )>(s.entity) else {
@@ -142,6 +178,18 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 damp(p, d.rate(), h);
             }
             let range = s.contacts.clone();
+            if s.stacked {
+                let t = std::time::Instant::now();
+                stacked_velocity_pass(
+                    &contacts[range.clone()],
+                    &corners[s.corners.clone()],
+                    p,
+                    surface,
+                    bodies,
+                    colliders,
+                );
+                stats.stacking_time += t.elapsed();
+            }
             velocity_pass(&mut contacts[range.clone()], p, bodies, colliders);
             restitution_pass(
                 episodes,

@@ -72,6 +72,7 @@ mod soft_gather;
 mod soft_project;
 mod soft_restitution;
 mod soft_separation;
+mod stacking;
 mod support;
 mod sweep;
 

@@ -40,6 +40,7 @@ mod particles;
 mod projection;
 mod runs;
 mod solver;
+mod stacking;
 mod stats;
 pub mod systems;
 mod work;
@@ -50,6 +51,7 @@ pub use families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 pub use mesh::{Surface, Tetrahedra};
 pub use particles::{ExternalAcceleration, Particles};
 pub use solver::{Solver, SolverSettings, SubstepHook};
+pub use stacking::{project_stacked, BodyConstraints, StackingLayers};
 pub use stats::{ErrorAccumulator, ErrorStats, Family, FamilyStats, StepStats};
 
 pub use hecs;

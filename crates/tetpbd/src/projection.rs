@@ -113,9 +113,26 @@ pub(crate) fn vertex_face<A: ParticleAccess>(
     lambdas: &mut [f32; 4],
     alpha_tilde: f32,
 ) -> (u32, u32) {
+    vertex_face_held(acc, tet, rest_heights, lambdas, alpha_tilde, |_| true)
+}
+
+/// [`vertex_face`] for the constraints whose held vertex (`p1`, a particle index) passes
+/// `held`; the others are left alone.
+#[inline(always)]
+pub(crate) fn vertex_face_held<A: ParticleAccess>(
+    acc: &mut A,
+    tet: [u32; 4],
+    rest_heights: &[f32; 4],
+    lambdas: &mut [f32; 4],
+    alpha_tilde: f32,
+    held: impl Fn(usize) -> bool,
+) -> (u32, u32) {
     let (mut applied, mut degenerate) = (0, 0);
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
         let idx = order.map(|o| tet[o] as usize);
+        if !held(idx[1]) {
+            continue;
+        }
         let p = idx.map(|i| acc.x(i));
         match constraint::vertex_face(&p[0], &p[1], &p[2], &p[3], rest_heights[k]) {
             Some(e) => {

@@ -6,6 +6,13 @@
 //!
 //! `--fast` skips the long cases. Every case runs under every configuration twice: without
 //! any safety net, and with `max_correction_speed` = 10 m/s.
+//!
+//! `--coupled <text>` runs only the coupled cases whose name contains `<text>` and prints
+//! their cells instead of writing the report:
+//!
+//! ```text
+//! cargo run --release -p tetpbd-stability --bin stability -- --coupled "1000 kg on soft"
+//! ```
 
 use std::fmt::Write as _;
 use std::process::Command;
@@ -42,6 +49,45 @@ fn cpu() -> String {
         .unwrap_or_else(|| "unknown CPU".into())
 }
 
+/// One coupled cell as the report writes it.
+fn cell(o: &CoupledOutcome) -> String {
+    let verdict = if o.pass() { "**pass**" } else { "**FAIL**" };
+    match &o.error {
+        Some(e) => format!("rejected: {e}"),
+        None => format!(
+            "{verdict} {}, peak {:.1} m/s, pen {:.1e} m{}",
+            o.criterion.1,
+            o.peak_speed,
+            o.penetration,
+            if o.inverted > 0 {
+                format!(", inv {}", o.inverted)
+            } else {
+                String::new()
+            }
+        ),
+    }
+}
+
+/// Runs the coupled cases whose name contains `filter` and prints their cells.
+fn coupled_only(filter: &str, configs: &[Config]) {
+    for case in coupled_cases().iter().filter(|c| c.name.contains(filter)) {
+        for c in configs {
+            if case.kind == CaseKind::Long && c.soft {
+                continue;
+            }
+            let t = Instant::now();
+            let o = (case.run)(c);
+            println!(
+                "{} | {}: {} ({:.1} s)",
+                case.name,
+                c.label(),
+                cell(&o),
+                t.elapsed().as_secs_f64()
+            );
+        }
+    }
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let out = args
@@ -51,6 +97,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or_else(|| "docs/stability.md".into());
     let fast = args.iter().any(|a| a == "--fast");
     let configs = Config::all();
+    if let Some(i) = args.iter().position(|a| a == "--coupled") {
+        let filter = args.get(i + 1).map_or("", |s| s.as_str());
+        coupled_only(filter, &configs);
+        return Ok(());
+    }
     let started = Instant::now();
 
     let mut doc = String::new();
@@ -173,22 +224,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             if o.pass() {
                 coupled_pass.0 += 1;
             }
-            let verdict = if o.pass() { "**pass**" } else { "**FAIL**" };
-            match &o.error {
-                Some(e) => write!(doc, " rejected: {e} |")?,
-                None => write!(
-                    doc,
-                    " {verdict} {}, peak {:.1} m/s, pen {:.1e} m{} |",
-                    o.criterion.1,
-                    o.peak_speed,
-                    o.penetration,
-                    if o.inverted > 0 {
-                        format!(", inv {}", o.inverted)
-                    } else {
-                        String::new()
-                    }
-                )?,
-            }
+            write!(doc, " {} |", cell(&o))?;
         }
         writeln!(doc)?;
         progress.suspend(|| {
