@@ -31,9 +31,10 @@
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::mesh::Tetrahedra;
 use crate::particles::Particles;
-use crate::projection::{self, ParticleAccess, SliceAccess};
+use crate::projection::{self, ParticleAccess};
 use crate::stats::Family;
 use crate::systems::ProjectionCount;
+use crate::work::{self, WorkAccess};
 
 /// Level of a particle that no root reaches.
 const UNREACHED: u32 = u32::MAX;
@@ -223,24 +224,22 @@ fn bucket(
     }
 }
 
-/// Particles below the current level are frozen.
-struct Frozen<'a> {
-    inner: SliceAccess<'a>,
+/// Particles below the current level are frozen (inverse mass 0).
+struct Frozen<'a, 'b> {
+    inner: &'a mut WorkAccess<'b>,
     level: &'a [u32],
     current: u32,
 }
 
-impl ParticleAccess for Frozen<'_> {
+impl ParticleAccess for Frozen<'_, '_> {
     #[inline(always)]
-    fn x(&self, i: usize) -> nalgebra::Vector3<f32> {
-        self.inner.x(i)
-    }
-    #[inline(always)]
-    fn w(&self, i: usize) -> f32 {
+    fn row(&self, i: usize) -> wide::f32x4 {
+        let row = self.inner.row(i);
         if self.level[i] < self.current {
-            0.0
+            let [x, y, z, _] = row.to_array();
+            wide::f32x4::new([x, y, z, 0.0])
         } else {
-            self.inner.w(i)
+            row
         }
     }
     #[inline(always)]
@@ -248,8 +247,8 @@ impl ParticleAccess for Frozen<'_> {
         self.inner.rest(i)
     }
     #[inline(always)]
-    fn add(&mut self, i: usize, d: nalgebra::Vector3<f32>) {
-        self.inner.add(i, d);
+    fn add_row(&mut self, i: usize, d: wide::f32x4) {
+        self.inner.add_row(i, d);
     }
 }
 
@@ -285,84 +284,81 @@ pub fn project_stacked(
         mut vertex_face,
         mut volume,
     } = families;
-    let mut acc = Frozen {
-        inner: SliceAccess {
-            x: &mut p.positions,
-            r: &mut p.residuals,
-            w: &p.inv_masses,
-            rest: &p.rest_positions,
-        },
-        level: &layers.level,
-        current: 0,
-    };
-    let range = |starts: &[u32], l: u32| {
-        starts
-            .get(l as usize - 1)
-            .zip(starts.get(l as usize))
-            .map_or(0..0, |(&a, &b)| a as usize..b as usize)
-    };
-    for l in 1..=layers.top {
-        acc.current = l;
-        for family in order {
-            match family {
-                Family::Edge => {
-                    let Some(e) = edges.as_deref_mut() else {
-                        continue;
-                    };
-                    let alpha_tilde = e.compliance / (h * h);
-                    for &k in &layers.edge_order[range(&layers.edge_starts, l)] {
-                        let k = k as usize;
-                        count.add(projection::edge(
-                            &mut acc,
-                            e.edges[k],
-                            e.rest_lengths[k],
-                            &mut e.lambdas[k],
-                            alpha_tilde,
-                        ));
+    work::with_access(p, |inner| {
+        let mut acc = Frozen {
+            inner,
+            level: &layers.level,
+            current: 0,
+        };
+        let range = |starts: &[u32], l: u32| {
+            starts
+                .get(l as usize - 1)
+                .zip(starts.get(l as usize))
+                .map_or(0..0, |(&a, &b)| a as usize..b as usize)
+        };
+        for l in 1..=layers.top {
+            acc.current = l;
+            for family in order {
+                match family {
+                    Family::Edge => {
+                        let Some(e) = edges.as_deref_mut() else {
+                            continue;
+                        };
+                        let alpha_tilde = e.compliance / (h * h);
+                        for &k in &layers.edge_order[range(&layers.edge_starts, l)] {
+                            let k = k as usize;
+                            count.add(projection::edge(
+                                &mut acc,
+                                e.edges[k],
+                                e.rest_lengths[k],
+                                &mut e.lambdas[k],
+                                alpha_tilde,
+                            ));
+                        }
                     }
-                }
-                Family::VertexFace => {
-                    let Some(vf) = vertex_face.as_deref_mut() else {
-                        continue;
-                    };
-                    let alpha_tilde = vf.compliance / (h * h);
-                    for &t in &layers.tet_order[range(&layers.tet_starts, l)] {
-                        let t = t as usize;
-                        // Only a vertex of this level is held above its face: moving a
-                        // face alone to hold a frozen vertex is ill-conditioned (the
-                        // height barely depends on a face point whose opposite edge
-                        // passes under the vertex) and blew the slab up.
-                        let level = &layers.level;
-                        let (a, d) = projection::vertex_face_held(
-                            &mut acc,
-                            tets.indices[t],
-                            &vf.rest_heights[t],
-                            &mut vf.lambdas[t],
-                            alpha_tilde,
-                            |i| level[i] == l,
-                        );
-                        count.applied += u64::from(a);
-                        count.degenerate += u64::from(d);
+                    Family::VertexFace => {
+                        let Some(vf) = vertex_face.as_deref_mut() else {
+                            continue;
+                        };
+                        let alpha_tilde = vf.compliance / (h * h);
+                        for &t in &layers.tet_order[range(&layers.tet_starts, l)] {
+                            let t = t as usize;
+                            // Only a vertex of this level is held above its face: moving a
+                            // face alone to hold a frozen vertex is ill-conditioned (the
+                            // height barely depends on a face point whose opposite edge
+                            // passes under the vertex) and blew the slab up.
+                            let level = &layers.level;
+                            let (a, d) = projection::vertex_face_held(
+                                &mut acc,
+                                tets.indices[t],
+                                &vf.rest_heights[t],
+                                &mut vf.lambdas[t],
+                                alpha_tilde,
+                                |i| level[i] == l,
+                            );
+                            count.applied += u64::from(a);
+                            count.degenerate += u64::from(d);
+                        }
                     }
-                }
-                Family::Volume => {
-                    let Some(vol) = volume.as_deref_mut() else {
-                        continue;
-                    };
-                    let alpha_tilde = vol.compliance / (h * h);
-                    for &t in &layers.tet_order[range(&layers.tet_starts, l)] {
-                        let t = t as usize;
-                        count.add(projection::volume(
-                            &mut acc,
-                            tets.indices[t],
-                            tets.rest_volumes[t],
-                            &mut vol.lambdas[t],
-                            alpha_tilde,
-                        ));
+                    Family::Volume => {
+                        let Some(vol) = volume.as_deref_mut() else {
+                            continue;
+                        };
+                        let alpha_tilde = vol.compliance / (h * h);
+                        for &t in &layers.tet_order[range(&layers.tet_starts, l)] {
+                            let t = t as usize;
+                            count.add(projection::volume(
+                                &mut acc,
+                                tets.indices[t],
+                                tets.rest_volumes[t],
+                                &mut vol.lambdas[t],
+                                alpha_tilde,
+                            ));
+                        }
                     }
                 }
             }
         }
-    }
+    });
     count
 }
