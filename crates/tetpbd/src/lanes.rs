@@ -6,13 +6,13 @@
 //! back with the compensated add. The scalar kernels in [`crate::projection`] are the
 //! reference these are tested against (`tests/lanes.rs`).
 //!
-//! A chunk whose lanes hit a degenerate configuration (a zero-length edge, a face too close
-//! to collinear) is handed to the scalar kernel, which owns the documented fallbacks.
+//! A chunk whose lanes hit a degenerate configuration (a zero-length edge, a tetrahedron
+//! collapsed to a point) is handed to the scalar kernel, which owns the documented fallbacks.
 
 use nalgebra::Vector3;
 use wide::f32x8;
 
-use crate::constraint::VERTEX_FACE_ORDER;
+use crate::constraint::{VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
 use crate::projection::{self, ParticleAccess};
 use crate::systems::ProjectionCount;
 
@@ -223,10 +223,44 @@ pub(crate) fn volumes<A: ParticleAccess>(
     count
 }
 
+/// [`crate::constraint::vertex_face_bounded`] on all lanes: `(C̃, [∇p0, ∇p1, ∇p2, ∇p3],
+/// valid)`, with `valid` false (and everything else meaningless) on lanes whose face has
+/// collapsed to a point. `h` holds the rest values `d`, `kappa` the thinness threshold.
+#[inline(always)]
+fn vertex_face_bounded(a: V3, b: V3, c: V3, h: f32x8, kappa: f32) -> (f32x8, [V3; 4], f32x8) {
+    let half = f32x8::splat(0.5);
+    let m = b.cross(c);
+    let s = m.dot(m).sqrt();
+    let q = (b.dot(b) + c.dot(c)) * half;
+    let valid = q.simd_gt(h * h * f32x8::splat(1e-12));
+    let kappa = f32x8::splat(kappa);
+    let k = valid.select(kappa * q, f32x8::ONE);
+    let healthy = s.simd_ge(k) & s.simd_gt(f32x8::ZERO);
+    let inv_k = f32x8::ONE / k;
+    let r = s * inv_k;
+    let d = healthy.select(s, (s * r + k) * half);
+    let e = healthy.select(f32x8::ONE / healthy.select(s, f32x8::ONE), inv_k);
+    let beta = healthy.select(f32x8::ZERO, kappa * half * (f32x8::ONE - r * r));
+    let f = a.dot(m);
+    let inv_d = f32x8::ONE / d;
+    let rf = f * inv_d * inv_d;
+    let g1 = m.scale(inv_d);
+    let g2 = c
+        .cross(a)
+        .scale(inv_d)
+        .sub(c.cross(m).scale(e).add(b.scale(beta)).scale(rf));
+    let g3 = a
+        .cross(b)
+        .scale(inv_d)
+        .sub(m.cross(b).scale(e).add(c.scale(beta)).scale(rf));
+    let g0 = g1.add(g2).add(g3).neg();
+    (f * inv_d - h, [g0, g1, g2, g3], valid)
+}
+
 /// The four vertex–face constraints of eight tetrahedra (`tets.len() == LANES`), the four
 /// one after another on all lanes, corrections accumulated in registers and scattered once.
-/// See [`projection::vertex_face`]. A chunk with a face near degeneracy (100 × the
-/// kernel's threshold) goes to the scalar kernel.
+/// See [`projection::vertex_face`]. A chunk with a face near collapse to a point
+/// (100 × the kernel's threshold) goes to the scalar kernel.
 pub(crate) fn vertex_faces<A: ParticleAccess>(
     acc: &mut A,
     tets: &[[u32; 4]],
@@ -237,15 +271,16 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
     let idx = [0, 1, 2, 3].map(|k| lanes_of(tets, k));
     let p0 = idx.map(|i| V3::gather(acc, &i));
     let w = idx.map(|i| gather_w(acc, &i));
-    let near = f32x8::splat(1e-5);
+    let near = f32x8::splat(1e-10);
+    let hs = [0, 1, 2, 3].map(|k| f32x8::from([0, 1, 2, 3, 4, 5, 6, 7].map(|l| heights[l][k])));
     // Pre-check every face at the start of the chunk.
-    for order in VERTEX_FACE_ORDER {
+    for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
         let (b, c) = (
             p0[order[2]].sub(p0[order[0]]),
             p0[order[3]].sub(p0[order[0]]),
         );
-        let m = b.cross(c);
-        let ok = m.dot(m).sqrt().simd_gt((b.dot(b) + c.dot(c)) * near);
+        let q = (b.dot(b) + c.dot(c)) * f32x8::splat(0.5);
+        let ok = q.simd_gt(hs[k] * hs[k] * near);
         if !ok.all() {
             let mut count = ProjectionCount::default();
             for l in 0..LANES {
@@ -268,22 +303,11 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
         let q = order.map(|o| p0[o].add(dp[o]));
         let (a, b, c) = (q[1].sub(q[0]), q[2].sub(q[0]), q[3].sub(q[0]));
-        let m = b.cross(c);
-        let m_len = m.dot(m).sqrt();
-        let valid = m_len.simd_gt((b.dot(b) + c.dot(c)) * f32x8::splat(1e-7));
-        let inv = valid.select(f32x8::ONE / m_len, f32x8::ZERO);
-        let n = m.scale(inv);
-        let na = n.dot(a);
-        let g1 = n;
-        let g2 = c.cross(a).add(n.cross(c).scale(na)).scale(inv);
-        let g3 = b.cross(a).add(n.cross(b).scale(na)).scale(inv).neg();
-        let g0 = g1.add(g2).add(g3).neg();
-        let g = [g0, g1, g2, g3];
+        let (cval, g, valid) = vertex_face_bounded(a, b, c, hs[k], VERTEX_FACE_KAPPA);
         let wo = order.map(|o| w[o]);
         let w_grad_sq = (0..4).fold(f32x8::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
-        let h = f32x8::from([0, 1, 2, 3, 4, 5, 6, 7].map(|l| heights[l][k]));
         let lam = f32x8::from([0, 1, 2, 3, 4, 5, 6, 7].map(|l| lambdas[l][k]));
-        let (dl, ok) = delta_lambda(na - h, lam, at, w_grad_sq);
+        let (dl, ok) = delta_lambda(cval, lam, at, w_grad_sq);
         let dl = valid.select(dl, f32x8::ZERO);
         let ok = ok & valid;
         let new = (lam + dl).to_array();
