@@ -195,12 +195,21 @@ pub const VERTEX_FACE_KAPPA: f32 = 0.1;
 ///   thin one. `∇p1 = ∇a`, `∇p2 = ∇b`, `∇p3 = ∇c`, `∇p0 = −(∇p1 + ∇p2 + ∇p3)`.
 /// * `D` does not depend on `p1`, so `C̃` is linear (monotone) in the vertex's position, as the
 ///   height is. `C̃` is homogeneous of degree 1 in the positions, its gradients of degree 0,
-///   and `D ≥ max(s, K/2)`: the gradients are bounded by about `(1 + 4|a|/√Q)/κ` at any scale
-///   and face shape, instead of growing as `|a||c| / |b × c|` when the face collapses to a
-///   segment. The seed's [`vertex_face`] is the limit `κ = 0`.
+///   and `D ≥ max(s, K/2)`: on the thin branch the gradients are bounded by about
+///   `(1 + 4|a|/√Q)/κ` at any scale, instead of growing as `|a||c| / |b × c|` when the face
+///   collapses to a segment. The seed's [`vertex_face`] is the limit `κ = 0`.
+///
+/// Where the thin branch's gradients are weaker than the seed's apex gradient alone
+/// (`Σᵢ |∇ᵢC̃|² < 1`; the seed's sum is always ≥ 1) the seed's height is used instead
+/// (`D = s`): that happens for a tetrahedron nearly collapsed onto a line, where `C̃ ≈ −d`
+/// while every thin-branch gradient vanishes and a hard projection would step about
+/// `d / |∇C̃|`, without bound, whereas the seed's step is bounded by `|C|`. `C̃` jumps there
+/// (from `f/D − d` to `f/s − d`); a projection evaluates it afresh, so only the step size
+/// changes.
 ///
 /// Returns `None` when the face has collapsed to a point (`Q ≤ 1e-12 d²`, or `d = 0` and
-/// `Q = 0`) or the input is not finite: no direction is defined.
+/// `Q = 0`), when the input is not finite, or when the seed's height is needed and the face
+/// is collinear (`s ≤ 1e-7 (|b|² + |c|²)`, as in [`vertex_face`]).
 #[inline]
 pub fn vertex_face_bounded<T: RealField + Copy>(
     p0: &Vector3<T>,
@@ -223,30 +232,43 @@ pub fn vertex_face_bounded<T: RealField + Copy>(
         return None;
     }
     let k = kappa * q;
-    let (d, e, beta) = if s >= k && s > T::zero() {
-        (s, T::one() / s, T::zero())
-    } else if k <= T::zero() {
-        return None;
-    } else {
-        let inv_k = T::one() / k;
-        let r = s * inv_k;
-        (
-            (s * r + k) * half,
-            inv_k,
-            kappa * half * (T::one() - r * r),
-        )
-    };
     let f = a.dot(&m);
-    let inv_d = T::one() / d;
-    let r = f * inv_d * inv_d;
-    let g1 = m * inv_d;
-    let g2 = c.cross(&a) * inv_d - (c.cross(&m) * e + b * beta) * r;
-    let g3 = a.cross(&b) * inv_d - (m.cross(&b) * e + c * beta) * r;
-    let g0 = -(g1 + g2 + g3);
-    Some(Evaluated {
-        c: f * inv_d - rest_value,
-        grad: [g0, g1, g2, g3],
-    })
+    let grads = |d: T, e: T, beta: T| {
+        let inv_d = T::one() / d;
+        let r = f * inv_d * inv_d;
+        let g1 = m * inv_d;
+        let g2 = c.cross(&a) * inv_d - (c.cross(&m) * e + b * beta) * r;
+        let g3 = a.cross(&b) * inv_d - (m.cross(&b) * e + c * beta) * r;
+        let g0 = -(g1 + g2 + g3);
+        Evaluated {
+            c: f * inv_d - rest_value,
+            grad: [g0, g1, g2, g3],
+        }
+    };
+    if s < k {
+        let r = s / k;
+        let e = grads(
+            (s * r + k) * half,
+            T::one() / k,
+            kappa * half * (T::one() - r * r),
+        );
+        let strength: T = e
+            .grad
+            .iter()
+            .map(|g| g.norm_squared())
+            .fold(T::zero(), |x, y| x + y);
+        // At least the seed's apex gradient (|n|² = 1): otherwise nearly collapsed onto a
+        // line, and the seed's height (below) takes the bounded step.
+        if strength >= T::one() {
+            return Some(e);
+        }
+    }
+    // Healthy (or weak thin) face: the seed's height, defined unless the face is collinear.
+    let threshold = q * nalgebra::convert::<f64, T>(2e-7);
+    if s.partial_cmp(&threshold) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    Some(grads(s, T::one() / s, T::zero()))
 }
 
 /// The value `f/D` of [`vertex_face_bounded`] (its `C̃ + d`): the signed height of `p1` above

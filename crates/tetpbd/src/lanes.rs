@@ -231,36 +231,58 @@ fn vertex_face_bounded(a: V3, b: V3, c: V3, h: f32x8, kappa: f32) -> (f32x8, [V3
     let half = f32x8::splat(0.5);
     let m = b.cross(c);
     let s = m.dot(m).sqrt();
-    let q = (b.dot(b) + c.dot(c)) * half;
-    let valid = q.simd_gt(h * h * f32x8::splat(1e-12));
-    let kappa = f32x8::splat(kappa);
-    let k = valid.select(kappa * q, f32x8::ONE);
-    let healthy = s.simd_ge(k) & s.simd_gt(f32x8::ZERO);
-    let inv_k = f32x8::ONE / k;
-    let r = s * inv_k;
-    let d = healthy.select(s, (s * r + k) * half);
-    let e = healthy.select(f32x8::ONE / healthy.select(s, f32x8::ONE), inv_k);
-    let beta = healthy.select(f32x8::ZERO, kappa * half * (f32x8::ONE - r * r));
+    let scale = b.dot(b) + c.dot(c);
+    let q = scale * half;
+    let point = !q.simd_gt(h * h * f32x8::splat(1e-12));
+    let k = point.select(f32x8::ONE, f32x8::splat(kappa) * q);
     let f = a.dot(m);
-    let inv_d = f32x8::ONE / d;
-    let rf = f * inv_d * inv_d;
-    let g1 = m.scale(inv_d);
-    let g2 = c
-        .cross(a)
-        .scale(inv_d)
-        .sub(c.cross(m).scale(e).add(b.scale(beta)).scale(rf));
-    let g3 = a
-        .cross(b)
-        .scale(inv_d)
-        .sub(m.cross(b).scale(e).add(c.scale(beta)).scale(rf));
-    let g0 = g1.add(g2).add(g3).neg();
-    (f * inv_d - h, [g0, g1, g2, g3], valid)
+    let grads = |d: f32x8, e: f32x8, beta: f32x8| {
+        let inv_d = f32x8::ONE / d;
+        let r = f * inv_d * inv_d;
+        let g1 = m.scale(inv_d);
+        let g2 = c
+            .cross(a)
+            .scale(inv_d)
+            .sub(c.cross(m).scale(e).add(b.scale(beta)).scale(r));
+        let g3 = a
+            .cross(b)
+            .scale(inv_d)
+            .sub(m.cross(b).scale(e).add(c.scale(beta)).scale(r));
+        (f * inv_d - h, [g1.add(g2).add(g3).neg(), g1, g2, g3])
+    };
+    let r = s / k;
+    let (thin_c, thin_g) = grads(
+        (s * r + k) * half,
+        f32x8::ONE / k,
+        f32x8::splat(kappa) * half * (f32x8::ONE - r * r),
+    );
+    let strength = thin_g.iter().fold(f32x8::ZERO, |x, g| x + g.dot(*g));
+    // The seed's height on healthy faces and on thin ones with weak gradients.
+    let seed = !(s.simd_lt(k) & strength.simd_ge(f32x8::ONE));
+    let collinear = !s.simd_gt(scale * f32x8::splat(1e-7));
+    let valid = !point & !(seed & collinear);
+    if !(seed & valid).any() {
+        return (thin_c, thin_g, valid);
+    }
+    let safe = collinear.select(f32x8::ONE, s);
+    let (seed_c, seed_g) = grads(safe, f32x8::ONE / safe, f32x8::ZERO);
+    let pick = |x: V3, y: V3| V3 {
+        x: seed.select(x.x, y.x),
+        y: seed.select(x.y, y.y),
+        z: seed.select(x.z, y.z),
+    };
+    (
+        seed.select(seed_c, thin_c),
+        [0, 1, 2, 3].map(|i| pick(seed_g[i], thin_g[i])),
+        valid,
+    )
 }
 
 /// The four vertex–face constraints of eight tetrahedra (`tets.len() == LANES`), the four
 /// one after another on all lanes, corrections accumulated in registers and scattered once.
-/// See [`projection::vertex_face`]. A chunk with a face near collapse to a point
-/// (100 × the kernel's threshold) goes to the scalar kernel.
+/// See [`projection::vertex_face`]. A chunk with a face not healthy by a margin of 2
+/// (`|b × c| ≤ 2κQ`) at its start goes to the scalar kernel; a lane whose face turns
+/// degenerate within the chunk is skipped and counted.
 pub(crate) fn vertex_faces<A: ParticleAccess>(
     acc: &mut A,
     tets: &[[u32; 4]],
@@ -271,16 +293,18 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
     let idx = [0, 1, 2, 3].map(|k| lanes_of(tets, k));
     let p0 = idx.map(|i| V3::gather(acc, &i));
     let w = idx.map(|i| gather_w(acc, &i));
-    let near = f32x8::splat(1e-10);
     let hs = [0, 1, 2, 3].map(|k| f32x8::from([0, 1, 2, 3, 4, 5, 6, 7].map(|l| heights[l][k])));
-    // Pre-check every face at the start of the chunk.
-    for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
+    // Pre-check every face at the start of the chunk: all healthy with a margin of 2
+    // (|b × c| > 2κQ), or the chunk goes to the scalar kernel.
+    let margin = f32x8::splat(VERTEX_FACE_KAPPA);
+    for order in VERTEX_FACE_ORDER {
         let (b, c) = (
             p0[order[2]].sub(p0[order[0]]),
             p0[order[3]].sub(p0[order[0]]),
         );
-        let q = (b.dot(b) + c.dot(c)) * f32x8::splat(0.5);
-        let ok = q.simd_gt(hs[k] * hs[k] * near);
+        let m = b.cross(c);
+        let twice_k = margin * (b.dot(b) + c.dot(c));
+        let ok = m.dot(m).simd_gt(twice_k * twice_k);
         if !ok.all() {
             let mut count = ProjectionCount::default();
             for l in 0..LANES {
