@@ -233,12 +233,16 @@ pub fn vertex_face_bounded<T: RealField + Copy>(
     }
     let k = kappa * q;
     let f = a.dot(&m);
-    let grads = |d: T, e: T, beta: T| {
-        let inv_d = T::one() / d;
+    let grads = |inv_d: T, e: T, beta: T| {
         let r = f * inv_d * inv_d;
         let g1 = m * inv_d;
-        let g2 = c.cross(&a) * inv_d - (c.cross(&m) * e + b * beta) * r;
-        let g3 = a.cross(&b) * inv_d - (m.cross(&b) * e + c * beta) * r;
+        let (mut u_b, mut u_c) = (c.cross(&m) * e, m.cross(&b) * e);
+        if beta != T::zero() {
+            u_b += b * beta;
+            u_c += c * beta;
+        }
+        let g2 = c.cross(&a) * inv_d - u_b * r;
+        let g3 = a.cross(&b) * inv_d - u_c * r;
         let g0 = -(g1 + g2 + g3);
         Evaluated {
             c: f * inv_d - rest_value,
@@ -248,7 +252,7 @@ pub fn vertex_face_bounded<T: RealField + Copy>(
     if s < k {
         let r = s / k;
         let e = grads(
-            (s * r + k) * half,
+            T::one() / ((s * r + k) * half),
             T::one() / k,
             kappa * half * (T::one() - r * r),
         );
@@ -268,7 +272,8 @@ pub fn vertex_face_bounded<T: RealField + Copy>(
     if s.partial_cmp(&threshold) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
-    Some(grads(s, T::one() / s, T::zero()))
+    let inv_s = T::one() / s;
+    Some(grads(inv_s, inv_s, T::zero()))
 }
 
 /// The value `f/D` of [`vertex_face_bounded`] (its `C̃ + d`): the signed height of `p1` above

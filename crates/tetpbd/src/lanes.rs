@@ -236,8 +236,7 @@ fn vertex_face_bounded(a: V3, b: V3, c: V3, h: f32x8, kappa: f32) -> (f32x8, [V3
     let point = !q.simd_gt(h * h * f32x8::splat(1e-12));
     let k = point.select(f32x8::ONE, f32x8::splat(kappa) * q);
     let f = a.dot(m);
-    let grads = |d: f32x8, e: f32x8, beta: f32x8| {
-        let inv_d = f32x8::ONE / d;
+    let grads = |inv_d: f32x8, e: f32x8, beta: f32x8| {
         let r = f * inv_d * inv_d;
         let g1 = m.scale(inv_d);
         let g2 = c
@@ -250,22 +249,30 @@ fn vertex_face_bounded(a: V3, b: V3, c: V3, h: f32x8, kappa: f32) -> (f32x8, [V3
             .sub(m.cross(b).scale(e).add(c.scale(beta)).scale(r));
         (f * inv_d - h, [g1.add(g2).add(g3).neg(), g1, g2, g3])
     };
+    let collinear = !s.simd_gt(scale * f32x8::splat(1e-7));
+    if !s.simd_lt(k).any() {
+        // Every lane healthy (the common case): the seed's height only.
+        let safe = collinear.select(f32x8::ONE, s);
+        let inv_s = f32x8::ONE / safe;
+        let (c, g) = grads(inv_s, inv_s, f32x8::ZERO);
+        return (c, g, !point & !collinear);
+    }
     let r = s / k;
     let (thin_c, thin_g) = grads(
-        (s * r + k) * half,
+        f32x8::ONE / ((s * r + k) * half),
         f32x8::ONE / k,
         f32x8::splat(kappa) * half * (f32x8::ONE - r * r),
     );
     let strength = thin_g.iter().fold(f32x8::ZERO, |x, g| x + g.dot(*g));
     // The seed's height on healthy faces and on thin ones with weak gradients.
     let seed = !(s.simd_lt(k) & strength.simd_ge(f32x8::ONE));
-    let collinear = !s.simd_gt(scale * f32x8::splat(1e-7));
     let valid = !point & !(seed & collinear);
     if !(seed & valid).any() {
         return (thin_c, thin_g, valid);
     }
     let safe = collinear.select(f32x8::ONE, s);
-    let (seed_c, seed_g) = grads(safe, f32x8::ONE / safe, f32x8::ZERO);
+    let inv_s = f32x8::ONE / safe;
+    let (seed_c, seed_g) = grads(inv_s, inv_s, f32x8::ZERO);
     let pick = |x: V3, y: V3| V3 {
         x: seed.select(x.x, y.x),
         y: seed.select(x.y, y.y),
