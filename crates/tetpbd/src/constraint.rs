@@ -210,7 +210,7 @@ pub const VERTEX_FACE_KAPPA: f32 = 0.1;
 /// Returns `None` when the face has collapsed to a point (`Q ≤ 1e-12 d²`, or `d = 0` and
 /// `Q = 0`), when the input is not finite, or when the seed's height is needed and the face
 /// is collinear (`s ≤ 1e-7 (|b|² + |c|²)`, as in [`vertex_face`]).
-#[inline]
+#[inline(always)]
 pub fn vertex_face_bounded<T: RealField + Copy>(
     p0: &Vector3<T>,
     p1: &Vector3<T>,
