@@ -167,10 +167,10 @@ pub fn vertex_face<T: RealField + Copy>(
 /// thin when `|b × c| < κ (|b|² + |c|²) / 2` (the ratio is `sin θ` for two equal sides at an
 /// angle θ). Dimensionless.
 ///
-/// 0.1 leaves every face of a regular tetrahedron (ratio 0.87) and of the box generators' cells
+/// 0.05 leaves every face of a regular tetrahedron (ratio 0.87) and of the box generators' cells
 /// (≥ 0.57) on the exact-height branch at rest; the long thin faces of slivers (⅓ m × 1 mm:
 /// about 0.006) are on the thin branch from the start.
-pub const VERTEX_FACE_KAPPA: f32 = 0.1;
+pub const VERTEX_FACE_KAPPA: f32 = 0.05;
 
 /// Degeneracy-aware vertex–face constraint: the signed height of `p1` above the plane through
 /// `p0, p2, p3` where the face is healthy, the signed volume over a bounded area where it is
