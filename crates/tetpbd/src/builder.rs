@@ -3,7 +3,7 @@
 use hecs::{Entity, World};
 use nalgebra::Vector3;
 
-use crate::constraint::{signed_height, signed_volume, VERTEX_FACE_ORDER};
+use crate::constraint::{bounded_height, signed_volume, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
 use crate::error::BuildError;
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::locality::{inverse, mean_edge_length, relabel_tets, row_order};
@@ -331,8 +331,8 @@ impl SoftBodyBuilder {
                 .map(|tet| {
                     VERTEX_FACE_ORDER.map(|o| {
                         let [a, b, c, d] = o.map(|k| mesh.vertices[tet[k] as usize]);
-                        // The volume check above guarantees a non-degenerate face.
-                        signed_height(&a, &b, &c, &d).unwrap_or(0.0)
+                        // The volume check above guarantees a non-degenerate tetrahedron.
+                        bounded_height(&a, &b, &c, &d, VERTEX_FACE_KAPPA, 0.0).unwrap_or(0.0)
                     })
                 })
                 .collect(),

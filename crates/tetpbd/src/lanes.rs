@@ -8,11 +8,13 @@
 //! [`crate::projection`] are the reference these are tested against (`tests/lanes.rs`).
 //!
 //! A chunk whose lanes hit a degenerate configuration (a zero-length edge, a face too close
-//! to collinear) is handed to the scalar kernel, which owns the documented fallbacks.
+//! to collinear) or, for vertex–face, a thin face (the thin branch of
+//! [`crate::constraint::vertex_face_bounded`]) is handed to the scalar kernel, which owns the
+//! documented fallbacks.
 
 use wide::f32x4;
 
-use crate::constraint::VERTEX_FACE_ORDER;
+use crate::constraint::{VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
 use crate::projection::{self, ParticleAccess};
 use crate::systems::ProjectionCount;
 
@@ -254,8 +256,11 @@ pub(crate) fn volumes<A: ParticleAccess>(
 
 /// The four vertex–face constraints of four tetrahedra, the four one after another on all
 /// lanes, corrections accumulated in registers and scattered once. See
-/// [`projection::vertex_face`]. A chunk with a face near degeneracy (100 × the kernel's
-/// threshold) goes to the scalar kernel.
+/// [`projection::vertex_face`]: on healthy faces [`crate::constraint::vertex_face_bounded`]
+/// is the seed's height, which these lanes compute. A chunk with a face not healthy by a
+/// margin of 2 at its start (`|b × c| ≤ 2κQ`, κ = [`VERTEX_FACE_KAPPA`]) goes to the scalar
+/// kernel; a lane whose face turns thin (`|b × c| < κQ`) within the chunk skips that
+/// projection and counts it as degenerate.
 #[inline(always)]
 pub(crate) fn vertex_faces<A: ParticleAccess>(
     acc: &mut A,
@@ -271,15 +276,16 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
         corner(tets, 3),
     ];
     let (p0, w) = gather_corners(acc, &idx);
-    let near = f32x4::splat(1e-5);
-    // Pre-check every face at the start of the chunk.
+    let kappa = f32x4::splat(VERTEX_FACE_KAPPA);
+    // Pre-check every face at the start of the chunk: healthy with a margin of 2.
     for order in VERTEX_FACE_ORDER {
         let (b, c) = (
             p0[order[2]].sub(p0[order[0]]),
             p0[order[3]].sub(p0[order[0]]),
         );
         let m = b.cross(c);
-        let ok = m.dot(m).sqrt().simd_gt((b.dot(b) + c.dot(c)) * near);
+        let twice_k = kappa * (b.dot(b) + c.dot(c));
+        let ok = m.dot(m).simd_gt(twice_k * twice_k);
         if !ok.all() {
             let mut count = ProjectionCount::default();
             for l in 0..LANES {
@@ -312,7 +318,8 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
         let (a, b, c) = (q[1].sub(q[0]), q[2].sub(q[0]), q[3].sub(q[0]));
         let m = b.cross(c);
         let m_len = m.dot(m).sqrt();
-        let valid = m_len.simd_gt((b.dot(b) + c.dot(c)) * f32x4::splat(1e-7));
+        // Healthy (`s ≥ κQ`, Q = (|b|² + |c|²)/2): the seed's height.
+        let valid = m_len.simd_ge((b.dot(b) + c.dot(c)) * kappa * f32x4::splat(0.5));
         let inv = valid.select(f32x4::ONE / m_len, f32x4::ZERO);
         let n = m.scale(inv);
         let na = n.dot(a);

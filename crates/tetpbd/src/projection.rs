@@ -102,9 +102,11 @@ pub(crate) fn edge<A: ParticleAccess>(
     }
 }
 
-/// The four vertex–face constraints of one tetrahedron, one after another. A degenerate
-/// face falls back to holding `p1` at its rest height above `p0` along the face's rest
-/// normal (linear in `p0`, `p1`; re-expands a collapsed tetrahedron).
+/// The four vertex–face constraints of one tetrahedron, one after another, in the
+/// degeneracy-aware form [`constraint::vertex_face_bounded`] with
+/// [`constraint::VERTEX_FACE_KAPPA`]. A face collapsed to a point falls back to holding
+/// `p1` at its rest value above `p0` along the face's rest normal (linear in `p0`, `p1`;
+/// re-expands a collapsed tetrahedron).
 #[inline(always)]
 pub(crate) fn vertex_face<A: ParticleAccess>(
     acc: &mut A,
@@ -134,7 +136,14 @@ pub(crate) fn vertex_face_held<A: ParticleAccess>(
             continue;
         }
         let p = idx.map(|i| acc.x(i));
-        match constraint::vertex_face(&p[0], &p[1], &p[2], &p[3], rest_heights[k]) {
+        match constraint::vertex_face_bounded(
+            &p[0],
+            &p[1],
+            &p[2],
+            &p[3],
+            rest_heights[k],
+            constraint::VERTEX_FACE_KAPPA,
+        ) {
             Some(e) => {
                 if apply(acc, idx, &e, &mut lambdas[k], alpha_tilde) {
                     applied += 1;

@@ -142,10 +142,12 @@ pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
 /// One Gauss–Seidel sweep over every body's [`VertexFaceConstraints`]: the four constraints
 /// of a tetrahedron one after another, tetrahedra in solver (colour) order.
 ///
-/// A degenerate face (collinear or coincident points, no plane) is counted and given a
-/// fallback: `p1` is held at its rest height above `p0` along the face's rest-pose normal.
-/// That constraint is linear in `p0` and `p1`, always defined, and re-expands a tetrahedron
-/// collapsed to a point or a line.
+/// Each constraint is the degeneracy-aware form [`crate::constraint::vertex_face_bounded`]:
+/// the height where the face is healthy, the signed volume over a bounded area where the face
+/// is thin (near collinear), so the gradients stay bounded. A face collapsed to a point (no
+/// plane, no direction) is counted and given a fallback: `p1` is held at its rest value above
+/// `p0` along the face's rest-pose normal. That constraint is linear in `p0` and `p1`, always
+/// defined, and re-expands a tetrahedron collapsed to a point.
 pub fn project_vertex_face_with(world: &mut World, h: f32, kernel: Kernel) -> ProjectionCount {
     let mut count = ProjectionCount::default();
     for (p, tets, vf) in
@@ -334,9 +336,13 @@ pub fn measure(world: &mut World) -> Measured {
         for (t, tet) in tets.indices.iter().enumerate() {
             for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
                 let [a, b, c, d] = order.map(|o| p.positions[tet[o] as usize]);
-                // A degenerate face has no height; its violation is the full rest height.
-                let hgt = constraint::signed_height(&a, &b, &c, &d).unwrap_or(0.0);
-                vface.add(hgt - vf.rest_heights[t][k]);
+                // A face collapsed to a point has no height; its violation is the full
+                // rest value.
+                let rest = vf.rest_heights[t][k];
+                let hgt =
+                    constraint::bounded_height(&a, &b, &c, &d, constraint::VERTEX_FACE_KAPPA, rest)
+                        .unwrap_or(0.0);
+                vface.add(hgt - rest);
             }
         }
     }

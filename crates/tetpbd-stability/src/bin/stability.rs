@@ -13,6 +13,10 @@
 //! ```text
 //! cargo run --release -p tetpbd-stability --bin stability -- --coupled "1000 kg on soft"
 //! ```
+//!
+//! `--case TEXT` keeps only the cases whose name contains `TEXT` (repeatable; coupled cases
+//! included), `--no-coupled` skips the coupled table. Pass `--out` with a filter so the partial
+//! matrix does not overwrite `docs/stability.md`.
 
 use std::fmt::Write as _;
 use std::process::Command;
@@ -96,6 +100,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .and_then(|i| args.get(i + 1).cloned())
         .unwrap_or_else(|| "docs/stability.md".into());
     let fast = args.iter().any(|a| a == "--fast");
+    let no_coupled = args.iter().any(|a| a == "--no-coupled");
+    let filters: Vec<&str> = args
+        .windows(2)
+        .filter(|w| w[0] == "--case")
+        .map(|w| w[1].as_str())
+        .collect();
+    let wanted = |name: &str| filters.is_empty() || filters.iter().any(|f| name.contains(f));
     let configs = Config::all();
     if let Some(i) = args.iter().position(|a| a == "--coupled") {
         let filter = args.get(i + 1).map_or("", |s| s.as_str());
@@ -145,14 +156,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     .map(|(title, net)| {
         let cases = all_cases(net)
             .into_iter()
-            .filter(|c| !fast || c.kind == CaseKind::Fast)
+            .filter(|c| (!fast || c.kind == CaseKind::Fast) && wanted(c.name))
             .collect();
         (title, cases)
     })
     .collect();
     let coupled: Vec<_> = coupled_cases()
         .into_iter()
-        .filter(|c| !fast || c.kind != CaseKind::Long)
+        .filter(|c| (!fast || c.kind != CaseKind::Long) && !no_coupled && wanted(c.name))
         .collect();
     let mut progress = Progress::new(
         "stability cases",
