@@ -17,6 +17,9 @@ use nalgebra::Vector3;
 use tetpbd::constraint::{self, Evaluated, VERTEX_FACE_ORDER};
 use tetpbd::{Family, SoftBody, SolverSettings};
 
+/// The solver's face-thinness threshold, in f64.
+const KAPPA: f64 = constraint::VERTEX_FACE_KAPPA as f64;
+
 /// Why a body or settings cannot be run by [`Xpbd64`].
 #[derive(Clone, Debug, PartialEq)]
 pub enum Xpbd64Error {
@@ -85,8 +88,9 @@ impl Xpbd64 {
                 .map(|t| {
                     VERTEX_FACE_ORDER.map(|o| {
                         let [a, b, c, d] = o.map(|k| at(t[k]));
-                        // The builder rejected degenerate tetrahedra, so every face has a plane.
-                        constraint::signed_height(&a, &b, &c, &d).unwrap_or(0.0)
+                        // As the builder: the rest value of the degeneracy-aware form (the
+                        // builder rejected degenerate tetrahedra, so every face has a plane).
+                        constraint::bounded_height(&a, &b, &c, &d, KAPPA, 0.0).unwrap_or(0.0)
                     })
                 })
                 .collect();
@@ -204,7 +208,15 @@ impl Xpbd64 {
                 let idx = order.map(|o| tet[o] as usize);
                 let p = idx.map(|i| self.x[i]);
                 let w = idx.map(|i| self.w[i]);
-                let e = match constraint::vertex_face(&p[0], &p[1], &p[2], &p[3], heights[t][k]) {
+                let bounded = constraint::vertex_face_bounded(
+                    &p[0],
+                    &p[1],
+                    &p[2],
+                    &p[3],
+                    heights[t][k],
+                    KAPPA,
+                );
+                let e = match bounded {
                     Some(e) => e,
                     None => {
                         self.degenerate += 1;
