@@ -355,7 +355,7 @@ pub fn unsettled(s: &mut String, rows: &[ContactRow]) {
             if r.res.finite { "yes" } else { "no" }
         );
     }
-    let _ = writeln!(s, "\nThe last column says which body keeps the run from resting and where it is: a 1 m cube whose centre is about 0.5 m up stands on the ground, one higher up lies on other cubes, one whose centre is beyond the ground's half extent ({} m) has left the ground over its edge (its particles then fall below y = 0, which the ground-penetration column counts).\n", GROUND_HALF_EXTENTS[0]);
+    let _ = writeln!(s, "\nThe last column says which body keeps the run from resting and where it is: a 1 m cube whose centre is about 0.5 m up stands on the ground, one higher up lies on other cubes or is in the air, one whose centre is beyond the ground's half extent ({} m) has left the ground over its edge (its particles then fall below y = 0, which the ground-penetration column counts).\n", GROUND_HALF_EXTENTS[0]);
 }
 
 /// Where a cube's centre `c` is, in words, for the unsettled table.
@@ -364,7 +364,7 @@ fn where_is(c: nalgebra::Vector3<f32>) -> &'static str {
     if c.x.abs() > hx || c.z.abs() > hz {
         ": beyond the ground's edge"
     } else if c.y > 0.8 {
-        ": on other cubes"
+        ": above a cube resting on the ground (on other cubes or in the air)"
     } else if c.y > 0.0 {
         ": on the ground"
     } else {
