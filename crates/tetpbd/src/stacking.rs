@@ -182,15 +182,16 @@ impl StackingLayers {
         self.incident.clear();
         self.incident.resize(self.first[n] as usize, 0);
         self.tet_count = tets.len();
-        let mut fill: Vec<u32> = self.first[..n].to_vec();
+        // `first[i]` is row i's fill cursor; afterwards it holds row i + 1's start.
         for (k, t) in tets.iter().enumerate() {
             for &i in t {
-                if let Some(f) = fill.get_mut(i as usize) {
+                if let Some(f) = self.first[..n].get_mut(i as usize) {
                     self.incident[*f as usize] = k as u32;
                     *f += 1;
                 }
             }
         }
+        shift_starts(&mut self.first);
     }
 }
 
@@ -215,12 +216,24 @@ fn bucket(
     }
     order.clear();
     order.resize(starts[top] as usize, 0);
-    let mut fill = starts[..top].to_vec();
+    // `starts[L - 1]` is level L's fill cursor; afterwards it holds level L + 1's start.
     for (k, l) in levels.map(|l| l as usize).enumerate() {
         if (1..=top).contains(&l) {
-            order[fill[l - 1] as usize] = k as u32;
-            fill[l - 1] += 1;
+            order[starts[l - 1] as usize] = k as u32;
+            starts[l - 1] += 1;
         }
+    }
+    shift_starts(starts);
+}
+
+/// After a counting-sort fill that advanced each row's start to the next row's, moves the
+/// starts back one row (no scratch buffer: the pass runs inside a step).
+fn shift_starts(starts: &mut [u32]) {
+    for j in (1..starts.len()).rev() {
+        starts[j] = starts[j - 1];
+    }
+    if let Some(s) = starts.first_mut() {
+        *s = 0;
     }
 }
 
