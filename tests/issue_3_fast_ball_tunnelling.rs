@@ -16,16 +16,11 @@
 
 mod coupling_common;
 
-use coupling_common::{ground, inverted, particles, scene};
+use coupling_common::{ground, inverted, particles, scene, soft_box_of, Families};
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
-use tetpbd::generators::{box_grid, CellSplit};
-use tetpbd::SoftBodyBuilder;
 use tetpbd_rapier::SoftCollider;
-
-/// Compliances of (edges, vertex–face, volume), `None` for a family the slab does not have.
-type Families = (Option<f32>, Option<f32>, Option<f32>);
 
 /// Hard edges + volume, the slab of the issue 3 cases.
 const HARD: Families = (Some(0.0), None, Some(0.0));
@@ -46,26 +41,17 @@ struct Drop {
 
 /// Drops a 0.1 m ball at `speed` (m/s, downwards) onto a 2 × 0.2 × 2 m slab of one cell
 /// thickness (8 × 1 × 8 cells, 1000 kg/m³, constraint `families`) on the ground, for 2 s.
-fn drop_ball(speed: f32, ccd: bool, (edges, vertex_face, volume): Families) -> Drop {
+fn drop_ball(speed: f32, ccd: bool, families: Families) -> Drop {
     let mut s = scene(10);
     ground(&mut s);
-    let mesh = box_grid(Vector3::new(2.0, 0.2, 2.0), [8, 1, 8], CellSplit::Six).expect("mesh");
-    let mut b = SoftBodyBuilder::new(mesh)
-        .density(1000.0)
-        .translation(Vector3::new(0.0, 0.1, 0.0));
-    if let Some(a) = edges {
-        b = b.edges(a);
-    }
-    if let Some(a) = vertex_face {
-        b = b.vertex_face(a);
-    }
-    if let Some(a) = volume {
-        b = b.volume(a);
-    }
-    let slab = b.build().expect("body").spawn(&mut s.soft);
-    s.soft
-        .insert_one(slab, SoftCollider::default())
-        .expect("entity");
+    let slab = soft_box_of(
+        &mut s,
+        (Vector3::new(2.0, 0.2, 2.0), [8, 1, 8]),
+        Vector3::new(0.0, 0.1, 0.0),
+        1000.0,
+        families,
+        SoftCollider::default(),
+    );
     // Off the particles' grid (spacing 0.25 m), so the ball falls between particles.
     let (ball, _) = s.physics.insert(
         RigidBodyBuilder::dynamic()
@@ -108,7 +94,7 @@ fn drop_ball(speed: f32, ccd: bool, (edges, vertex_face, volume): Families) -> D
     let (lo, hi) = p.aabb();
     d.slab = (lo.y, hi.y);
     println!(
-        "{speed} m/s (ccd {ccd}, {edges:?}/{vertex_face:?}/{volume:?}): ball centre lowest over the slab {:.4} m, after 10 frames \
+        "{speed} m/s (ccd {ccd}, families {families:?}): ball centre lowest over the slab {:.4} m, after 10 frames \
          {:.4} m at {:.3} m/s; slab y {:.4}..{:.4} m, inverted {:?}",
         d.lowest_over_slab, d.settled, d.settled_speed, d.slab.0, d.slab.1, d.inverted
     );
