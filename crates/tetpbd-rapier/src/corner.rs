@@ -64,7 +64,8 @@ use crate::frame::{ColliderProxy, ParticleContact};
 
 /// Cosine of the largest angle between a vertex's particle contact normal and its triangle's
 /// normal at which the particle contact still holds the collider against the triangle, so
-/// the triangle is left to it in the ordinary pass (30°).
+/// the triangle is left to it in the ordinary pass (30°; 20° and 45° held the fast balls of
+/// issue 6 as well, see `docs/stability.md`).
 const HOLDING_ANGLE_COS: f32 = 0.866;
 
 /// One rigid shape over one soft surface triangle.
