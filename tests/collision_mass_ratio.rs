@@ -2,16 +2,13 @@
 
 mod coupling_common;
 
-use coupling_common::{ground, inverted, particles, run, scene, soft_box, soft_box_with_density};
+use coupling_common::{
+    ground, inverted, particles, run, scene, soft_box, soft_box_of, soft_box_with_density, Families,
+};
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
-use tetpbd::generators::{box_grid, CellSplit};
-use tetpbd::SoftBodyBuilder;
 use tetpbd_rapier::SoftCollider;
-
-/// Compliances of (edges, vertex–face, volume), `None` for a family the body does not have.
-type Families = (Option<f32>, Option<f32>, Option<f32>);
 
 /// The constraint configurations of the stability matrix: a label and the families.
 const CONFIGS: [(&str, Families); 6] = [
@@ -30,28 +27,19 @@ const CONFIGS: [(&str, Families); 6] = [
 /// stacking_mass_ratio`) carries it.
 #[test]
 fn heavy_box_on_light_slab() {
-    for (label, (edges, vertex_face, volume)) in CONFIGS {
+    for (label, families) in CONFIGS {
         let mut s = scene(10);
         ground(&mut s);
         let size = Vector3::new(0.6, 0.1, 0.6);
-        let mesh = box_grid(size, [3, 1, 3], CellSplit::Six).expect("mesh");
         // 1 kg slab: density 1 kg / 0.036 m³, its lower surface 3 mm above the ground.
-        let mut b = SoftBodyBuilder::new(mesh)
-            .density(1.0 / (size.x * size.y * size.z))
-            .translation(Vector3::new(0.0, 0.05 + 0.003, 0.0));
-        if let Some(a) = edges {
-            b = b.edges(a);
-        }
-        if let Some(a) = vertex_face {
-            b = b.vertex_face(a);
-        }
-        if let Some(a) = volume {
-            b = b.volume(a);
-        }
-        let slab = b.build().expect("body").spawn(&mut s.soft);
-        s.soft
-            .insert_one(slab, SoftCollider::default())
-            .expect("entity");
+        let slab = soft_box_of(
+            &mut s,
+            (size, [3, 1, 3]),
+            Vector3::new(0.0, 0.05 + 0.003, 0.0),
+            1.0 / (size.x * size.y * size.z),
+            families,
+            SoftCollider::default(),
+        );
         assert!((particles(&s, slab).total_mass() - 1.0).abs() < 1e-3);
         let half = 0.2;
         let (boxh, _) = s.physics.insert(

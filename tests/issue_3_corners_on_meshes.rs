@@ -80,6 +80,20 @@ fn trimesh_spike_is_caught_by_soft_triangles() {
     check(mesh);
 }
 
+/// A fixed polyhedron's corners are paired only with the soft triangles that can reach them
+/// (`corner` module docs, issue 6): the tip is still caught by the triangle over it.
+#[test]
+fn fixed_convex_spike_is_caught_by_soft_triangles() {
+    let v = [
+        Vector::new(-0.5, 0.0, -0.5),
+        Vector::new(0.5, 0.0, -0.5),
+        Vector::new(0.5, 0.0, 0.5),
+        Vector::new(-0.5, 0.0, 0.5),
+        Vector::new(0.0, TIP, 0.0),
+    ];
+    check(ColliderBuilder::convex_hull(&v).expect("convex hull"));
+}
+
 #[test]
 fn heightfield_peak_is_caught_by_soft_triangles() {
     // 3 × 3 heights over 1 m × 1 m: one peak in the middle.

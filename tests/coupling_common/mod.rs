@@ -10,6 +10,9 @@ use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings, Tetrahedra};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider};
 
+/// Compliances of (edges, vertex–face, volume), `None` for a family the body does not have.
+pub type Families = (Option<f32>, Option<f32>, Option<f32>);
+
 /// A scene at 60 Hz with `substeps` soft substeps.
 pub fn scene(substeps: u32) -> CoupledWorld {
     scene_with(substeps, 1)
@@ -54,15 +57,32 @@ pub fn soft_box_with_density(
     density: f32,
     collider: SoftCollider,
 ) -> Entity {
+    let hard = (Some(0.0), None, Some(0.0));
+    soft_box_of(scene, (size, cells), at, density, hard, collider)
+}
+
+/// [`soft_box_with_density`] with the constraint `families`; `(size, cells)` as in
+/// [`soft_box`].
+pub fn soft_box_of(
+    scene: &mut CoupledWorld,
+    (size, cells): (Vector3<f32>, [u32; 3]),
+    at: Vector3<f32>,
+    density: f32,
+    (edges, vertex_face, volume): Families,
+    collider: SoftCollider,
+) -> Entity {
     let mesh = generators::box_grid(size, cells, CellSplit::Six).expect("mesh");
-    let body = SoftBodyBuilder::new(mesh)
-        .density(density)
-        .edges(0.0)
-        .volume(0.0)
-        .translation(at)
-        .build()
-        .expect("body");
-    let e = body.spawn(&mut scene.soft);
+    let mut b = SoftBodyBuilder::new(mesh).density(density).translation(at);
+    if let Some(a) = edges {
+        b = b.edges(a);
+    }
+    if let Some(a) = vertex_face {
+        b = b.vertex_face(a);
+    }
+    if let Some(a) = volume {
+        b = b.volume(a);
+    }
+    let e = b.build().expect("body").spawn(&mut scene.soft);
     scene.soft.insert_one(e, collider).expect("entity");
     e
 }

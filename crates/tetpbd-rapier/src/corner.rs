@@ -14,7 +14,7 @@
 //!
 //! The correction is spread over the triangle's particles barycentrically and the opposite
 //! impulse goes to the rigid body at `v`; Coulomb friction acts on the relative tangential
-//! motion as for particles. The rigid points are
+//! motion as for particles. The rigid points (`corner_points` module) are
 //!
 //! * every vertex of a polyhedral shape (cuboid, convex polyhedron, triangle; the inner
 //!   vertices of the rounded variants, border radius added to the thickness), each its own
@@ -33,13 +33,23 @@
 //! collider: one particle alone cannot stop a fast body, and its contact normal may be tilted
 //! enough to let the body slip past it.
 //!
-//! A triangle whose vertex is itself in contact with the collider (in the same iteration)
-//! is skipped: there the particle contacts hold the surface, and two sets of constraints on
-//! the same spot only fight. The smooth parts of a compound take no part (their contacts
-//! with the soft particles still act). `v` is only caught while its projection
+//! A triangle with a vertex that *holds* the collider is skipped in the ordinary pass: a
+//! vertex in contact with the collider (in the same iteration) whose contact normal lies
+//! within 30° of the triangle's normal. There the particle contact holds the surface, and two
+//! sets of constraints on the same spot only fight. A vertex touching the collider's side
+//! (its normal tilted further) does not hold it: the body slides past that particle into the
+//! triangle. Issue 6: a ball at 100 m/s pushed a vertex of a compliant slab into its side, the
+//! vertex's normal was about 45° off the triangle's, and with every touching vertex ruling
+//! its triangles out the ball sank into the slab (and, under soft edges + volume, through it
+//! and the ground); the triangle now stops it. The smooth parts of a compound take no part
+//! (their contacts with the soft particles still act). `v` is only caught while its projection
 //! falls inside the triangle (within 0.1 % of its barycentric range, so a point on a shared
 //! edge is not lost between two triangles) and it is less than half the triangle's shortest
-//! edge behind it, so triangles on the far side of the body never grab it.
+//! edge behind it, so triangles on the far side of the body never grab it. A corner of a
+//! fixed collider is therefore only paired with the triangles whose bounds over the frame
+//! (the vertices' positions and their predicted positions one frame on), loosened by the
+//! thickness and half the triangle's longest edge, contain it: the far corners of a ground
+//! cuboid are not evaluated against every soft triangle beside the particles resting on it.
 
 use nalgebra::{Isometry3, Point3, Vector3};
 use rapier3d::geometry::{Aabb, ColliderSet};
@@ -49,7 +59,14 @@ use tetpbd::{Particles, Surface};
 
 use crate::bodies::{BodyKind, BodyProxy};
 use crate::convert::{pose_to_glam, to_glam, to_na};
+use crate::corner_points::Corners;
 use crate::frame::{ColliderProxy, ParticleContact};
+
+/// Cosine of the largest angle between a vertex's particle contact normal and its triangle's
+/// normal at which the particle contact still holds the collider against the triangle, so
+/// the triangle is left to it in the ordinary pass (30°; 20° and 45° held the fast balls of
+/// issue 6 as well, see `docs/stability.md`).
+const HOLDING_ANGLE_COS: f32 = 0.866;
 
 /// One rigid shape over one soft surface triangle.
 #[derive(Clone, Debug)]
@@ -81,97 +98,10 @@ pub(crate) struct CornerContact {
     pub impulse: Vector3<f32>,
 }
 
-/// The rigid points of a shape, in its local frame: scratch space whose capacity is reused
-/// from one collider to the next, so gathering allocates nothing once warm.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Corners {
-    /// Each point with the extra thickness of its (rounded) part, m.
-    pub points: Vec<(Vector3<f32>, f32)>,
-    /// Some points are vertices of a triangle mesh or heightfield: many, so each is only
-    /// paired with the soft triangles near it.
-    pub from_mesh: bool,
-}
-
-impl Corners {
-    /// Replaces the points with the corners of `shape`. A triangle mesh or heightfield
-    /// contributes the vertices of its triangles inside `near` (local frame).
-    pub fn fill(&mut self, shape: &dyn Shape, near: &Aabb) {
-        self.points.clear();
-        self.from_mesh = append_corners(shape, near, &mut self.points);
-    }
-}
-
-/// Appends the corners of `shape` to `out`; returns whether some are mesh vertices.
-fn append_corners(shape: &dyn Shape, near: &Aabb, out: &mut Vec<(Vector3<f32>, f32)>) -> bool {
-    let cuboid_corners = |h: Vector3<f32>, extra: f32, out: &mut Vec<(Vector3<f32>, f32)>| {
-        out.extend((0..8).map(|k| {
-            let c = Vector3::new(
-                if k & 1 == 0 { -h.x } else { h.x },
-                if k & 2 == 0 { -h.y } else { h.y },
-                if k & 4 == 0 { -h.z } else { h.z },
-            );
-            (c, extra)
-        }));
-    };
-    if let Some(c) = shape.as_cuboid() {
-        cuboid_corners(to_na(c.half_extents), 0.0, out);
-    } else if let Some(c) = shape.as_round_cuboid() {
-        cuboid_corners(to_na(c.inner_shape.half_extents), c.border_radius, out);
-    } else if let Some(c) = shape.as_convex_polyhedron() {
-        out.extend(c.points().iter().map(|p| (to_na(*p), 0.0)));
-    } else if let Some(c) = shape.as_round_convex_polyhedron() {
-        let r = c.border_radius;
-        out.extend(c.inner_shape.points().iter().map(|p| (to_na(*p), r)));
-    } else if let Some(t) = shape.as_triangle() {
-        out.extend([t.a, t.b, t.c].map(|v| (to_na(v), 0.0)));
-    } else if let Some(mesh) = shape.as_trimesh() {
-        let first = out.len();
-        for t in mesh.bvh().intersect_aabb(near) {
-            let tri = mesh.triangle(t);
-            out.extend([tri.a, tri.b, tri.c].map(|v| (to_na(v), 0.0)));
-        }
-        dedup_mesh_vertices(out, first);
-        return true;
-    } else if let Some(hf) = shape.as_heightfield() {
-        let first = out.len();
-        hf.map_elements_in_local_aabb(near, &mut |_, tri| {
-            out.extend([tri.a, tri.b, tri.c].map(|v| (to_na(v), 0.0)));
-        });
-        dedup_mesh_vertices(out, first);
-        return true;
-    } else if let Some(compound) = shape.as_compound() {
-        // The corners of every part, in the compound's frame, each with its part's radius.
-        let mut from_mesh = false;
-        for (pose, part) in compound.shapes() {
-            let part_near = near.transform_by(&pose.inverse());
-            let first = out.len();
-            from_mesh |= append_corners(part.as_ref(), &part_near, out);
-            for (c, _) in &mut out[first..] {
-                *c = to_na(pose.transform_point(to_glam(c)));
-            }
-        }
-        return from_mesh;
-    }
-    false
-}
-
-/// Mesh vertices from `first` on without repeats (sorted by coordinates, so the order is
-/// deterministic).
-fn dedup_mesh_vertices(out: &mut Vec<(Vector3<f32>, f32)>, first: usize) {
-    let key = |p: &(Vector3<f32>, f32)| [p.0.x.to_bits(), p.0.y.to_bits(), p.0.z.to_bits()];
-    out[first..].sort_unstable_by_key(key);
-    let mut keep = first;
-    for k in first..out.len() {
-        if keep == first || key(&out[k]) != key(&out[keep - 1]) {
-            out[keep] = out[k];
-            keep += 1;
-        }
-    }
-    out.truncate(keep);
-}
-
 /// Adds the corner–triangle candidates of one collider against one soft body. `corners` is
-/// scratch space (its capacity is reused across calls).
+/// scratch space (its capacity is reused across calls). `still`: the collider stands at
+/// `pose` for the whole frame (fixed), so each of its corners is only paired with the
+/// triangles it can reach (see the module docs).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn gather_corners(
     out: &mut Vec<CornerContact>,
@@ -179,6 +109,7 @@ pub(crate) fn gather_corners(
     collider: usize,
     collider_aabb: &Aabb,
     pose: &Isometry3<f32>,
+    still: bool,
     p: &Particles,
     surface: &Surface,
     dt: f32,
@@ -224,6 +155,11 @@ pub(crate) fn gather_corners(
         if !ta.intersects(collider_aabb) {
             continue;
         }
+        // A still corner is caught only in front of the triangle or less than half its
+        // shortest edge behind it, with its projection inside it.
+        let [a, b, c] = tri.map(|i| p.positions()[i as usize]);
+        let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
+        let reachable = ta.loosened(0.5 * longest);
         let vc = tri.map(|i| {
             vertex_contacts
                 .binary_search_by_key(&i, |(p, _)| *p)
@@ -235,12 +171,13 @@ pub(crate) fn gather_corners(
                 Some(&(c, r)) => (Some(c), r),
                 None => (None, 0.0),
             };
-            // A mesh vertex only with the soft triangles near it.
-            if corners.from_mesh
-                && corner.is_some_and(|c| {
-                    !ta.contains_local_point(to_glam(&(pose * Point3::from(c)).coords))
-                })
-            {
+            // A mesh vertex only with the soft triangles near it, a still corner only with
+            // those it can reach.
+            let world = corner.map(|c| to_glam(&(pose * Point3::from(c)).coords));
+            if world.is_some_and(|w| {
+                (corners.from_mesh && !ta.contains_local_point(w))
+                    || (still && !reachable.contains_local_point(w))
+            }) {
                 continue;
             }
             out.push(CornerContact {
@@ -279,7 +216,7 @@ pub(crate) enum CornerPass {
     /// substep: this pass runs before the particle contacts, so a fast body is stopped by
     /// the surface it hits first rather than by a particle poking into it from the side.
     Crossing,
-    /// Every point, except on triangles with a vertex touching the same collider.
+    /// Every point, except on triangles with a vertex holding the same collider (module docs).
     Ordinary,
     /// Every point, on every triangle: the soft surface is frozen (the `stacking` pass), so
     /// a particle contact and a triangle on the same spot cannot fight; they both push the
@@ -350,49 +287,30 @@ fn sweep_corners(
         let Some(tri) = surface.triangles().get(k.triangle as usize) else {
             continue;
         };
-        // Where a vertex already touches the collider, the particle contacts hold the
-        // surface; the triangle only stops what slips between particles (and what crosses
-        // it within the substep, below).
-        let vertex_touches = k
-            .vertex_contacts
-            .iter()
-            .flatten()
-            .any(|&c| contacts.get(c).is_some_and(|c| c.active));
-        // In the ordinary pass a touching vertex rules the triangle out (a crossing there is
-        // only taken in the crossing pass).
-        if vertex_touches && pass == CornerPass::Ordinary {
-            continue;
-        }
         let idx = tri.map(|i| i as usize);
         let [a, b, c] = idx.map(|i| p.positions()[i]);
-        let cp = &colliders[k.collider];
-        let shortest = (b - a).norm().min((c - b).norm()).min((a - c).norm());
-        // Fast: the rigid point moves more than a tenth of the shortest edge in the substep
-        // (bounded by the body's shift plus its turn times the point's distance from the
-        // body's origin; support points bounded by the shape's bounding sphere).
-        let fast = moved.is_some_and(|(shift, turn)| {
-            let limit = 0.1 * shortest;
-            if shift > limit || turn <= 0.0 {
-                return shift > limit;
-            }
-            let radius = match k.corner {
-                Some(c) => c.norm(),
-                None => set.get(cp.handle).map_or(f32::INFINITY, |co| {
-                    let sphere = co.shape().compute_local_bounding_sphere();
-                    sphere.radius + to_na(sphere.center).norm()
-                }),
-            };
-            shift + turn * (radius + cp.local.translation.vector.norm()) > limit
-        });
-        if crossing_only && !fast {
-            continue;
-        }
         let m = (b - a).cross(&(c - a));
         let area2 = m.norm();
         if area2.is_nan() || area2 <= 1e-12 {
             continue;
         }
         let n = m / area2;
+        // In the ordinary pass a vertex holding the collider rules the triangle out (a
+        // crossing there is only taken in the crossing pass).
+        if pass == CornerPass::Ordinary && vertex_holds(k, contacts, &n) {
+            continue;
+        }
+        let cp = &colliders[k.collider];
+        let shortest = || (b - a).norm().min((c - b).norm()).min((a - c).norm());
+        // The crossing pass only takes fast points; the others only need to know once the
+        // point is found behind the plane.
+        let early = crossing_only.then(|| {
+            let shortest = shortest();
+            (shortest, is_fast(k, cp, set, moved, shortest))
+        });
+        if early.is_some_and(|(_, fast)| !fast) {
+            continue;
+        }
         let pose = cp.pose(bodies);
         let local = match k.corner {
             Some(c) => c,
@@ -416,6 +334,10 @@ fn sweep_corners(
         if c_val >= 0.0 {
             continue;
         }
+        let (shortest, fast) = early.unwrap_or_else(|| {
+            let shortest = shortest();
+            (shortest, is_fast(k, cp, set, moved, shortest))
+        });
         // Crossed the plane from the front within this substep (a fast rigid point, one that
         // itself moved more than a tenth of the shortest edge): caught at any depth, at the
         // crossing point. The point's start of the substep is carried along with the
@@ -478,6 +400,47 @@ fn sweep_corners(
     }
 }
 
+/// Whether a vertex of the triangle (unit outward normal `n`) already touches the collider
+/// with a contact normal close to the triangle's: that particle contact then holds the body
+/// against the surface, and the triangle only stops what slips between particles (and what
+/// crosses it within the substep). A vertex touching the body's side, its normal tilted more
+/// than `HOLDING_ANGLE_COS` from the triangle's, does not hold it: the body slides past that
+/// particle into the triangle.
+fn vertex_holds(k: &CornerContact, contacts: &[ParticleContact], n: &Vector3<f32>) -> bool {
+    k.vertex_contacts.iter().flatten().any(|&i| {
+        contacts
+            .get(i)
+            .is_some_and(|c| c.active && -c.normal.dot(n) > HOLDING_ANGLE_COS)
+    })
+}
+
+/// Whether the rigid point of `k` moves more than a tenth of the triangle's `shortest` edge
+/// in the substep (`moved`: the body's shift and turn, `None` for a fixed body). Bounded by
+/// the body's shift plus its turn times the point's distance from the body's origin; support
+/// points by the shape's bounding sphere.
+fn is_fast(
+    k: &CornerContact,
+    cp: &ColliderProxy,
+    set: &ColliderSet,
+    moved: Option<(f32, f32)>,
+    shortest: f32,
+) -> bool {
+    moved.is_some_and(|(shift, turn)| {
+        let limit = 0.1 * shortest;
+        if shift > limit || turn <= 0.0 {
+            return shift > limit;
+        }
+        let radius = match k.corner {
+            Some(c) => c.norm(),
+            None => set.get(cp.handle).map_or(f32::INFINITY, |co| {
+                let sphere = co.shape().compute_local_bounding_sphere();
+                sphere.radius + to_na(sphere.center).norm()
+            }),
+        };
+        shift + turn * (radius + cp.local.translation.vector.norm()) > limit
+    })
+}
+
 /// Coulomb friction between the rigid point `v` and the triangle (as for particles, see
 /// [`crate::contact`]): the relative tangential motion over the substep is removed while
 /// the tangential multiplier stays under `μ_s λ_n`, else limited to `μ_d λ_n`.
@@ -531,53 +494,4 @@ fn friction(
     }
     k.lambda_t += applied;
     k.sub_impulse += t * applied;
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use rapier3d::geometry::SharedShape;
-    use rapier3d::math::{Pose, Vector};
-
-    #[test]
-    fn compound_parts_keep_their_own_border_radius() {
-        let compound = SharedShape::compound(vec![
-            (
-                Pose::translation(-1.0, 0.0, 0.0),
-                SharedShape::cuboid(0.5, 0.5, 0.5),
-            ),
-            (
-                Pose::translation(1.0, 0.0, 0.0),
-                SharedShape::round_cuboid(0.4, 0.4, 0.4, 0.1),
-            ),
-        ]);
-        let near = Aabb::new(Vector::splat(-10.0), Vector::splat(10.0));
-        let mut c = Corners::default();
-        c.fill(compound.as_ref(), &near);
-        assert_eq!(c.points.len(), 16);
-        assert!(!c.from_mesh);
-        for (p, r) in &c.points {
-            let expected = if p.x > 0.0 { 0.1 } else { 0.0 };
-            assert_eq!(*r, expected, "corner {p:?}");
-        }
-    }
-
-    #[test]
-    fn mesh_vertices_only_near_the_soft_body_and_once_each() {
-        let v = vec![
-            Vector::new(0.0, 0.0, 0.0),
-            Vector::new(1.0, 0.0, 0.0),
-            Vector::new(0.0, 0.0, 1.0),
-            Vector::new(10.0, 0.0, 10.0),
-            Vector::new(11.0, 0.0, 10.0),
-            Vector::new(10.0, 0.0, 11.0),
-        ];
-        let mesh = SharedShape::trimesh(v, vec![[0, 2, 1], [1, 2, 0], [3, 5, 4]]).expect("mesh");
-        let near = Aabb::new(Vector::splat(-1.0), Vector::splat(2.0));
-        let mut c = Corners::default();
-        c.fill(mesh.as_ref(), &near);
-        assert!(c.from_mesh);
-        assert_eq!(c.points.len(), 3, "{:?}", c.points);
-        assert!(c.points.iter().all(|(p, _)| p.x < 2.0 && p.z < 2.0));
-    }
 }

@@ -14,7 +14,8 @@ use tetpbd::{Particles, Surface};
 use crate::attachment::{AttachTarget, Attachments};
 use crate::bodies::{BodyKind, BodyProxy};
 use crate::convert::{pose_to_glam, pose_to_na, to_glam};
-use crate::corner::{gather_corners, CornerContact, Corners};
+use crate::corner::{gather_corners, CornerContact};
+use crate::corner_points::Corners;
 use crate::material::SoftCollider;
 use crate::report::CouplingStats;
 use crate::shape_query::InsideRule;
@@ -347,6 +348,10 @@ impl Frame {
                     };
                     let solve = sc.solver_groups.test(co.solver_groups());
                     let cp = &self.colliders[ci];
+                    // Does not move over the frame (`corner::gather_corners`).
+                    let still = cp
+                        .body
+                        .is_none_or(|b| self.bodies[b].kind == BodyKind::Fixed);
                     let (mu_d, mu_s) = sc.combined_friction(cp.friction, cp.friction_rule);
                     let e = sc.combined_restitution(cp.restitution, cp.restitution_rule);
                     let first = self.contacts.len();
@@ -398,6 +403,7 @@ impl Frame {
                             ci,
                             &caabb,
                             &pose_to_na(co.position()),
+                            still,
                             p,
                             surface,
                             dt,

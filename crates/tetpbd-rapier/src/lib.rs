@@ -55,6 +55,7 @@ mod bodies;
 mod contact;
 pub mod convert;
 mod corner;
+mod corner_points;
 mod coupling;
 mod damping;
 mod error;
