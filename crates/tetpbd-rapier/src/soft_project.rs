@@ -111,8 +111,11 @@ impl ContactFrame {
             return;
         }
         self.load(world, g, Field::Position);
-        let alpha_tilde = s.compliance / (h * h);
-        let steps = (s.max_separation_speed * h, s.skin_speed * h);
+        let steps = (
+            s.compliance / (h * h),
+            s.max_separation_speed * h,
+            s.skin_speed * h,
+        );
         let ContactFrame {
             x,
             x_prev,
@@ -120,8 +123,17 @@ impl ContactFrame {
             candidates,
             ..
         } = self;
-        for c in candidates.iter_mut().filter(|c| !c.recovery) {
-            match project_one(c, x, x_prev, w, s, alpha_tilde, steps) {
+        for i in 0..candidates.len() {
+            if candidates[i].recovery {
+                continue;
+            }
+            let mut c = candidates[i].clone();
+            let beside = |n: &Vector3<f32>, d: f32, x: &[Vector3<f32>]| {
+                flush_beside(candidates, i, n, d, x, s.thickness)
+            };
+            let r = project_one(&mut c, x, x_prev, w, s, steps, &beside);
+            candidates[i] = c;
+            match r {
                 Outcome::Degenerate => stats.degenerate += 1,
                 Outcome::Clamped => stats.clamps += 1,
                 Outcome::Done => {}
@@ -200,8 +212,8 @@ fn project_one(
     x_prev: &[Vector3<f32>],
     w: &[f32],
     s: &SoftContactSettings,
-    alpha_tilde: f32,
-    (step, skin_step): (f32, f32),
+    (alpha_tilde, step, skin_step): (f32, f32, f32),
+    beside: &dyn Fn(&Vector3<f32>, f32, &[Vector3<f32>]) -> bool,
 ) -> Outcome {
     let p = c.p as usize;
     let tri = c.tri.map(|i| i as usize);
@@ -221,7 +233,7 @@ fn project_one(
     // fast particle entering at a convex edge). One sliding past the triangle's edge beside
     // it does neither and is left to the neighbouring faces.
     let touching = c.active || (c.prism_prev && inside_now) || crossed_inside(c, d, x, x_prev);
-    if !touching {
+    if !touching || (!c.active && d < 0.0 && beside(&n, d, x)) {
         return Outcome::Done;
     }
     let bary = if inside_now {
@@ -272,6 +284,41 @@ fn project_one(
     } else {
         Outcome::Done
     }
+}
+
+/// `true` when candidate `i`'s particle, `d` behind its triangle (normal `n`), is less deep
+/// behind a face of the same body across a crease (another candidate of its group, whose
+/// prism it is in): it is grazing that side face, not entering through this one.
+fn flush_beside(
+    candidates: &[Candidate],
+    i: usize,
+    n: &Vector3<f32>,
+    d: f32,
+    x: &[Vector3<f32>],
+    thickness: f32,
+) -> bool {
+    let c = &candidates[i];
+    let xp = x[c.p as usize];
+    let [g0, g1] = c.group.map(|k| k as usize);
+    candidates.get(g0..g1).is_some_and(|group| {
+        group.iter().enumerate().any(|(k, o)| {
+            if g0 + k == i {
+                return false;
+            }
+            let [a, b, t] = o.tri.map(|j| x[j as usize]);
+            let Some(m) = triangle_normal(&a, &b, &t) else {
+                return false;
+            };
+            let crease = m.dot(n).abs() < 0.7;
+            let dm = (xp - a).dot(&m);
+            crease
+                && dm >= -thickness
+                && dm > d
+                && plane_barycentric(&xp, &a, &b, &t, &m)
+                    .iter()
+                    .all(|&v| v >= -PRISM_TOLERANCE)
+        })
+    })
 }
 
 /// `true` when the particle, moving from its substep start towards the triangle's plane
