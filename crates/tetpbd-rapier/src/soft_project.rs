@@ -1,5 +1,6 @@
 //! Per-substep work of soft–soft contacts: the XPBD vertex–triangle projection with
-//! friction, the velocity pass and the end-of-frame statistics (see
+//! friction (and, for a particle grazing a side face, which face catches it:
+//! `flush_beside`), the velocity pass and the end-of-frame statistics (see
 //! [`crate::SoftContacts`] for the equations).
 
 use hecs::World;
@@ -15,6 +16,11 @@ use crate::soft_gather::{Candidate, ContactFrame, Gather};
 /// still count as inside its prism: rounding only. A wider band lets a face catch particles
 /// sliding past its edges (they snag and are shot off along the face normal).
 const PRISM_TOLERANCE: f32 = 1e-3;
+
+/// Largest `|cos|` of the angle between two triangles' normals for them to count as faces on
+/// either side of a crease (a side face) in [`flush_beside`]: 45° to 135° apart. Coplanar
+/// neighbours and the far side of a thin sheet are not side faces.
+const CREASE_COS: f32 = 0.7;
 
 /// Which per-particle array a load or store touches.
 #[derive(Clone, Copy)]
@@ -231,7 +237,8 @@ fn project_one(
     // A particle touches the triangle if it was over it at the substep start and still is,
     // or if its path over the substep crossed the triangle's plane inside the triangle (a
     // fast particle entering at a convex edge). One sliding past the triangle's edge beside
-    // it does neither and is left to the neighbouring faces.
+    // it does neither and is left to the neighbouring faces, and so is one behind the plane
+    // that is grazing a side face of the same body.
     let touching = c.active || (c.prism_prev && inside_now) || crossed_inside(c, d, x, x_prev);
     if !touching || (!c.active && d < 0.0 && beside(&n, d, x)) {
         return Outcome::Done;
@@ -286,9 +293,11 @@ fn project_one(
     }
 }
 
-/// `true` when candidate `i`'s particle, `d` behind its triangle (normal `n`), is less deep
-/// behind a face of the same body across a crease (another candidate of its group, whose
-/// prism it is in): it is grazing that side face, not entering through this one.
+/// `true` when candidate `i`'s particle, `d` (m, < 0) behind its triangle (unit normal `n`),
+/// is less deep behind a side face of the same body: another candidate of its group whose
+/// normal `m` makes a crease with `n` (`|m·n| <` [`CREASE_COS`]), whose prism it is in and
+/// whose plane it is at most `thickness` behind. It is then grazing that side face, not
+/// entering through this one (see the module docs of `soft_contact`).
 fn flush_beside(
     candidates: &[Candidate],
     i: usize,
@@ -309,7 +318,7 @@ fn flush_beside(
             let Some(m) = triangle_normal(&a, &b, &t) else {
                 return false;
             };
-            let crease = m.dot(n).abs() < 0.7;
+            let crease = m.dot(n).abs() < CREASE_COS;
             let dm = (xp - a).dot(&m);
             crease
                 && dm >= -thickness
