@@ -205,6 +205,10 @@ impl ContactFrame {
     }
 }
 
+/// Whether the particle of the candidate being projected, behind its triangle (normal,
+/// distance) at these positions, is grazing a side face instead ([`flush_beside`]).
+type Beside<'a> = &'a dyn Fn(&Vector3<f32>, f32, &[Vector3<f32>]) -> bool;
+
 enum Outcome {
     Done,
     Clamped,
@@ -219,7 +223,7 @@ fn project_one(
     w: &[f32],
     s: &SoftContactSettings,
     (alpha_tilde, step, skin_step): (f32, f32, f32),
-    beside: &dyn Fn(&Vector3<f32>, f32, &[Vector3<f32>]) -> bool,
+    beside: Beside<'_>,
 ) -> Outcome {
     let p = c.p as usize;
     let tri = c.tri.map(|i| i as usize);
