@@ -133,13 +133,7 @@ impl ContactFrame {
             if candidates[i].recovery {
                 continue;
             }
-            let mut c = candidates[i].clone();
-            let beside = |n: &Vector3<f32>, d: f32, x: &[Vector3<f32>]| {
-                flush_beside(candidates, i, n, d, x, s.thickness)
-            };
-            let r = project_one(&mut c, x, x_prev, w, s, steps, &beside);
-            candidates[i] = c;
-            match r {
+            match project_one(candidates, i, x, x_prev, w, s, steps) {
                 Outcome::Degenerate => stats.degenerate += 1,
                 Outcome::Clamped => stats.clamps += 1,
                 Outcome::Done => {}
@@ -205,26 +199,23 @@ impl ContactFrame {
     }
 }
 
-/// Whether the particle of the candidate being projected, behind its triangle (normal,
-/// distance) at these positions, is grazing a side face instead ([`flush_beside`]).
-type Beside<'a> = &'a dyn Fn(&Vector3<f32>, f32, &[Vector3<f32>]) -> bool;
-
 enum Outcome {
     Done,
     Clamped,
     Degenerate,
 }
 
-/// Projects one candidate (see the module docs of `soft_contact`).
+/// Projects candidate `i` (see the module docs of `soft_contact`).
 fn project_one(
-    c: &mut Candidate,
+    candidates: &mut [Candidate],
+    i: usize,
     x: &mut [Vector3<f32>],
     x_prev: &[Vector3<f32>],
     w: &[f32],
     s: &SoftContactSettings,
     (alpha_tilde, step, skin_step): (f32, f32, f32),
-    beside: Beside<'_>,
 ) -> Outcome {
+    let c = &candidates[i];
     let p = c.p as usize;
     let tri = c.tri.map(|i| i as usize);
     let [a, b, t] = tri.map(|i| x[i]);
@@ -244,9 +235,10 @@ fn project_one(
     // it does neither and is left to the neighbouring faces, and so is one behind the plane
     // that is grazing a side face of the same body.
     let touching = c.active || (c.prism_prev && inside_now) || crossed_inside(c, d, x, x_prev);
-    if !touching || (!c.active && d < 0.0 && beside(&n, d, x)) {
+    if !touching || (!c.active && d < 0.0 && flush_beside(candidates, i, &n, d, x, s.thickness)) {
         return Outcome::Done;
     }
+    let c = &mut candidates[i];
     let bary = if inside_now {
         let bw = bw.map(|v| v.max(0.0));
         let sum: f32 = bw.iter().sum();
