@@ -39,6 +39,16 @@
 //! it came from and is pushed back to it, while a particle resting under the sheet is never
 //! pulled through it, and one sliding past a face's edge beside it does not snag on it.
 //!
+//! A candidate that is not yet active in the substep is also left alone while its particle
+//! is behind the triangle's plane but less deep behind another triangle of the same body
+//! across a crease (normals 45° to 135° apart: a side face), whose prism it is in, and at
+//! most `δ` behind that one: the particle is grazing the side face (two cubes falling past
+//! each other face to face, edges flush), not entering through the face it passes. Without
+//! this, a landed cube's few millimetres of bulge put its top-edge particles inside the
+//! falling neighbour's bottom face, which stopped the neighbour on the edge and kicked it
+//! sideways (issue #5). The side face takes the particle over from the next substep on, once
+//! the particle was inside its prism at the substep start.
+//!
 //! # Deep overlap and the speed bound
 //!
 //! Every contact's target height is reached at a bounded rate: with `d_prev` the

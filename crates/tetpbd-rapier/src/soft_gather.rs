@@ -52,6 +52,10 @@ pub(crate) struct Candidate {
     pub clamped: bool,
     /// The particle projected inside the triangle at the substep start.
     pub prism_prev: bool,
+    /// Candidates `group[0]..group[1]` are those of the same particle against the same
+    /// body (this one included): the faces next to this triangle that the particle may be
+    /// flush with (see `soft_project::flush_beside`).
+    pub group: [u32; 2],
     /// `w_p + Σ β² w` of the last projection, 1/kg.
     pub wsum: f32,
     /// Normal and barycentrics of the last projection.
@@ -360,6 +364,7 @@ impl Gather {
                 }
                 continue;
             }
+            let first = frame.candidates.len() as u32;
             let query = Aabb::new(to_glam(&lo), to_glam(&hi));
             found.clear();
             found.extend(cache_b.tri_bvh.intersect_aabb(&query));
@@ -386,6 +391,10 @@ impl Gather {
                     .candidates
                     .push(candidate(slot as u32, tri, false, depth_limit));
             }
+            let last = frame.candidates.len() as u32;
+            for c in &mut frame.candidates[first as usize..] {
+                c.group = [first, last];
+            }
         }
     }
 }
@@ -403,6 +412,7 @@ fn candidate(p: u32, tri: [u32; 3], recovery: bool, depth_limit: f32) -> Candida
         ever: false,
         clamped: false,
         prism_prev: false,
+        group: [0, 0],
         wsum: 0.0,
         n: Vector3::zeros(),
         bary: [1.0 / 3.0; 3],

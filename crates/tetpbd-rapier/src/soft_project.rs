@@ -1,5 +1,6 @@
 //! Per-substep work of soft–soft contacts: the XPBD vertex–triangle projection with
-//! friction, the velocity pass and the end-of-frame statistics (see
+//! friction (and, for a particle grazing a side face, which face catches it:
+//! `flush_beside`), the velocity pass and the end-of-frame statistics (see
 //! [`crate::SoftContacts`] for the equations).
 
 use hecs::World;
@@ -15,6 +16,11 @@ use crate::soft_gather::{Candidate, ContactFrame, Gather};
 /// still count as inside its prism: rounding only. A wider band lets a face catch particles
 /// sliding past its edges (they snag and are shot off along the face normal).
 const PRISM_TOLERANCE: f32 = 1e-3;
+
+/// Largest `|cos|` of the angle between two triangles' normals for them to count as faces on
+/// either side of a crease (a side face) in [`flush_beside`]: 45° to 135° apart. Coplanar
+/// neighbours and the far side of a thin sheet are not side faces.
+const CREASE_COS: f32 = 0.7;
 
 /// Which per-particle array a load or store touches.
 #[derive(Clone, Copy)]
@@ -111,8 +117,11 @@ impl ContactFrame {
             return;
         }
         self.load(world, g, Field::Position);
-        let alpha_tilde = s.compliance / (h * h);
-        let steps = (s.max_separation_speed * h, s.skin_speed * h);
+        let steps = (
+            s.compliance / (h * h),
+            s.max_separation_speed * h,
+            s.skin_speed * h,
+        );
         let ContactFrame {
             x,
             x_prev,
@@ -120,8 +129,11 @@ impl ContactFrame {
             candidates,
             ..
         } = self;
-        for c in candidates.iter_mut().filter(|c| !c.recovery) {
-            match project_one(c, x, x_prev, w, s, alpha_tilde, steps) {
+        for i in 0..candidates.len() {
+            if candidates[i].recovery {
+                continue;
+            }
+            match project_one(candidates, i, x, x_prev, w, s, steps) {
                 Outcome::Degenerate => stats.degenerate += 1,
                 Outcome::Clamped => stats.clamps += 1,
                 Outcome::Done => {}
@@ -193,16 +205,17 @@ enum Outcome {
     Degenerate,
 }
 
-/// Projects one candidate (see the module docs of `soft_contact`).
+/// Projects candidate `i` (see the module docs of `soft_contact`).
 fn project_one(
-    c: &mut Candidate,
+    candidates: &mut [Candidate],
+    i: usize,
     x: &mut [Vector3<f32>],
     x_prev: &[Vector3<f32>],
     w: &[f32],
     s: &SoftContactSettings,
-    alpha_tilde: f32,
-    (step, skin_step): (f32, f32),
+    (alpha_tilde, step, skin_step): (f32, f32, f32),
 ) -> Outcome {
+    let c = &candidates[i];
     let p = c.p as usize;
     let tri = c.tri.map(|i| i as usize);
     let [a, b, t] = tri.map(|i| x[i]);
@@ -219,11 +232,13 @@ fn project_one(
     // A particle touches the triangle if it was over it at the substep start and still is,
     // or if its path over the substep crossed the triangle's plane inside the triangle (a
     // fast particle entering at a convex edge). One sliding past the triangle's edge beside
-    // it does neither and is left to the neighbouring faces.
+    // it does neither and is left to the neighbouring faces, and so is one behind the plane
+    // that is grazing a side face of the same body.
     let touching = c.active || (c.prism_prev && inside_now) || crossed_inside(c, d, x, x_prev);
-    if !touching {
+    if !touching || (!c.active && d < 0.0 && flush_beside(candidates, i, &n, d, x, s.thickness)) {
         return Outcome::Done;
     }
+    let c = &mut candidates[i];
     let bary = if inside_now {
         let bw = bw.map(|v| v.max(0.0));
         let sum: f32 = bw.iter().sum();
@@ -272,6 +287,43 @@ fn project_one(
     } else {
         Outcome::Done
     }
+}
+
+/// `true` when candidate `i`'s particle, `d` (m, < 0) behind its triangle (unit normal `n`),
+/// is less deep behind a side face of the same body: another candidate of its group whose
+/// normal `m` makes a crease with `n` (`|m·n| <` [`CREASE_COS`]), whose prism it is in and
+/// whose plane it is at most `thickness` behind. It is then grazing that side face, not
+/// entering through this one (see the module docs of `soft_contact`).
+fn flush_beside(
+    candidates: &[Candidate],
+    i: usize,
+    n: &Vector3<f32>,
+    d: f32,
+    x: &[Vector3<f32>],
+    thickness: f32,
+) -> bool {
+    let c = &candidates[i];
+    let xp = x[c.p as usize];
+    let [g0, g1] = c.group.map(|k| k as usize);
+    candidates.get(g0..g1).is_some_and(|group| {
+        group.iter().enumerate().any(|(k, o)| {
+            if g0 + k == i {
+                return false;
+            }
+            let [a, b, t] = o.tri.map(|j| x[j as usize]);
+            let Some(m) = triangle_normal(&a, &b, &t) else {
+                return false;
+            };
+            let crease = m.dot(n).abs() < CREASE_COS;
+            let dm = (xp - a).dot(&m);
+            crease
+                && dm >= -thickness
+                && dm > d
+                && plane_barycentric(&xp, &a, &b, &t, &m)
+                    .iter()
+                    .all(|&v| v >= -PRISM_TOLERANCE)
+        })
+    })
 }
 
 /// `true` when the particle, moving from its substep start towards the triangle's plane

@@ -4,8 +4,11 @@
 //! frame dt and substeps, in one process.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --bin vs_rapier [-- --frames F]
+//! cargo run --release -p tetpbd-bench --bin vs_rapier [-- --frames F] [--pile] [--tetpbd-only]
 //! ```
+//!
+//! `--pile` runs only scene d); `--tetpbd-only` prints tetpbd's rows at every substep count
+//! and runs no rapier (no comparisons).
 //!
 //! Prints, per engine and scene: median wall ms per frame over the resting phase (cube: from
 //! 2 s on, pile: from 3 s on), the settled max |v| (largest particle speed over the last 30
@@ -20,7 +23,9 @@
 //! of a surface particle of one body inside another's tetrahedra; settled max |v| from
 //! positions (displacement over a frame / dt).
 
-use tetpbd_bench::{build_contact, run_contact, ContactEngine, ContactResult, ContactScene, DT};
+use tetpbd_bench::{
+    build_contact, flag, run_contact, ContactEngine, ContactResult, ContactScene, DT,
+};
 
 use rapier3d::prelude::{SoftBodyCellModel, SoftBodySolver};
 
@@ -66,8 +71,19 @@ fn compare(scene: &ContactScene) -> Res<()> {
     let mut ours = Vec::new();
     for substeps in TETPBD_SUBSTEPS {
         for e in [undamped, damped] {
-            ours.push((e, substeps, measure(e, scene, substeps)?));
+            let x = measure(e, scene, substeps)?;
+            if flag("--tetpbd-only") {
+                print_row(
+                    &format!("{}, {substeps} substeps", e.label()),
+                    scene.tets(),
+                    &x,
+                );
+            }
+            ours.push((e, substeps, x));
         }
+    }
+    if flag("--tetpbd-only") {
+        return Ok(());
     }
     for substeps in RAPIER_SUBSTEPS {
         let r = measure(RAPIER, scene, substeps)?;
@@ -146,7 +162,7 @@ fn main() -> Res<()> {
         load()
     );
     println!("engine                                     tets   ms/frame    max|v| m/s   ground pen. m   interpen. m   volume err %");
-    for cells in [4u32, 8, 12] {
+    for cells in [4u32, 8, 12].into_iter().filter(|_| !flag("--pile")) {
         let scene = ContactScene::drop(cells, frames)?;
         println!("c) 1 m cube, {cells}³ cells, dropped 5 cm onto rigid ground");
         compare(&scene)?;
