@@ -39,6 +39,8 @@ mod parallel;
 mod particles;
 mod projection;
 mod runs;
+#[cfg(feature = "parallel")]
+mod schedule;
 mod solver;
 mod stacking;
 mod stats;

@@ -1,7 +1,11 @@
 //! Parallel Gauss–Seidel (feature `parallel`): within a colour class no two constraints
-//! share a particle, so a class's projections run concurrently on rayon's pool and the
-//! result is bit-identical to the serial sweep, for any number of threads. Classes run one
-//! after another; the overflow class (see [`crate::ordering`]) runs serially.
+//! share a particle, so a class's projections run concurrently and the result is
+//! bit-identical to the serial sweep, for any number of threads. A family's sweep is one
+//! parallel region whose phases are the classes, run one after another
+//! ([`crate::schedule::run_phases`]); the overflow class (see [`crate::ordering`]) runs on
+//! one thread. The passes over the particles of a large body (prediction, the copies into
+//! and out of the working copy, the velocity update) run as rayon parallel iterators over
+//! runs of particles: each particle's update is independent, so they are bit-identical too.
 
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -11,11 +15,16 @@ use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints}
 use crate::mesh::Tetrahedra;
 use crate::projection::ParticleAccess;
 use crate::runs::{edge_run, vertex_face_run, volume_run};
-use crate::systems::{Kernel, ProjectionCount};
-use crate::work::{Slot, WorkAccess};
+use crate::schedule::PARTICLE_CHUNK;
+use crate::systems::{Kernel, PredictRun, ProjectionCount, VelocityRun, VelocityUpdate};
+use crate::work::{self, Slot, WorkAccess};
 
 /// Bodies with fewer constraints in a family than this take the serial path.
 const MIN_PARALLEL: usize = 4096;
+
+/// Bodies with fewer particles than this run the passes over the particles (prediction,
+/// copies, velocity update) serially.
+const MIN_PARALLEL_PARTICLES: usize = 4096;
 
 /// Whether a family of `len` constraints runs on the pool: large enough, and the pool has
 /// more than one thread (on one thread the serial sweep does the same work without the
@@ -24,8 +33,82 @@ pub(crate) fn worth_it(len: usize) -> bool {
     len >= MIN_PARALLEL && rayon::current_num_threads() > 1
 }
 
-/// Items per rayon task (a multiple of the SIMD lanes).
-const CHUNK: usize = 256;
+/// Whether a pass over `len` particles runs on the pool.
+pub(crate) fn particles_worth_it(len: usize) -> bool {
+    len >= MIN_PARALLEL_PARTICLES && rayon::current_num_threads() > 1
+}
+
+/// [`crate::systems::predict`] of one body, in runs of [`PARTICLE_CHUNK`] particles.
+pub(crate) fn predict(run: PredictRun<'_>, a: Vector3<f32>, h: f32, keep: f32) {
+    let c = PARTICLE_CHUNK;
+    run.positions
+        .par_chunks_mut(c)
+        .zip(run.prev_positions.par_chunks_mut(c))
+        .zip(run.velocities.par_chunks_mut(c))
+        .zip(run.inv_masses.par_chunks(c))
+        .zip(run.residuals.par_chunks_mut(c))
+        .for_each(
+            |((((positions, prev_positions), velocities), inv_masses), residuals)| {
+                PredictRun {
+                    positions,
+                    prev_positions,
+                    velocities,
+                    inv_masses,
+                    residuals,
+                }
+                .predict(a, h, keep)
+            },
+        );
+}
+
+/// [`crate::systems::update_velocities`] of one body, in runs of [`PARTICLE_CHUNK`]
+/// particles (the counts are sums, whatever the split).
+pub(crate) fn update_velocities(
+    run: VelocityRun<'_>,
+    h: f32,
+    max_correction_speed: Option<f32>,
+) -> VelocityUpdate {
+    let c = PARTICLE_CHUNK;
+    run.positions
+        .par_chunks_mut(c)
+        .zip(run.prev_positions.par_chunks(c))
+        .zip(run.velocities.par_chunks_mut(c))
+        .zip(run.residuals.par_chunks(c))
+        .map(|(((positions, prev_positions), velocities), residuals)| {
+            VelocityRun {
+                positions,
+                prev_positions,
+                velocities,
+                residuals,
+            }
+            .update(h, max_correction_speed)
+        })
+        .reduce(VelocityUpdate::default, |mut a, b| {
+            a += b;
+            a
+        })
+}
+
+/// [`crate::work::load`] in runs of [`PARTICLE_CHUNK`] particles.
+pub(crate) fn load(slots: &mut [Slot], x: &[Vector3<f32>], w: &[f32], r: &[Vector3<f32>]) {
+    let c = PARTICLE_CHUNK;
+    slots
+        .par_chunks_mut(c)
+        .zip(x.par_chunks(c))
+        .zip(w.par_chunks(c))
+        .zip(r.par_chunks(c))
+        .for_each(|(((s, x), w), r)| work::load_run(s, x, w, r));
+}
+
+/// [`crate::work::store`] in runs of [`PARTICLE_CHUNK`] particles.
+pub(crate) fn store(slots: &[Slot], x: &mut [Vector3<f32>], r: &mut [Vector3<f32>]) {
+    let c = PARTICLE_CHUNK;
+    slots
+        .par_chunks(c)
+        .zip(x.par_chunks_mut(c))
+        .zip(r.par_chunks_mut(c))
+        .for_each(|((s, x), r)| work::store_run(s, x, r));
+}
 
 /// Shared access to a body's working copy for the projections of one colour class.
 #[derive(Clone, Copy)]
@@ -75,33 +158,58 @@ impl ParticleAccess for SharedAccess {
     }
 }
 
-/// Runs `f` over every class: independent classes split into chunks of [`CHUNK`] items
-/// run in parallel, the overflow class serially. `f` gets the access, the run's first item
-/// index, the run's multipliers and whether the run is independent.
+/// A mutable slice shared by the threads of one sweep, each taking disjoint runs.
+struct SharedItems<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+// SAFETY: the threads of a sweep take the runs of [`SharedItems::run`] from
+// [`crate::schedule::run_phases`], which hands every item of a phase to exactly one call;
+// the slice is borrowed mutably for the whole sweep, so no other access exists meanwhile.
+unsafe impl<T: Send> Sync for SharedItems<T> {}
+
+impl<T> SharedItems<T> {
+    /// The items `range`.
+    ///
+    /// # Safety
+    /// No other live reference may overlap `range`.
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn run(&self, range: std::ops::Range<usize>) -> &mut [T] {
+        assert!(range.start <= range.end && range.end <= self.len);
+        // SAFETY: in bounds (checked); exclusive by the caller's guarantee.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(range.start), range.len()) }
+    }
+}
+
+/// Runs `f` over every class, classes in order, in one parallel region
+/// ([`crate::schedule::run_phases`]: the classes are its phases). `f` gets the access, the
+/// run's first item index, the run's multipliers and whether the run is independent.
 fn sweep<T: Send>(
     classes: &crate::ordering::ColourClasses,
     items: &mut [T],
     acc: SharedAccess,
     f: impl Fn(&mut SharedAccess, usize, &mut [T], bool) -> ProjectionCount + Sync,
 ) -> ProjectionCount {
-    let mut total = ProjectionCount::default();
-    for (range, independent) in classes.ranges() {
-        let start = range.start;
-        let class = &mut items[range];
-        if independent {
-            total += class
-                .par_chunks_mut(CHUNK)
-                .enumerate()
-                .map(|(c, chunk)| f(&mut { acc }, start + c * CHUNK, chunk, true))
-                .reduce(ProjectionCount::default, |mut a, b| {
-                    a += b;
-                    a
-                });
-        } else {
-            total += f(&mut { acc }, start, class, false);
-        }
-    }
-    total
+    let shared = SharedItems {
+        ptr: items.as_mut_ptr(),
+        len: items.len(),
+    };
+    crate::schedule::run_phases(
+        classes.len(),
+        crate::schedule::CLASS_CHUNK,
+        |k| {
+            let (r, independent) = classes.class(k);
+            (r.len(), independent)
+        },
+        |k, within| {
+            let (r, independent) = classes.class(k);
+            let first = r.start + within.start;
+            // SAFETY: `run_phases` hands each item of a class to one call only.
+            let run = unsafe { shared.run(first..r.start + within.end) };
+            f(&mut { acc }, first, run, independent)
+        },
+    )
 }
 
 pub(crate) fn edges(

@@ -6,7 +6,8 @@
 //! ```
 //!
 //! `--breakdown` also prints, per body and thread count, the median ms per frame spent in
-//! prediction, each family's system and the velocity update (from [`tetpbd::StepStats`]),
+//! prediction, the copies into and out of the working copy, each family's system and the
+//! velocity update (from [`tetpbd::StepStats`]),
 //! and the number of colour classes of the edges and tetrahedra (the phases of a parallel
 //! sweep).
 //!
@@ -26,13 +27,14 @@ use tetpbd::{SoftBodyBuilder, Solver, SolverSettings, StepStats, TetMesh};
 use tetpbd_bench::{arg, flag, orders};
 
 /// Median ms per frame of a hanging cube (top face pinned), and the median ms per frame
-/// of each phase: prediction, volume, vertex–face, edges, velocity update.
+/// of each phase: prediction, copies into and out of the working copy, volume, vertex–face,
+/// edges, velocity update.
 fn frame_ms(
     mesh: &TetMesh,
     set: &str,
     spatial: bool,
     frames: usize,
-) -> Result<(f64, [f64; 5]), Box<dyn std::error::Error>> {
+) -> Result<(f64, [f64; 6]), Box<dyn std::error::Error>> {
     let top: Vec<u32> = (0..mesh.vertices.len() as u32)
         .filter(|&i| mesh.vertices[i as usize].y > 0.4999)
         .collect();
@@ -52,7 +54,7 @@ fn frame_ms(
         ..Default::default()
     })?;
     let mut times = Vec::with_capacity(frames);
-    let mut phases: [Vec<f64>; 5] = Default::default();
+    let mut phases: [Vec<f64>; 6] = Default::default();
     for f in 0..frames + 2 {
         let t = Instant::now();
         let s = solver.step(&mut world)?;
@@ -66,9 +68,10 @@ fn frame_ms(
     Ok((median(&mut times), phases.map(|mut v| median(&mut v))))
 }
 
-fn phase_ms(s: &StepStats) -> [f64; 5] {
+fn phase_ms(s: &StepStats) -> [f64; 6] {
     [
         s.predict_time,
+        s.copy_time,
         s.volume.time,
         s.vertex_face.time,
         s.edge.time,
@@ -127,7 +130,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 })?),
             );
             #[cfg(not(feature = "parallel"))]
-            let (one, two): (_, Option<(f64, [f64; 5])>) =
+            let (one, two): (_, Option<(f64, [f64; 6])>) =
                 (frame_ms(&mesh, set, spatial, frames)?, None);
             let ((one, one_phases), two_phases) = (one, two.map(|t| t.1));
             let two = two.map(|t| t.0);
@@ -144,8 +147,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let (e, t) = class_counts(&mesh);
                 println!("    colour classes: {e} of edges, {t} of tetrahedra");
                 for (threads, p) in [(1, Some(one_phases)), (2, two_phases)] {
-                    if let Some([pr, vo, vf, ed, ve]) = p {
-                        println!("    {threads} thread(s), ms/frame: predict {pr:.2}  volume {vo:.2}  vertex-face {vf:.2}  edges {ed:.2}  velocities {ve:.2}");
+                    if let Some([pr, co, vo, vf, ed, ve]) = p {
+                        println!("    {threads} thread(s), ms/frame: predict {pr:.2}  copies {co:.2}  volume {vo:.2}  vertex-face {vf:.2}  edges {ed:.2}  velocities {ve:.2}");
                     }
                 }
             }
