@@ -45,6 +45,8 @@ mod solver;
 mod stacking;
 mod stats;
 pub mod systems;
+#[cfg(feature = "parallel")]
+mod team;
 mod work;
 
 pub use builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};

@@ -4,18 +4,19 @@
 //! parallel region whose phases are the classes, run one after another
 //! ([`crate::schedule::run_phases`]); the overflow class (see [`crate::ordering`]) runs on
 //! one thread. The passes over the particles of a large body (prediction, the copies into
-//! and out of the working copy, the velocity update) run as rayon parallel iterators over
-//! runs of particles: each particle's update is independent, so they are bit-identical too.
+//! and out of the working copy, the velocity update) run the same way as one phase of runs
+//! of particles: each particle's update is independent, so they are bit-identical too.
+//! Inside [`crate::Solver::step`] every region is posted to the step's team
+//! ([`crate::team`]) instead of waking the pool's threads.
 
 use nalgebra::Vector3;
-use rayon::prelude::*;
 use wide::f32x4;
 
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::mesh::Tetrahedra;
 use crate::projection::ParticleAccess;
 use crate::runs::{edge_run, vertex_face_run, volume_run};
-use crate::schedule::PARTICLE_CHUNK;
+use crate::schedule::{run_phases, Nothing, Shared, PARTICLE_CHUNK};
 use crate::systems::{Kernel, PredictRun, ProjectionCount, VelocityRun, VelocityUpdate};
 use crate::work::{self, Slot, WorkAccess};
 
@@ -38,76 +39,87 @@ pub(crate) fn particles_worth_it(len: usize) -> bool {
     len >= MIN_PARALLEL_PARTICLES && rayon::current_num_threads() > 1
 }
 
-/// [`crate::systems::predict`] of one body, in runs of [`PARTICLE_CHUNK`] particles.
-pub(crate) fn predict(run: PredictRun<'_>, a: Vector3<f32>, h: f32, keep: f32) {
-    let c = PARTICLE_CHUNK;
-    run.positions
-        .par_chunks_mut(c)
-        .zip(run.prev_positions.par_chunks_mut(c))
-        .zip(run.velocities.par_chunks_mut(c))
-        .zip(run.inv_masses.par_chunks(c))
-        .zip(run.residuals.par_chunks_mut(c))
-        .for_each(
-            |((((positions, prev_positions), velocities), inv_masses), residuals)| {
-                PredictRun {
-                    positions,
-                    prev_positions,
-                    velocities,
-                    inv_masses,
-                    residuals,
-                }
-                .predict(a, h, keep)
-            },
-        );
+/// Runs `f` over runs of [`PARTICLE_CHUNK`] of `len` particles on the pool, summing what it
+/// returns.
+fn particle_pass<C: Default + std::ops::AddAssign + Send>(
+    len: usize,
+    f: impl Fn(std::ops::Range<usize>) -> C + Sync,
+) -> C {
+    run_phases(1, PARTICLE_CHUNK, |_| (len, true), |_, r| f(r))
 }
 
-/// [`crate::systems::update_velocities`] of one body, in runs of [`PARTICLE_CHUNK`]
-/// particles (the counts are sums, whatever the split).
+/// [`crate::systems::predict`] of one body, in runs of particles.
+pub(crate) fn predict(run: PredictRun<'_>, a: Vector3<f32>, h: f32, keep: f32) {
+    let n = run.positions.len();
+    let (x, xp, v, r) = (
+        Shared::new(run.positions),
+        Shared::new(run.prev_positions),
+        Shared::new(run.velocities),
+        Shared::new(run.residuals),
+    );
+    let w = run.inv_masses;
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each particle to one call only.
+        let run = unsafe {
+            PredictRun {
+                positions: x.run(i.clone()),
+                prev_positions: xp.run(i.clone()),
+                velocities: v.run(i.clone()),
+                inv_masses: &w[i.clone()],
+                residuals: r.run(i),
+            }
+        };
+        run.predict(a, h, keep);
+        Nothing
+    });
+}
+
+/// [`crate::systems::update_velocities`] of one body, in runs of particles (the counts are
+/// sums, whatever the split).
 pub(crate) fn update_velocities(
     run: VelocityRun<'_>,
     h: f32,
     max_correction_speed: Option<f32>,
 ) -> VelocityUpdate {
-    let c = PARTICLE_CHUNK;
-    run.positions
-        .par_chunks_mut(c)
-        .zip(run.prev_positions.par_chunks(c))
-        .zip(run.velocities.par_chunks_mut(c))
-        .zip(run.residuals.par_chunks(c))
-        .map(|(((positions, prev_positions), velocities), residuals)| {
+    let n = run.positions.len();
+    let (x, v) = (Shared::new(run.positions), Shared::new(run.velocities));
+    let (xp, r) = (run.prev_positions, run.residuals);
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each particle to one call only.
+        let run = unsafe {
             VelocityRun {
-                positions,
-                prev_positions,
-                velocities,
-                residuals,
+                positions: x.run(i.clone()),
+                prev_positions: &xp[i.clone()],
+                velocities: v.run(i.clone()),
+                residuals: &r[i],
             }
-            .update(h, max_correction_speed)
-        })
-        .reduce(VelocityUpdate::default, |mut a, b| {
-            a += b;
-            a
-        })
+        };
+        run.update(h, max_correction_speed)
+    })
 }
 
-/// [`crate::work::load`] in runs of [`PARTICLE_CHUNK`] particles.
+/// [`crate::work::load`] in runs of particles.
 pub(crate) fn load(slots: &mut [Slot], x: &[Vector3<f32>], w: &[f32], r: &[Vector3<f32>]) {
-    let c = PARTICLE_CHUNK;
-    slots
-        .par_chunks_mut(c)
-        .zip(x.par_chunks(c))
-        .zip(w.par_chunks(c))
-        .zip(r.par_chunks(c))
-        .for_each(|(((s, x), w), r)| work::load_run(s, x, w, r));
+    let n = slots.len().min(x.len()).min(w.len()).min(r.len());
+    let s = Shared::new(slots);
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each particle to one call only.
+        let slots = unsafe { s.run(i.clone()) };
+        work::load_run(slots, &x[i.clone()], &w[i.clone()], &r[i]);
+        Nothing
+    });
 }
 
-/// [`crate::work::store`] in runs of [`PARTICLE_CHUNK`] particles.
+/// [`crate::work::store`] in runs of particles.
 pub(crate) fn store(slots: &[Slot], x: &mut [Vector3<f32>], r: &mut [Vector3<f32>]) {
-    let c = PARTICLE_CHUNK;
-    slots
-        .par_chunks(c)
-        .zip(x.par_chunks_mut(c))
-        .zip(r.par_chunks_mut(c))
-        .for_each(|((s, x), r)| work::store_run(s, x, r));
+    let n = slots.len().min(x.len()).min(r.len());
+    let (xs, rs) = (Shared::new(x), Shared::new(r));
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each particle to one call only.
+        let (x, r) = unsafe { (xs.run(i.clone()), rs.run(i.clone())) };
+        work::store_run(&slots[i], x, r);
+        Nothing
+    });
 }
 
 /// Shared access to a body's working copy for the projections of one colour class.
@@ -158,30 +170,6 @@ impl ParticleAccess for SharedAccess {
     }
 }
 
-/// A mutable slice shared by the threads of one sweep, each taking disjoint runs.
-struct SharedItems<T> {
-    ptr: *mut T,
-    len: usize,
-}
-
-// SAFETY: the threads of a sweep take the runs of [`SharedItems::run`] from
-// [`crate::schedule::run_phases`], which hands every item of a phase to exactly one call;
-// the slice is borrowed mutably for the whole sweep, so no other access exists meanwhile.
-unsafe impl<T: Send> Sync for SharedItems<T> {}
-
-impl<T> SharedItems<T> {
-    /// The items `range`.
-    ///
-    /// # Safety
-    /// No other live reference may overlap `range`.
-    #[allow(clippy::mut_from_ref)]
-    unsafe fn run(&self, range: std::ops::Range<usize>) -> &mut [T] {
-        assert!(range.start <= range.end && range.end <= self.len);
-        // SAFETY: in bounds (checked); exclusive by the caller's guarantee.
-        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(range.start), range.len()) }
-    }
-}
-
 /// Runs `f` over every class, classes in order, in one parallel region
 /// ([`crate::schedule::run_phases`]: the classes are its phases). `f` gets the access, the
 /// run's first item index, the run's multipliers and whether the run is independent.
@@ -191,11 +179,8 @@ fn sweep<T: Send>(
     acc: SharedAccess,
     f: impl Fn(&mut SharedAccess, usize, &mut [T], bool) -> ProjectionCount + Sync,
 ) -> ProjectionCount {
-    let shared = SharedItems {
-        ptr: items.as_mut_ptr(),
-        len: items.len(),
-    };
-    crate::schedule::run_phases(
+    let shared = Shared::new(items);
+    run_phases(
         classes.len(),
         crate::schedule::CLASS_CHUNK,
         |k| {

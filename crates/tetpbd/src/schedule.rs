@@ -96,6 +96,46 @@ impl Cut {
     }
 }
 
+/// The result of a pass that counts nothing.
+#[derive(Default)]
+pub(crate) struct Nothing;
+
+impl AddAssign for Nothing {
+    fn add_assign(&mut self, _: Nothing) {}
+}
+
+/// A mutable slice shared by the threads of one parallel region, each taking disjoint runs.
+pub(crate) struct Shared<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+// SAFETY: the threads of a region take the runs of [`Shared::run`] as [`run_phases`] hands
+// them out, every item of a phase to exactly one call; the slice is borrowed mutably for the
+// whole region (`Shared::new`), so no other access exists meanwhile.
+unsafe impl<T: Send> Sync for Shared<T> {}
+
+impl<T> Shared<T> {
+    /// Shares `items` (borrowed mutably for as long as the `Shared` lives).
+    pub fn new(items: &mut [T]) -> Shared<T> {
+        Shared {
+            ptr: items.as_mut_ptr(),
+            len: items.len(),
+        }
+    }
+
+    /// The items `range`.
+    ///
+    /// # Safety
+    /// No other live reference may overlap `range`.
+    #[allow(clippy::mut_from_ref)]
+    pub unsafe fn run(&self, range: Range<usize>) -> &mut [T] {
+        assert!(range.start <= range.end && range.end <= self.len);
+        // SAFETY: in bounds (checked); exclusive by the caller's guarantee.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(range.start), range.len()) }
+    }
+}
+
 /// Claims the next chunk of `region` below `end` (its count over all phases), if any.
 fn claim(region: &Region, end: usize) -> Option<usize> {
     let mut c = region.claimed.load(Ordering::Relaxed);
@@ -184,7 +224,9 @@ pub(crate) fn run_phases<C: Default + AddAssign + Send>(
             *t += count;
         }
     };
-    fan_out(threads, &worker);
+    if !crate::team::post(&worker) {
+        fan_out(threads, &worker);
+    }
     total.into_inner().unwrap_or_default()
 }
 

@@ -201,8 +201,18 @@ impl Solver {
         world: &mut World,
         hook: &mut dyn SubstepHook,
     ) -> Result<StepStats, SettingsError> {
+        self.settings.validate()?;
+        // With the `parallel` feature, the pool's other threads stay awake for the step
+        // (crate::team), so the parallel passes of large bodies need not wake them.
+        #[cfg(feature = "parallel")]
+        return crate::team::with_team(|| self.run_step(world, hook));
+        #[cfg(not(feature = "parallel"))]
+        self.run_step(world, hook)
+    }
+
+    /// One frame with validated settings.
+    fn run_step(&self, world: &mut World, hook: &mut dyn SubstepHook) -> Result<StepStats, SettingsError> {
         let s = &self.settings;
-        s.validate()?;
         let start = Instant::now();
         let mut stats = StepStats {
             substeps: s.substeps,
