@@ -98,6 +98,17 @@ pub(crate) fn update_velocities(
     })
 }
 
+/// Fills `items` with `value`, in runs of [`PARTICLE_CHUNK`] items.
+pub(crate) fn fill<T: Copy + Send + Sync>(items: &mut [T], value: T) {
+    let n = items.len();
+    let shared = Shared::new(items);
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each item to one call only.
+        unsafe { shared.run(i) }.fill(value);
+        Nothing
+    });
+}
+
 /// [`crate::work::load`] in runs of particles.
 pub(crate) fn load(slots: &mut [Slot], x: &[Vector3<f32>], w: &[f32], r: &[Vector3<f32>]) {
     let n = slots.len().min(x.len()).min(w.len()).min(r.len());

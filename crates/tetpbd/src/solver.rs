@@ -211,7 +211,11 @@ impl Solver {
     }
 
     /// One frame with validated settings.
-    fn run_step(&self, world: &mut World, hook: &mut dyn SubstepHook) -> Result<StepStats, SettingsError> {
+    fn run_step(
+        &self,
+        world: &mut World,
+        hook: &mut dyn SubstepHook,
+    ) -> Result<StepStats, SettingsError> {
         let s = &self.settings;
         let start = Instant::now();
         let mut stats = StepStats {

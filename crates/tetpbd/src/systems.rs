@@ -126,14 +126,24 @@ pub fn add_compensated(x: &mut Vector3<f32>, r: &mut Vector3<f32>, d: Vector3<f3
 /// Sets every multiplier λ to zero (start of a substep).
 pub fn reset_lambdas(world: &mut World) {
     for e in world.query_mut::<&mut EdgeConstraints>() {
-        e.lambdas.fill(0.0);
+        zero(&mut e.lambdas);
     }
     for v in world.query_mut::<&mut VertexFaceConstraints>() {
-        v.lambdas.fill([0.0; 4]);
+        zero(&mut v.lambdas);
     }
     for v in world.query_mut::<&mut VolumeConstraints>() {
-        v.lambdas.fill(0.0);
+        zero(&mut v.lambdas);
     }
+}
+
+/// Sets every multiplier of a family to zero (in parallel on a large family).
+fn zero<T: Default + Copy + Send + Sync>(lambdas: &mut [T]) {
+    #[cfg(feature = "parallel")]
+    if crate::parallel::worth_it(lambdas.len()) {
+        crate::parallel::fill(lambdas, T::default());
+        return;
+    }
+    lambdas.fill(T::default());
 }
 
 /// Which kernels the projections run on.
