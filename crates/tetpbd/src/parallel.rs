@@ -29,7 +29,7 @@ const MIN_PARALLEL_PARTICLES: usize = 4096;
 
 /// Whether a family of `len` constraints runs on the pool: large enough, and the pool has
 /// more than one thread (on one thread the serial sweep does the same work without the
-/// per-class task overhead; the results are bit-identical either way).
+/// region's claims and waits; the results are bit-identical either way).
 pub(crate) fn worth_it(len: usize) -> bool {
     len >= MIN_PARALLEL && rayon::current_num_threads() > 1
 }

@@ -35,6 +35,7 @@
 use std::ops::{AddAssign, Range};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
 use crate::lanes::LANES;
 
@@ -152,16 +153,39 @@ fn claim(region: &Region, end: usize) -> Option<usize> {
     None
 }
 
-/// Spins until `counter` reaches `target` (acquiring the writes of the chunks it counts),
-/// yielding the core now and then in case the thread it waits for is not running.
+/// Spins until `counter` reaches `target` (acquiring the writes of the chunks it counts).
 fn wait_for(counter: &AtomicUsize, target: usize) {
-    let mut spins = 0u32;
+    let mut backoff = Backoff::default();
     while counter.load(Ordering::Acquire) < target {
-        spins = spins.wrapping_add(1);
-        if spins.is_multiple_of(256) {
-            std::thread::yield_now();
-        } else {
+        backoff.wait();
+    }
+}
+
+/// How long a wait spins (yielding the core every 256 rounds) before it sleeps between
+/// checks: on a loaded machine the thread waited for may not be running, and a spinning
+/// waiter would hold the core it needs.
+const SLEEP_AFTER: Duration = Duration::from_micros(200);
+
+/// One waiting loop's state: spin, yield now and then, sleep after [`SLEEP_AFTER`].
+#[derive(Default)]
+pub(crate) struct Backoff {
+    spins: u32,
+    start: Option<Instant>,
+}
+
+impl Backoff {
+    /// One round of waiting.
+    pub fn wait(&mut self) {
+        self.spins = self.spins.wrapping_add(1);
+        if !self.spins.is_multiple_of(256) {
             std::hint::spin_loop();
+            return;
+        }
+        let start = *self.start.get_or_insert_with(Instant::now);
+        if start.elapsed() > SLEEP_AFTER {
+            std::thread::sleep(Duration::from_micros(20));
+        } else {
+            std::thread::yield_now();
         }
     }
 }

@@ -25,6 +25,8 @@ use std::cell::{Cell, UnsafeCell};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
+use crate::schedule::Backoff;
+
 /// How long a helper waits for the next job before it leaves the team.
 const LINGER: Duration = Duration::from_micros(500);
 
@@ -198,14 +200,9 @@ pub(crate) fn post(worker: &(dyn Fn() + Sync)) -> bool {
     team.epoch.fetch_add(1, Ordering::SeqCst);
     worker();
     team.epoch.fetch_add(1, Ordering::SeqCst);
-    let mut spins = 0u32;
+    let mut backoff = Backoff::default();
     while team.active.load(Ordering::SeqCst) > 0 {
-        spins = spins.wrapping_add(1);
-        if spins.is_multiple_of(256) {
-            std::thread::yield_now();
-        } else {
-            std::hint::spin_loop();
-        }
+        backoff.wait();
     }
     // SAFETY: the epoch is even again and `active` drained: no helper reads the job.
     unsafe { *team.job.get() = None };
