@@ -34,6 +34,17 @@ pub(crate) fn worth_it(len: usize) -> bool {
     len >= MIN_PARALLEL && rayon::current_num_threads() > 1
 }
 
+/// Whether some body of `world` takes a parallel path (so a step is worth a team).
+pub(crate) fn any_parallel(world: &mut hecs::World) -> bool {
+    use crate::{EdgeConstraints, Particles};
+    let mut q = world.query::<(&Particles, Option<&EdgeConstraints>, Option<&Tetrahedra>)>();
+    q.iter().any(|(p, e, t)| {
+        particles_worth_it(p.len())
+            || e.is_some_and(|e| worth_it(e.len()))
+            || t.is_some_and(|t| worth_it(t.len()))
+    })
+}
+
 /// Whether a pass over `len` particles runs on the pool.
 pub(crate) fn particles_worth_it(len: usize) -> bool {
     len >= MIN_PARALLEL_PARTICLES && rayon::current_num_threads() > 1

@@ -202,11 +202,13 @@ impl Solver {
         hook: &mut dyn SubstepHook,
     ) -> Result<StepStats, SettingsError> {
         self.settings.validate()?;
-        // With the `parallel` feature, the pool's other threads stay awake for the step
-        // (crate::team), so the parallel passes of large bodies need not wake them.
+        // With the `parallel` feature and a body large enough for a parallel pass, the pool's
+        // other threads stay awake for the step (crate::team), so the passes need not wake
+        // them.
         #[cfg(feature = "parallel")]
-        return crate::team::with_team(|| self.run_step(world, hook));
-        #[cfg(not(feature = "parallel"))]
+        if crate::parallel::any_parallel(world) {
+            return crate::team::with_team(|| self.run_step(world, hook));
+        }
         self.run_step(world, hook)
     }
 
