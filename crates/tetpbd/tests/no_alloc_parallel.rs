@@ -6,12 +6,12 @@
 //! and the only other thread is the test harness's, waiting for this test.
 #![cfg(feature = "parallel")]
 
+mod common;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use nalgebra::Vector3;
-use tetpbd::generators::{box_grid, CellSplit};
-use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings};
+use tetpbd::{Particles, Solver, SolverSettings};
 
 /// Counts the allocations of all threads.
 struct Counting;
@@ -56,18 +56,7 @@ fn parallel_steps_after_the_first_allocate_nothing() {
         .unwrap();
     let mut world = hecs::World::new();
     // 16³ cells: 4913 particles and 24 576 tetrahedra, above every parallel threshold.
-    let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [16; 3], CellSplit::Six).unwrap();
-    let top: Vec<u32> = (0..mesh.vertices.len() as u32)
-        .filter(|&i| mesh.vertices[i as usize].y > 0.49)
-        .collect();
-    let body = SoftBodyBuilder::new(mesh)
-        .edges(1e-6)
-        .volume(0.0)
-        .vertex_face(1e-5)
-        .pinned(top)
-        .build()
-        .unwrap()
-        .spawn(&mut world);
+    let body = common::hanging_cube(&mut world, 16);
     let mut solver = Solver::new(SolverSettings {
         substeps: 4,
         max_correction_speed: Some(10.0),
