@@ -39,10 +39,14 @@ mod parallel;
 mod particles;
 mod projection;
 mod runs;
+#[cfg(feature = "parallel")]
+mod schedule;
 mod solver;
 mod stacking;
 mod stats;
 pub mod systems;
+#[cfg(feature = "parallel")]
+mod team;
 mod work;
 
 pub use builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};

@@ -39,13 +39,25 @@ pub struct ColourClasses {
 }
 
 impl ColourClasses {
+    /// Number of classes.
+    pub fn len(&self) -> usize {
+        self.starts.len().saturating_sub(1)
+    }
+
+    /// `true` when there are no classes (no items).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Class `k` (`k < len()`) as a range, with `true` when its items are independent.
+    pub fn class(&self, k: usize) -> (std::ops::Range<usize>, bool) {
+        let range = self.starts[k] as usize..self.starts[k + 1] as usize;
+        (range, !(self.overflow && k + 1 == self.len()))
+    }
+
     /// The classes as ranges, each with `true` when its items are independent.
     pub fn ranges(&self) -> impl Iterator<Item = (std::ops::Range<usize>, bool)> + '_ {
-        let n = self.starts.len().saturating_sub(1);
-        self.starts
-            .windows(2)
-            .enumerate()
-            .map(move |(k, w)| (w[0] as usize..w[1] as usize, !(self.overflow && k + 1 == n)))
+        (0..self.len()).map(|k| self.class(k))
     }
 }
 

@@ -1,31 +1,148 @@
 //! Parallel Gauss–Seidel (feature `parallel`): within a colour class no two constraints
-//! share a particle, so a class's projections run concurrently on rayon's pool and the
-//! result is bit-identical to the serial sweep, for any number of threads. Classes run one
-//! after another; the overflow class (see [`crate::ordering`]) runs serially.
+//! share a particle, so a class's projections run concurrently and the result is
+//! bit-identical to the serial sweep, for any number of threads. A family's sweep is one
+//! parallel region whose phases are the classes, run one after another
+//! ([`crate::schedule::run_phases`]); the overflow class (see [`crate::ordering`]) runs on
+//! one thread. The passes over the particles of a large body (prediction, the copies into
+//! and out of the working copy, the velocity update) run the same way as one phase of runs
+//! of particles: each particle's update is independent, so they are bit-identical too.
+//! Inside [`crate::Solver::step`] every region is posted to the step's team
+//! ([`crate::team`]) instead of waking the pool's threads.
 
 use nalgebra::Vector3;
-use rayon::prelude::*;
 use wide::f32x4;
 
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::mesh::Tetrahedra;
 use crate::projection::ParticleAccess;
 use crate::runs::{edge_run, vertex_face_run, volume_run};
-use crate::systems::{Kernel, ProjectionCount};
-use crate::work::{Slot, WorkAccess};
+use crate::schedule::{run_phases, Nothing, Shared, PARTICLE_CHUNK};
+use crate::systems::{Kernel, PredictRun, ProjectionCount, VelocityRun, VelocityUpdate};
+use crate::work::{self, Slot, WorkAccess};
 
 /// Bodies with fewer constraints in a family than this take the serial path.
 const MIN_PARALLEL: usize = 4096;
 
+/// Bodies with fewer particles than this run the passes over the particles (prediction,
+/// copies, velocity update) serially.
+const MIN_PARALLEL_PARTICLES: usize = 4096;
+
 /// Whether a family of `len` constraints runs on the pool: large enough, and the pool has
 /// more than one thread (on one thread the serial sweep does the same work without the
-/// per-class task overhead; the results are bit-identical either way).
+/// region's claims and waits; the results are bit-identical either way).
 pub(crate) fn worth_it(len: usize) -> bool {
     len >= MIN_PARALLEL && rayon::current_num_threads() > 1
 }
 
-/// Items per rayon task (a multiple of the SIMD lanes).
-const CHUNK: usize = 256;
+/// Whether some body of `world` takes a parallel path (so a step is worth a team).
+pub(crate) fn any_parallel(world: &mut hecs::World) -> bool {
+    use crate::{EdgeConstraints, Particles};
+    let mut q = world.query::<(&Particles, Option<&EdgeConstraints>, Option<&Tetrahedra>)>();
+    q.iter().any(|(p, e, t)| {
+        particles_worth_it(p.len())
+            || e.is_some_and(|e| worth_it(e.len()))
+            || t.is_some_and(|t| worth_it(t.len()))
+    })
+}
+
+/// Whether a pass over `len` particles runs on the pool.
+pub(crate) fn particles_worth_it(len: usize) -> bool {
+    len >= MIN_PARALLEL_PARTICLES && rayon::current_num_threads() > 1
+}
+
+/// Runs `f` over runs of [`PARTICLE_CHUNK`] of `len` particles on the pool, summing what it
+/// returns.
+fn particle_pass<C: Default + std::ops::AddAssign + Send>(
+    len: usize,
+    f: impl Fn(std::ops::Range<usize>) -> C + Sync,
+) -> C {
+    run_phases(1, PARTICLE_CHUNK, |_| (len, true), |_, r| f(r))
+}
+
+/// [`crate::systems::predict`] of one body, in runs of particles.
+pub(crate) fn predict(run: PredictRun<'_>, a: Vector3<f32>, h: f32, keep: f32) {
+    let n = run.positions.len();
+    let (x, xp, v, r) = (
+        Shared::new(run.positions),
+        Shared::new(run.prev_positions),
+        Shared::new(run.velocities),
+        Shared::new(run.residuals),
+    );
+    let w = run.inv_masses;
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each particle to one call only.
+        let run = unsafe {
+            PredictRun {
+                positions: x.run(i.clone()),
+                prev_positions: xp.run(i.clone()),
+                velocities: v.run(i.clone()),
+                inv_masses: &w[i.clone()],
+                residuals: r.run(i),
+            }
+        };
+        run.predict(a, h, keep);
+        Nothing
+    });
+}
+
+/// [`crate::systems::update_velocities`] of one body, in runs of particles (the counts are
+/// sums, whatever the split).
+pub(crate) fn update_velocities(
+    run: VelocityRun<'_>,
+    h: f32,
+    max_correction_speed: Option<f32>,
+) -> VelocityUpdate {
+    let n = run.positions.len();
+    let (x, v) = (Shared::new(run.positions), Shared::new(run.velocities));
+    let (xp, r) = (run.prev_positions, run.residuals);
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each particle to one call only.
+        let run = unsafe {
+            VelocityRun {
+                positions: x.run(i.clone()),
+                prev_positions: &xp[i.clone()],
+                velocities: v.run(i.clone()),
+                residuals: &r[i],
+            }
+        };
+        run.update(h, max_correction_speed)
+    })
+}
+
+/// Fills `items` with `value`, in runs of [`PARTICLE_CHUNK`] items.
+pub(crate) fn fill<T: Copy + Send + Sync>(items: &mut [T], value: T) {
+    let n = items.len();
+    let shared = Shared::new(items);
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each item to one call only.
+        unsafe { shared.run(i) }.fill(value);
+        Nothing
+    });
+}
+
+/// [`crate::work::load`] in runs of particles.
+pub(crate) fn load(slots: &mut [Slot], x: &[Vector3<f32>], w: &[f32], r: &[Vector3<f32>]) {
+    let n = slots.len().min(x.len()).min(w.len()).min(r.len());
+    let s = Shared::new(slots);
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each particle to one call only.
+        let slots = unsafe { s.run(i.clone()) };
+        work::load_run(slots, &x[i.clone()], &w[i.clone()], &r[i]);
+        Nothing
+    });
+}
+
+/// [`crate::work::store`] in runs of particles.
+pub(crate) fn store(slots: &[Slot], x: &mut [Vector3<f32>], r: &mut [Vector3<f32>]) {
+    let n = slots.len().min(x.len()).min(r.len());
+    let (xs, rs) = (Shared::new(x), Shared::new(r));
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each particle to one call only.
+        let (x, r) = unsafe { (xs.run(i.clone()), rs.run(i.clone())) };
+        work::store_run(&slots[i], x, r);
+        Nothing
+    });
+}
 
 /// Shared access to a body's working copy for the projections of one colour class.
 #[derive(Clone, Copy)]
@@ -75,33 +192,31 @@ impl ParticleAccess for SharedAccess {
     }
 }
 
-/// Runs `f` over every class: independent classes split into chunks of [`CHUNK`] items
-/// run in parallel, the overflow class serially. `f` gets the access, the run's first item
-/// index, the run's multipliers and whether the run is independent.
+/// Runs `f` over every class, classes in order, in one parallel region
+/// ([`crate::schedule::run_phases`]: the classes are its phases). `f` gets the access, the
+/// run's first item index, the run's multipliers and whether the run is independent.
 fn sweep<T: Send>(
     classes: &crate::ordering::ColourClasses,
     items: &mut [T],
     acc: SharedAccess,
     f: impl Fn(&mut SharedAccess, usize, &mut [T], bool) -> ProjectionCount + Sync,
 ) -> ProjectionCount {
-    let mut total = ProjectionCount::default();
-    for (range, independent) in classes.ranges() {
-        let start = range.start;
-        let class = &mut items[range];
-        if independent {
-            total += class
-                .par_chunks_mut(CHUNK)
-                .enumerate()
-                .map(|(c, chunk)| f(&mut { acc }, start + c * CHUNK, chunk, true))
-                .reduce(ProjectionCount::default, |mut a, b| {
-                    a += b;
-                    a
-                });
-        } else {
-            total += f(&mut { acc }, start, class, false);
-        }
-    }
-    total
+    let shared = Shared::new(items);
+    run_phases(
+        classes.len(),
+        crate::schedule::CLASS_CHUNK,
+        |k| {
+            let (r, independent) = classes.class(k);
+            (r.len(), independent)
+        },
+        |k, within| {
+            let (r, independent) = classes.class(k);
+            let first = r.start + within.start;
+            // SAFETY: `run_phases` hands each item of a class to one call only.
+            let run = unsafe { shared.run(first..r.start + within.end) };
+            f(&mut { acc }, first, run, independent)
+        },
+    )
 }
 
 pub(crate) fn edges(

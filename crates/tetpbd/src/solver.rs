@@ -8,6 +8,7 @@ use nalgebra::Vector3;
 use crate::error::SettingsError;
 use crate::stats::{Family, StepStats};
 use crate::systems;
+use crate::work::{self, CopyMode};
 
 /// Settings of a [`Solver`]. Fields are public; [`SolverSettings::validate`] (called by every
 /// step) rejects bad values with a typed error before they reach the state.
@@ -170,7 +171,9 @@ impl<H: SubstepHook + ?Sized> SubstepHook for &mut H {
 /// for each of `substeps` substeps (h = dt / substeps):
 ///     predict            x_prev ← x; v ← (v + h(g + a))·damping; x ← x + h v
 ///     reset λ
-///     repeat `iterations` times: project families in `order`, then hook.project
+///     repeat `iterations` times:
+///         copy the particles into the projections' working copy (crate::work)
+///         project families in `order` on it, copy back, then hook.project
 ///     update velocities  v ← (x − x_prev) / h
 ///     hook.end_substep
 /// ```
@@ -198,8 +201,24 @@ impl Solver {
         world: &mut World,
         hook: &mut dyn SubstepHook,
     ) -> Result<StepStats, SettingsError> {
+        self.settings.validate()?;
+        // With the `parallel` feature and a body large enough for a parallel pass, the pool's
+        // other threads stay awake for the step (crate::team), so the passes need not wake
+        // them.
+        #[cfg(feature = "parallel")]
+        if crate::parallel::any_parallel(world) {
+            return crate::team::with_team(|| self.run_step(world, hook));
+        }
+        self.run_step(world, hook)
+    }
+
+    /// One frame with validated settings.
+    fn run_step(
+        &self,
+        world: &mut World,
+        hook: &mut dyn SubstepHook,
+    ) -> Result<StepStats, SettingsError> {
         let s = &self.settings;
-        s.validate()?;
         let start = Instant::now();
         let mut stats = StepStats {
             substeps: s.substeps,
@@ -226,18 +245,20 @@ impl Solver {
             hook.begin_substep(world, h);
             hook_time += t.elapsed();
             for _ in 0..s.iterations {
+                let t = Instant::now();
+                work::load_bodies(world);
+                stats.copy_time += t.elapsed();
                 for family in s.order {
                     let t = Instant::now();
-                    let c = match family {
-                        Family::Edge => systems::project_edges_with(world, h, s.kernel),
-                        Family::VertexFace => systems::project_vertex_face_with(world, h, s.kernel),
-                        Family::Volume => systems::project_volume_with(world, h, s.kernel),
-                    };
+                    let c = systems::project_family(world, family, h, s.kernel, CopyMode::Resident);
                     let f = stats.family_mut(family);
                     f.time += t.elapsed();
                     f.projections += c.applied;
                     f.degenerate += c.degenerate;
                 }
+                let t = Instant::now();
+                work::store_bodies(world);
+                stats.copy_time += t.elapsed();
                 let t = Instant::now();
                 hook.project(world, h);
                 hook_time += t.elapsed();

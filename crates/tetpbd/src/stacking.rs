@@ -297,7 +297,7 @@ pub fn project_stacked(
         mut vertex_face,
         mut volume,
     } = families;
-    work::with_access(p, |inner| {
+    work::with_access(p, work::CopyMode::PerSweep, |inner| {
         let mut acc = Frozen {
             inner,
             level: &layers.level,

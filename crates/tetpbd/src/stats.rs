@@ -115,6 +115,9 @@ pub struct StepStats {
     pub predict_time: Duration,
     /// Time in the velocity update.
     pub velocity_time: Duration,
+    /// Time copying the particles into the projections' working copy and back, once per
+    /// iteration (the families' times exclude it).
+    pub copy_time: Duration,
     /// Time in user hooks (e.g. collision constraints).
     pub hook_time: Duration,
     /// Time measuring error after the step.

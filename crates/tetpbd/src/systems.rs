@@ -14,8 +14,8 @@ use crate::mesh::Tetrahedra;
 use crate::particles::{ExternalAcceleration, Particles};
 use crate::projection;
 use crate::runs::{edge_run, vertex_face_run, volume_run};
-use crate::stats::{ErrorAccumulator, ErrorStats};
-use crate::work::{self, WorkAccess};
+use crate::stats::{ErrorAccumulator, ErrorStats, Family};
+use crate::work::{self, CopyMode, WorkAccess};
 
 /// Projections done and skipped by one call of a family system.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -62,6 +62,41 @@ pub fn predict(world: &mut World, h: f32, gravity: Vector3<f32>, damping: f32) {
             residuals,
             ..
         } = p;
+        let run = PredictRun {
+            positions,
+            prev_positions,
+            velocities,
+            inv_masses,
+            residuals,
+        };
+        #[cfg(feature = "parallel")]
+        if crate::parallel::particles_worth_it(run.positions.len()) {
+            crate::parallel::predict(run, a, h, keep);
+            continue;
+        }
+        run.predict(a, h, keep);
+    }
+}
+
+/// The particle arrays [`predict`] writes, for a run of particles.
+pub(crate) struct PredictRun<'a> {
+    pub positions: &'a mut [Vector3<f32>],
+    pub prev_positions: &'a mut [Vector3<f32>],
+    pub velocities: &'a mut [Vector3<f32>],
+    pub inv_masses: &'a [f32],
+    pub residuals: &'a mut [Vector3<f32>],
+}
+
+impl PredictRun<'_> {
+    /// [`predict`] on these particles, with acceleration `a` and damping factor `keep`.
+    pub fn predict(self, a: Vector3<f32>, h: f32, keep: f32) {
+        let PredictRun {
+            positions,
+            prev_positions,
+            velocities,
+            inv_masses,
+            residuals,
+        } = self;
         for i in 0..positions.len() {
             prev_positions[i] = positions[i];
             residuals[i] = Vector3::zeros();
@@ -91,14 +126,24 @@ pub fn add_compensated(x: &mut Vector3<f32>, r: &mut Vector3<f32>, d: Vector3<f3
 /// Sets every multiplier λ to zero (start of a substep).
 pub fn reset_lambdas(world: &mut World) {
     for e in world.query_mut::<&mut EdgeConstraints>() {
-        e.lambdas.fill(0.0);
+        zero(&mut e.lambdas);
     }
     for v in world.query_mut::<&mut VertexFaceConstraints>() {
-        v.lambdas.fill([0.0; 4]);
+        zero(&mut v.lambdas);
     }
     for v in world.query_mut::<&mut VolumeConstraints>() {
-        v.lambdas.fill(0.0);
+        zero(&mut v.lambdas);
     }
+}
+
+/// Sets every multiplier of a family to zero (in parallel on a large family).
+fn zero<T: Default + Copy + Send + Sync>(lambdas: &mut [T]) {
+    #[cfg(feature = "parallel")]
+    if crate::parallel::worth_it(lambdas.len()) {
+        crate::parallel::fill(lambdas, T::default());
+        return;
+    }
+    lambdas.fill(T::default());
 }
 
 /// Which kernels the projections run on.
@@ -126,12 +171,7 @@ pub fn project_edges(world: &mut World, h: f32) -> ProjectionCount {
 /// (which share no particle) are projected concurrently; the result is bit-identical to the
 /// serial sweep.
 pub fn project_edges_with(world: &mut World, h: f32, kernel: Kernel) -> ProjectionCount {
-    let mut count = ProjectionCount::default();
-    for (p, e) in world.query_mut::<(&mut Particles, &mut EdgeConstraints)>() {
-        let alpha_tilde = e.compliance / (h * h);
-        count += work::with_access(p, |acc| edges_of(acc, e, alpha_tilde, kernel));
-    }
-    count
+    project_family(world, Family::Edge, h, kernel, CopyMode::PerSweep)
 }
 
 /// One sweep over every body's [`VertexFaceConstraints`] with the default kernel.
@@ -149,14 +189,7 @@ pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
 /// `p0` along the face's rest-pose normal. That constraint is linear in `p0` and `p1`, always
 /// defined, and re-expands a tetrahedron collapsed to a point.
 pub fn project_vertex_face_with(world: &mut World, h: f32, kernel: Kernel) -> ProjectionCount {
-    let mut count = ProjectionCount::default();
-    for (p, tets, vf) in
-        world.query_mut::<(&mut Particles, &Tetrahedra, &mut VertexFaceConstraints)>()
-    {
-        let alpha_tilde = vf.compliance / (h * h);
-        count += work::with_access(p, |acc| vertex_faces_of(acc, tets, vf, alpha_tilde, kernel));
-    }
-    count
+    project_family(world, Family::VertexFace, h, kernel, CopyMode::PerSweep)
 }
 
 /// One sweep over every body's [`VolumeConstraints`] with the default kernel.
@@ -168,11 +201,45 @@ pub fn project_volume(world: &mut World, h: f32) -> ProjectionCount {
 /// order. A tetrahedron whose gradients vanish (all four points collinear) is skipped and
 /// counted.
 pub fn project_volume_with(world: &mut World, h: f32, kernel: Kernel) -> ProjectionCount {
+    project_family(world, Family::Volume, h, kernel, CopyMode::PerSweep)
+}
+
+/// One sweep of `family` over every body that has it, reaching the particles as `mode` says.
+pub(crate) fn project_family(
+    world: &mut World,
+    family: Family,
+    h: f32,
+    kernel: Kernel,
+    mode: CopyMode,
+) -> ProjectionCount {
     let mut count = ProjectionCount::default();
-    for (p, tets, vol) in world.query_mut::<(&mut Particles, &Tetrahedra, &mut VolumeConstraints)>()
-    {
-        let alpha_tilde = vol.compliance / (h * h);
-        count += work::with_access(p, |acc| volumes_of(acc, tets, vol, alpha_tilde, kernel));
+    match family {
+        Family::Edge => {
+            for (p, e) in world.query_mut::<(&mut Particles, &mut EdgeConstraints)>() {
+                let alpha_tilde = e.compliance / (h * h);
+                count += work::with_access(p, mode, |acc| edges_of(acc, e, alpha_tilde, kernel));
+            }
+        }
+        Family::VertexFace => {
+            for (p, tets, vf) in
+                world.query_mut::<(&mut Particles, &Tetrahedra, &mut VertexFaceConstraints)>()
+            {
+                let alpha_tilde = vf.compliance / (h * h);
+                count += work::with_access(p, mode, |acc| {
+                    vertex_faces_of(acc, tets, vf, alpha_tilde, kernel)
+                });
+            }
+        }
+        Family::Volume => {
+            for (p, tets, vol) in
+                world.query_mut::<(&mut Particles, &Tetrahedra, &mut VolumeConstraints)>()
+            {
+                let alpha_tilde = vol.compliance / (h * h);
+                count += work::with_access(p, mode, |acc| {
+                    volumes_of(acc, tets, vol, alpha_tilde, kernel)
+                });
+            }
+        }
     }
     count
 }
@@ -283,6 +350,47 @@ pub fn update_velocities(
             residuals,
             ..
         } = p;
+        let run = VelocityRun {
+            positions,
+            prev_positions,
+            velocities,
+            residuals,
+        };
+        #[cfg(feature = "parallel")]
+        if crate::parallel::particles_worth_it(run.positions.len()) {
+            out += crate::parallel::update_velocities(run, h, max_correction_speed);
+            continue;
+        }
+        out += run.update(h, max_correction_speed);
+    }
+    out
+}
+
+impl std::ops::AddAssign for VelocityUpdate {
+    fn add_assign(&mut self, o: VelocityUpdate) {
+        self.non_finite_resets += o.non_finite_resets;
+        self.clamped += o.clamped;
+    }
+}
+
+/// The particle arrays [`update_velocities`] uses, for a run of particles.
+pub(crate) struct VelocityRun<'a> {
+    pub positions: &'a mut [Vector3<f32>],
+    pub prev_positions: &'a [Vector3<f32>],
+    pub velocities: &'a mut [Vector3<f32>],
+    pub residuals: &'a [Vector3<f32>],
+}
+
+impl VelocityRun<'_> {
+    /// [`update_velocities`] on these particles.
+    pub fn update(self, h: f32, max_correction_speed: Option<f32>) -> VelocityUpdate {
+        let VelocityRun {
+            positions,
+            prev_positions,
+            velocities,
+            residuals,
+        } = self;
+        let mut out = VelocityUpdate::default();
         for i in 0..positions.len() {
             // Divide, not multiply by 1/h: h · (1/h) ≠ 1 in f32, a bias every substep.
             let mut v = ((positions[i] - prev_positions[i]) + residuals[i]) / h;
@@ -302,8 +410,8 @@ pub fn update_velocities(
                 out.non_finite_resets += 1;
             }
         }
+        out
     }
-    out
 }
 
 /// `|C|` of every constraint at the current positions, per family, over all bodies.

@@ -32,3 +32,21 @@ impl Rng {
         )
     }
 }
+
+/// A cube of `cells³` cells (six tetrahedra each) with its top face pinned and all three
+/// families, spawned into `world`: the body of the parallel tests.
+pub fn hanging_cube(world: &mut hecs::World, cells: u32) -> hecs::Entity {
+    use tetpbd::generators::{box_grid, CellSplit};
+    let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Six).unwrap();
+    let top: Vec<u32> = (0..mesh.vertices.len() as u32)
+        .filter(|&i| mesh.vertices[i as usize].y > 0.49)
+        .collect();
+    tetpbd::SoftBodyBuilder::new(mesh)
+        .edges(1e-6)
+        .volume(0.0)
+        .vertex_face(1e-5)
+        .pinned(top)
+        .build()
+        .unwrap()
+        .spawn(world)
+}

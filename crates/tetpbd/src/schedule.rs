@@ -1,0 +1,320 @@
+//! One parallel region for a whole sweep (feature `parallel`): a sequence of phases (the
+//! colour classes of a family, or the particles of a copy) that must run one after another,
+//! each phase's items split among the threads of rayon's pool.
+//!
+//! Why not one rayon parallel iterator per phase: a sweep of a 100k-tetrahedron body has
+//! 30 classes of tetrahedra (14 of edges), each a few hundred microseconds of work or less.
+//! Between two parallel iterators rayon's idle thread goes to sleep and has to be woken, which
+//! on this virtual machine costs tens of microseconds each time (measured in
+//! docs/performance.md, "Scaling"). Here every thread of the pool enters once per sweep and
+//! waits at a phase boundary by spinning on a counter.
+//!
+//! **Layout.** Each phase is cut into `R` contiguous *regions*, one per thread (`R` = the
+//! pool's threads, at most [`MAX_REGIONS`]), at multiples of [`LANES`] items, and each region
+//! into chunks of a given number of items (a multiple of [`LANES`]). A thread works through its own region first (thread `i`
+//! owns region `i`: consecutive classes of a family cover the mesh in the same order, so the
+//! particles a thread touches stay in its cache from one phase to the next), then takes the
+//! chunks left in other regions. A phase that is not independent (the overflow class) is one
+//! chunk.
+//!
+//! **Claiming and waiting.** Each region has a claim counter and a done counter, both
+//! counting its chunks over all phases so far. A thread claims a chunk of phase `k` with a
+//! compare-and-swap that never passes the region's last chunk of phase `k`, and moves on to
+//! phase `k + 1` only once every region is fully claimed for phase `k`. Before running its
+//! first chunk of phase `k` it waits until every region's done counter has reached the
+//! region's chunks of the phases before `k`. So a thread only ever waits for chunks that other
+//! threads have claimed and are running (a chunk never waits inside): a thread that enters
+//! late, or never (its pool is busy elsewhere), holds nobody up, and one thread alone runs
+//! the sweep serially. No deadlock, whatever the pool does.
+//!
+//! **Determinism.** The chunks cut a phase at multiples of [`LANES`] from the phase's start,
+//! so the SIMD kernels group the same four items as the serial sweep does, and the items of a
+//! phase are independent: the result is bit-identical to the serial sweep for any number of
+//! threads and any assignment of chunks to threads.
+
+use std::ops::{AddAssign, Range};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use crate::lanes::LANES;
+
+/// Constraints per chunk of a colour class: small enough to balance the threads at a class
+/// boundary (a 100k-tetrahedron body has 7–9 chunks per thread in most classes), large
+/// enough that a claim costs little beside it (256 volume projections take about 3 µs; 64
+/// measured 2–4 % slower per frame on 2 threads).
+pub(crate) const CLASS_CHUNK: usize = 256;
+
+/// Particles per chunk of a pass over the particles (a copy, the prediction, the velocity
+/// update: a few nanoseconds per particle).
+pub(crate) const PARTICLE_CHUNK: usize = 1024;
+
+/// Regions per phase at most (threads beyond this share regions).
+const MAX_REGIONS: usize = 16;
+
+/// One region's counters, on a cache line of its own (its owner updates them).
+#[derive(Default)]
+#[repr(align(128))]
+struct Region {
+    claimed: AtomicUsize,
+    done: AtomicUsize,
+}
+
+/// Where a phase of `len` items is cut for `regions` regions.
+#[derive(Clone, Copy)]
+struct Cut {
+    len: usize,
+    independent: bool,
+    regions: usize,
+    chunk: usize,
+}
+
+impl Cut {
+    /// First item of region `r` (`r ≤ regions`).
+    fn bound(&self, r: usize) -> usize {
+        if r >= self.regions {
+            self.len
+        } else {
+            self.len * r / self.regions / LANES * LANES
+        }
+    }
+
+    /// Chunks of region `r`.
+    fn chunks(&self, r: usize) -> usize {
+        if !self.independent {
+            return usize::from(r == 0 && self.len > 0);
+        }
+        (self.bound(r + 1) - self.bound(r)).div_ceil(self.chunk)
+    }
+
+    /// Items of chunk `j` of region `r`.
+    fn items(&self, r: usize, j: usize) -> Range<usize> {
+        if !self.independent {
+            return 0..self.len;
+        }
+        let (lo, hi) = (self.bound(r), self.bound(r + 1));
+        let first = lo + j * self.chunk;
+        first..(first + self.chunk).min(hi)
+    }
+}
+
+/// The result of a pass that counts nothing.
+#[derive(Default)]
+pub(crate) struct Nothing;
+
+impl AddAssign for Nothing {
+    fn add_assign(&mut self, _: Nothing) {}
+}
+
+/// A mutable slice shared by the threads of one parallel region, each taking disjoint runs.
+pub(crate) struct Shared<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+// SAFETY: the threads of a region take the runs of [`Shared::run`] as [`run_phases`] hands
+// them out, every item of a phase to exactly one call; the slice is borrowed mutably for the
+// whole region (`Shared::new`), so no other access exists meanwhile.
+unsafe impl<T: Send> Sync for Shared<T> {}
+
+impl<T> Shared<T> {
+    /// Shares `items` (borrowed mutably for as long as the `Shared` lives).
+    pub fn new(items: &mut [T]) -> Shared<T> {
+        Shared {
+            ptr: items.as_mut_ptr(),
+            len: items.len(),
+        }
+    }
+
+    /// The items `range`.
+    ///
+    /// # Safety
+    /// No other live reference may overlap `range`.
+    #[allow(clippy::mut_from_ref)]
+    pub unsafe fn run(&self, range: Range<usize>) -> &mut [T] {
+        assert!(range.start <= range.end && range.end <= self.len);
+        // SAFETY: in bounds (checked); exclusive by the caller's guarantee.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(range.start), range.len()) }
+    }
+}
+
+/// Claims the next chunk of `region` below `end` (its count over all phases), if any.
+fn claim(region: &Region, end: usize) -> Option<usize> {
+    let mut c = region.claimed.load(Ordering::Relaxed);
+    while c < end {
+        match region
+            .claimed
+            .compare_exchange_weak(c, c + 1, Ordering::Relaxed, Ordering::Relaxed)
+        {
+            Ok(_) => return Some(c),
+            Err(now) => c = now,
+        }
+    }
+    None
+}
+
+/// Spins until `counter` reaches `target` (acquiring the writes of the chunks it counts).
+fn wait_for(counter: &AtomicUsize, target: usize) {
+    let mut backoff = Backoff::default();
+    while counter.load(Ordering::Acquire) < target {
+        backoff.wait();
+    }
+}
+
+/// How long a wait spins (yielding the core every 256 rounds) before it sleeps between
+/// checks: on a loaded machine the thread waited for may not be running, and a spinning
+/// waiter would hold the core it needs.
+const SLEEP_AFTER: Duration = Duration::from_micros(200);
+
+/// One waiting loop's state: spin, yield now and then, sleep after [`SLEEP_AFTER`].
+#[derive(Default)]
+pub(crate) struct Backoff {
+    spins: u32,
+    start: Option<Instant>,
+}
+
+impl Backoff {
+    /// One round of waiting.
+    pub fn wait(&mut self) {
+        self.spins = self.spins.wrapping_add(1);
+        if !self.spins.is_multiple_of(256) {
+            std::hint::spin_loop();
+            return;
+        }
+        let start = *self.start.get_or_insert_with(Instant::now);
+        if start.elapsed() > SLEEP_AFTER {
+            std::thread::sleep(Duration::from_micros(20));
+        } else {
+            std::thread::yield_now();
+        }
+    }
+}
+
+/// Runs `phases` phases in order on every thread of the current rayon pool: phase `k` has
+/// `phase(k) = (len, independent)` items, and `work(k, items)` does the `items` of phase `k`
+/// (indices within the phase), cut in chunks of `chunk` items (rounded up to a multiple of
+/// [`LANES`]). Returns the sum of what `work` returned (summed per thread, then over the
+/// threads: use it for counts, whose sum does not depend on the order).
+///
+/// The items of an independent phase must be pairwise independent (touch disjoint data);
+/// `work` then runs concurrently on disjoint ranges of the phase. A phase that is not
+/// independent runs as one range on one thread.
+pub(crate) fn run_phases<C: Default + AddAssign + Send>(
+    phases: usize,
+    chunk: usize,
+    phase: impl Fn(usize) -> (usize, bool) + Sync,
+    work: impl Fn(usize, Range<usize>) -> C + Sync,
+) -> C {
+    let threads = rayon::current_num_threads();
+    let regions_n = threads.clamp(1, MAX_REGIONS);
+    let chunk = chunk.max(1).next_multiple_of(LANES);
+    let regions: [Region; MAX_REGIONS] = Default::default();
+    let total = Mutex::new(C::default());
+    let worker = || {
+        let home = rayon::current_thread_index().unwrap_or(0) % regions_n;
+        let mut count = C::default();
+        // Chunks of each region in the phases before the current one.
+        let mut before = [0usize; MAX_REGIONS];
+        for k in 0..phases {
+            let (len, independent) = phase(k);
+            let cut = Cut {
+                len,
+                independent,
+                regions: regions_n,
+                chunk,
+            };
+            let mut ready = false;
+            loop {
+                let got = (0..regions_n)
+                    .map(|i| (home + i) % regions_n)
+                    .find_map(|r| {
+                        claim(&regions[r], before[r] + cut.chunks(r)).map(|c| (r, c - before[r]))
+                    });
+                let Some((r, j)) = got else { break };
+                if !ready {
+                    for (region, &b) in regions.iter().zip(&before).take(regions_n) {
+                        wait_for(&region.done, b);
+                    }
+                    ready = true;
+                }
+                count += work(k, cut.items(r, j));
+                regions[r].done.fetch_add(1, Ordering::Release);
+            }
+            for (r, b) in before.iter_mut().enumerate().take(regions_n) {
+                *b += cut.chunks(r);
+            }
+        }
+        // A poisoned lock means another worker panicked; the scope re-raises that panic.
+        if let Ok(mut t) = total.lock() {
+            *t += count;
+        }
+    };
+    if !crate::team::post(&worker) {
+        fan_out(threads, &worker);
+    }
+    total.into_inner().unwrap_or_default()
+}
+
+/// Runs `worker` on up to `n` threads of the pool: this one and `n - 1` rayon jobs others may
+/// steal (`rayon::join`, whose jobs live on the stack: no allocation, unlike a scope's
+/// spawned jobs). A job nobody stole runs here afterwards and finds nothing left to do.
+fn fan_out(n: usize, worker: &(impl Fn() + Sync)) {
+    if n <= 1 {
+        worker();
+    } else {
+        rayon::join(worker, || fan_out(n - 1, worker));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::systems::ProjectionCount;
+
+    /// Every item of every phase is worked exactly once, phases in order, on 1 to 3 threads,
+    /// and the ranges of an independent phase start at multiples of the lanes.
+    #[test]
+    fn every_item_once_phases_in_order() {
+        let lens = [0usize, 1, 5, 63, 64, 65, 1000, 7, 4097];
+        for threads in 1..=3 {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let seen: Vec<Vec<AtomicUsize>> = lens
+                .iter()
+                .map(|&n| (0..n).map(|_| AtomicUsize::new(0)).collect())
+                .collect();
+            let count = pool.install(|| {
+                run_phases(
+                    lens.len(),
+                    CLASS_CHUNK,
+                    |k| (lens[k], k != 7),
+                    |k, items| {
+                        let earlier_done = seen[..k]
+                            .iter()
+                            .flatten()
+                            .all(|s| s.load(Ordering::SeqCst) == 1);
+                        assert!(earlier_done, "phase {k} started before the ones before it");
+                        if k != 7 {
+                            assert_eq!(items.start % LANES, 0);
+                        } else {
+                            assert_eq!(items, 0..lens[k]);
+                        }
+                        for i in items.clone() {
+                            seen[k][i].fetch_add(1, Ordering::SeqCst);
+                        }
+                        ProjectionCount {
+                            applied: items.len() as u64,
+                            degenerate: 1,
+                        }
+                    },
+                )
+            });
+            assert_eq!(count.applied, lens.iter().sum::<usize>() as u64);
+            for (k, s) in seen.iter().enumerate() {
+                assert!(s.iter().all(|x| x.load(Ordering::SeqCst) == 1), "phase {k}");
+            }
+        }
+    }
+}
