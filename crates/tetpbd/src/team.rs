@@ -191,20 +191,33 @@ pub(crate) fn post(worker: &(dyn Fn() + Sync)) -> bool {
         return false;
     }
     // SAFETY: only the lifetime is erased; the job is closed and every helper that may use
-    // it has left it (`active` drained) before this function returns.
+    // it has left it (`active` drained) before this function returns or unwinds (`Close`).
     let job: Job = unsafe {
         std::mem::transmute::<&(dyn Fn() + Sync + '_), &'static (dyn Fn() + Sync)>(worker)
     };
     // SAFETY: the epoch is even (between jobs) and no helper is active, so nobody reads it.
     unsafe { *team.job.get() = Some(job) };
     team.epoch.fetch_add(1, Ordering::SeqCst);
+    // Closes the job when this function is left, also by a panic of `worker`: no helper may
+    // still run the closure once its frame is gone.
+    let _close = Close(team);
     worker();
-    team.epoch.fetch_add(1, Ordering::SeqCst);
-    let mut backoff = Backoff::default();
-    while team.active.load(Ordering::SeqCst) > 0 {
-        backoff.wait();
-    }
-    // SAFETY: the epoch is even again and `active` drained: no helper reads the job.
-    unsafe { *team.job.get() = None };
     true
+}
+
+/// Closes the open job of a team on drop: the epoch made even, then every helper inside the
+/// job waited for.
+struct Close<'a>(&'a Team);
+
+impl Drop for Close<'_> {
+    fn drop(&mut self) {
+        let team = self.0;
+        team.epoch.fetch_add(1, Ordering::SeqCst);
+        let mut backoff = Backoff::default();
+        while team.active.load(Ordering::SeqCst) > 0 {
+            backoff.wait();
+        }
+        // SAFETY: the epoch is even again and `active` drained: no helper reads the job.
+        unsafe { *team.job.get() = None };
+    }
 }
