@@ -237,11 +237,10 @@ impl<'a> RapierContext<'a> {
 ///   (a few cm/s), the one-frame lag between the soft load and rapier's answer.
 /// * The soft load pressing an anchored body onto its supports does not reach rapier: it
 ///   neither tips the body over nor weighs on a dynamic support below it (only the body's
-///   own motion into a support is handed to that support, as an impulse). A body counts as
-///   anchored only while rapier reports an active rigid contact: a light body that a
-///   compliant attachment lifts off its support is a plain dynamic body in the next frame,
-///   and a heavy soft body on it can push it into the ground inside the substeps (a
-///   0.125 kg box under a 100 kg soft cube attached with 1e-5 m/N diverged after about 1 s).
+///   own motion into a support is handed to that support, as an impulse). It stays
+///   immovable against such a load even while an attachment lifts it off its supports: a
+///   0.125 kg box under a 100 kg soft cube attached with 1e-5 m/N gains energy each time the
+///   spring lifts it and diverges within 2 s (`support` module docs, Limits).
 /// * The force and torque of a supported body's load stay in rapier's user force and torque
 ///   of the body until the coupling takes them off after rapier's next step; calling
 ///   `RigidBody::reset_forces`/`reset_torques` on it between two coupled steps leaves their
