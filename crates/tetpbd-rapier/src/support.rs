@@ -78,7 +78,7 @@ pub(crate) struct Support {
     /// Lowest value the constraint may take, m (≤ 0).
     floor: f32,
     /// Friction coefficient of the contact (rapier's combined one).
-    friction: f32,
+    pub friction: f32,
     /// The support's body when it is dynamic, and its world centre of mass, m.
     other: Option<(RigidBodyHandle, Vector3<f32>)>,
     /// Positional impulse on the anchored body in the current substep, kg·m.
@@ -156,6 +156,35 @@ pub(crate) fn gather_supports(
     }
 }
 
+/// Measures each anchored body's clearance above its supports at its current pose: the
+/// smallest support constraint value (m; ≤ 0 where it stands on them).
+pub(crate) fn measure_clearance(supports: &[Support], bodies: &mut [BodyProxy]) {
+    for s in supports {
+        bodies[s.body].set_clearance(f32::INFINITY);
+    }
+    for s in supports {
+        let body = &mut bodies[s.body];
+        let x = (body.pose * Point3::from(s.local)).coords;
+        let c = s.normal.dot(&(x - s.point)) - s.floor;
+        if !c.is_nan() {
+            body.lower_clearance(c);
+        }
+    }
+}
+
+/// Starts a substep of the anchored bodies: measures their clearance and decides which are
+/// held on their supports ([`BodyProxy::hold`]).
+pub(crate) fn hold_supported(supports: &[Support], bodies: &mut [BodyProxy]) {
+    measure_clearance(supports, bodies);
+    let mut last = usize::MAX;
+    for s in supports {
+        if s.body != last {
+            bodies[s.body].hold();
+            last = s.body;
+        }
+    }
+}
+
 /// One sweep over the supports: keeps each anchored body's contact points out of its
 /// supports (the support immovable), with static Coulomb friction on the point's motion
 /// over the substep (as the particle contacts, `contact` module docs).
@@ -172,7 +201,7 @@ pub(crate) fn project_supports(supports: &mut [Support], bodies: &mut [BodyProxy
             continue;
         }
         let p = s.normal * (-c / w);
-        body.apply_position_impulse(&p, &x);
+        body.apply_support_impulse(&p, &x);
         s.sub += p;
         // Friction: undo the tangential motion of the point over the substep, up to
         // μ times the normal impulse of the substep.
@@ -194,7 +223,7 @@ pub(crate) fn project_supports(supports: &mut [Support], bodies: &mut [BodyProxy
         let dl = (len / w).min(room);
         if dl > 0.0 {
             let p = -t * dl;
-            body.apply_position_impulse(&p, &x);
+            body.apply_support_impulse(&p, &x);
             s.sub += p;
         }
     }
