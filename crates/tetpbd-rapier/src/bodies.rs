@@ -20,7 +20,8 @@
 //! A dynamic body in contact with other rigid colliders is *supported*: infinitely heavy
 //! inside the substeps, its summed soft reaction handed to rapier as a force for its next
 //! step. One that also carries an attachment is *anchored* (`support` module docs): it
-//! takes part with its mass, except against impulses pressing it into its supports.
+//! takes part with its mass, except while its supports hold it against the soft load and
+//! against impulses pressing it into supports it stands on.
 
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
@@ -83,8 +84,8 @@ pub(crate) struct BodyProxy {
     impulse: Vector3<f32>,
     angular: Vector3<f32>,
     /// Mean contact normal of an anchored body's rigid supports (unit, towards the body;
-    /// zero for any other body): an impulse pressing the body into them does not move it
-    /// and is left to the supports (`support` module docs).
+    /// zero for any other body): the soft load they hold and impulses pressing the body
+    /// into them are left to them (`support` module docs).
     support_normal: Vector3<f32>,
     /// An anchored body's clearance above its supports (m, the smallest support constraint
     /// value, `support` module docs) when it was last measured, and its centre of mass then.
@@ -191,14 +192,16 @@ impl BodyProxy {
     }
 
     /// Makes a supported body *anchored* (`support` module docs): it takes part with its
-    /// generalized inverse mass, except against impulses pressing it into its supports,
-    /// whose mean contact normal (towards the body) is `normal`. It is written back every
-    /// frame, which also keeps rapier from putting it to sleep: left at rapier's result in
-    /// a frame where the soft body only pressed it into its supports, the scene of
-    /// `tests/issue_3_attachment_with_contacts.rs` (a) diverged after about 2 s.
+    /// generalized inverse mass, except while its supports hold it ([`Self::hold`]) and
+    /// against impulses pressing it into supports it stands on; `normal` is their mean
+    /// contact normal (towards the body), `friction` their smallest friction coefficient.
+    /// It is written back every frame, which also keeps rapier from putting it to sleep:
+    /// left at rapier's result in a frame where the soft body only pressed it into its
+    /// supports, the scene of `tests/issue_3_attachment_with_contacts.rs` (a) diverged
+    /// after about 2 s.
     pub fn anchor(&mut self, normal: Vector3<f32>, friction: f32) {
-        self.friction = friction;
         if self.kind == BodyKind::Supported {
+            self.friction = friction;
             self.kind = BodyKind::Dynamic;
             self.touched = true;
             self.support_normal = normal.try_normalize(1e-6).unwrap_or_default();
@@ -236,8 +239,7 @@ impl BodyProxy {
     /// Whether a soft impulse along `push` moves the body: not on an anchored body that is
     /// held, nor when it presses an anchored body that stands on its supports.
     fn moves(&self, push: &Vector3<f32>) -> bool {
-        !self.is_anchored()
-            || !(self.held || (self.presses(push) && self.clearance() <= TOUCH))
+        !self.is_anchored() || !(self.held || (self.presses(push) && self.clearance() <= TOUCH))
     }
 
     /// Starts a substep of an anchored body, its clearance measured at its new pose: it is

@@ -16,9 +16,7 @@ use crate::restitution::{com_velocity, end_episodes, restitution_pass};
 use crate::rolling::rolling_pass;
 use crate::shape_query::surface_point;
 use crate::stacking::{stacked_velocity_pass, stacking_pass, Stacking};
-use crate::support::{
-    end_substep_supports, hold_supported, measure_clearance, project_supports,
-};
+use crate::support::{end_substep_supports, hold_supported, measure_clearance, project_supports};
 
 /// Borrows the frame state and rapier's query pipeline for one soft step.
 pub(crate) struct CouplingHook<'q, 'a> {
