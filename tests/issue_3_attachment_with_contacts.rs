@@ -8,7 +8,7 @@ use hecs::Entity;
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
-use tetpbd::Particles;
+use tetpbd::{Particles, Tetrahedra};
 use tetpbd_rapier::convert::to_na;
 use tetpbd_rapier::{AttachTarget, Attachments, CoupledWorld, SoftCollider};
 
@@ -83,6 +83,8 @@ struct Sample {
     upright: f32,
     /// Whether every particle position and velocity is finite.
     finite: bool,
+    /// Inverted tetrahedra over the given soft bodies.
+    inverted: usize,
 }
 
 fn sample(
@@ -96,8 +98,11 @@ fn sample(
     let pose = tetpbd_rapier::convert::pose_to_na(rb.position());
     let mut particle_speed = 0.0f32;
     let mut finite = true;
+    let mut inverted = 0;
     for &e in soft {
         let p = scene.soft.get::<&Particles>(e).expect("particles");
+        let t = scene.soft.get::<&Tetrahedra>(e).expect("tetrahedra");
+        inverted += t.count_inverted(p.positions());
         finite &= p
             .positions()
             .iter()
@@ -115,6 +120,7 @@ fn sample(
         box_at: pose.translation.vector,
         upright: (pose.rotation * Vector3::y()).y,
         finite,
+        inverted,
     }
 }
 
@@ -161,12 +167,13 @@ const FPS: usize = 60;
 /// Length of the runs, s.
 const SECONDS: usize = 10;
 
-/// Checks what every scene must keep: finite state in every frame, the attachment holding
-/// (the particle within 2 cm of its anchor through impacts, within `max_gap` once settled)
-/// and, from `settled` on, particles and box slow.
+/// Checks what every scene must keep: finite state and no inverted tetrahedron in every
+/// frame, the attachment holding (the particle within 2 cm of its anchor through impacts,
+/// within `max_gap` once settled) and, from `settled` on, particles and box slow.
 fn check_bounded(name: &str, samples: &[Sample], settled: usize, max_gap: f32) {
     for (f, s) in samples.iter().enumerate() {
         assert!(s.finite, "{name}: non-finite soft state at frame {f}");
+        assert_eq!(s.inverted, 0, "{name}: inverted tetrahedra at frame {f}");
         assert!(
             s.gap < if f >= settled { max_gap } else { 0.02 },
             "{name}: attachment torn to {} m at frame {f}",
@@ -184,40 +191,84 @@ fn check_bounded(name: &str, samples: &[Sample], settled: usize, max_gap: f32) {
     }
 }
 
-/// Scene (a): a 2-cell soft cube (100 kg, or 1000 kg) standing on a 0.125 kg dynamic box
-/// that rests on the ground, its bottom-centre particle pinned to the box. The box touches
-/// the ground (rapier contact) and the soft cube: it used to be flung away within two frames.
-/// Over 10 s the box stays within 5 cm of its place, upright, and the pin holds.
+/// Scene (a): a 2-cell soft cube of `density` standing on a 0.125 kg dynamic box that rests on
+/// the ground, its bottom-centre particle attached to the box with `compliance` (m/N), run
+/// for 10 s; the cube is moved by `shift` (m) off the box's axis. Returns the samples and the
+/// box's start.
+fn cube_on_box(
+    compliance: f32,
+    density: f32,
+    shift: Vector3<f32>,
+) -> (String, Vec<Sample>, Vector3<f32>) {
+    let name = format!(
+        "a (compliance {compliance:e} m/N, density {density} kg/m³, cube moved by {:?} m)",
+        shift.as_slice()
+    );
+    let mut s = scene();
+    let start = Vector3::new(2.0, 0.25, 0.0);
+    let b = rigid_box(&mut s, start);
+    let e = soft_cube(&mut s, 2, Vector3::new(2.0, 1.01, 0.0) + shift, density);
+    let i = nearest(&s, e, Vector3::new(2.0, 0.51, 0.0) + shift);
+    attach(&mut s, e, i, b, compliance);
+    let samples = run(&mut s, SECONDS * FPS, &[e], (e, i), b);
+    print(&name, &samples);
+    (name, samples, start)
+}
+
+/// What scene (a) must keep besides [`check_bounded`]: the box within 5 cm of its place and
+/// upright in every frame, and creeping less than 5 cm from 2 s to 10 s.
+fn check_box_in_place(name: &str, samples: &[Sample], start: Vector3<f32>) {
+    for (f, x) in samples.iter().enumerate() {
+        assert!(
+            (x.box_at - start).norm() < 0.05 && x.upright > 0.99,
+            "{name}: the box left its place at frame {f}: at {:?}, up {}",
+            x.box_at,
+            x.upright
+        );
+    }
+    let creep = (samples[SECONDS * FPS - 1].box_at - samples[2 * FPS - 1].box_at).norm();
+    println!("{name}: box moved {creep:.4} m from 2 s to {SECONDS} s");
+    // The soft cube keeps rocking on the small box top (particle speeds of 0.03–0.2 m/s)
+    // and walks the box about 1 cm/s; that creep is bounded here, not absent.
+    assert!(creep < 0.05, "{name}: the box creeps {creep} m");
+}
+
+/// Scene (a) with a rigid pin (100 kg, or 1000 kg soft cube), the cube centred on the box or
+/// moved by 1–2 mm (the scene is chaotic). The box touches the ground (rapier contact) and
+/// the soft cube: it used to be flung away within two frames. Over 10 s the box stays within
+/// 5 cm of its place, upright, and the pin holds.
 #[test]
 fn soft_cube_attached_to_a_box_on_the_ground() {
-    // Known limit: with a compliant attachment (1e-5 m/N) the spring lifts the box off
-    // the ground; without a rigid contact it is no longer anchored, the soft cube pushes it
-    // into the ground inside the substeps and it diverges after about 1 s.
-    for (compliance, density) in [(0.0, 100.0), (0.0, 1000.0)] {
-        let name = format!("a (compliance {compliance:e} m/N, density {density} kg/m³)");
-        let mut s = scene();
-        let start = Vector3::new(2.0, 0.25, 0.0);
-        let b = rigid_box(&mut s, start);
-        let e = soft_cube(&mut s, 2, Vector3::new(2.0, 1.01, 0.0), density);
-        let i = nearest(&s, e, Vector3::new(2.0, 0.51, 0.0));
-        attach(&mut s, e, i, b, compliance);
-        let samples = run(&mut s, SECONDS * FPS, &[e], (e, i), b);
-        print(&name, &samples);
-        check_bounded(&name, &samples, FPS, 5e-3);
-        for (f, x) in samples.iter().enumerate() {
-            assert!(
-                (x.box_at - start).norm() < 0.05 && x.upright > 0.99,
-                "{name}: the box left its place at frame {f}: at {:?}, up {}",
-                x.box_at,
-                x.upright
-            );
+    let shifts = [
+        Vector3::zeros(),
+        Vector3::new(1e-3, 0.0, 0.0),
+        Vector3::new(0.0, 0.0, 1e-3),
+        Vector3::new(-2e-3, 0.0, 1e-3),
+    ];
+    for density in [100.0, 1000.0] {
+        for shift in shifts {
+            let (name, samples, start) = cube_on_box(0.0, density, shift);
+            check_bounded(&name, &samples, FPS, 5e-3);
+            check_box_in_place(&name, &samples, start);
         }
-        let creep = (samples[SECONDS * FPS - 1].box_at - samples[2 * FPS - 1].box_at).norm();
-        println!("{name}: box moved {creep:.4} m from 2 s to {SECONDS} s");
-        // The soft cube keeps rocking on the small box top (particle speeds of 0.03–0.2 m/s)
-        // and walks the box about 1 cm/s; that creep is bounded here, not absent.
-        assert!(creep < 0.05, "{name}: the box creeps {creep} m");
     }
+}
+
+/// Scene (a) with a compliant attachment (1e-5 m/N, 100 kg soft cube). The anchor lies 1 cm
+/// above the box top (where the particle started), so the cube's weight compresses the
+/// spring by up to about 1 cm before the cube rests on the box (7.6 mm measured with a fixed
+/// box): the attachment is held to 1.2 cm once settled.
+///
+/// It used to diverge within 2 s: every 1–2 s the rocking cube lifted the box off the
+/// ground through the spring while soft impulses pressing the box into its supports still
+/// left it unmoved, and the scene gained 10–60 J in such frames (`support` module docs).
+/// With the cube moved 1 mm sideways it may tip off the box top, as it does off a fixed
+/// box (same docs, Limits); this run does not.
+#[test]
+fn soft_cube_attached_compliantly_to_a_box_on_the_ground() {
+    let (name, samples, start) = cube_on_box(1e-5, 100.0, Vector3::zeros());
+    check_bounded(&name, &samples, FPS, 0.012);
+    check_box_in_place(&name, &samples, start);
 }
 
 /// Scene (b): a 0.125 kg dynamic box resting on a soft cube (soft contacts only), a second

@@ -20,12 +20,16 @@
 //! A dynamic body in contact with other rigid colliders is *supported*: infinitely heavy
 //! inside the substeps, its summed soft reaction handed to rapier as a force for its next
 //! step. One that also carries an attachment is *anchored* (`support` module docs): it
-//! takes part with its mass, except against impulses pressing it into its supports.
+//! takes part with its mass, except while its supports hold it against the soft load and
+//! against impulses pressing it into supports it stands on.
 
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
 
 use crate::convert::{inertia_to_na, pose_to_glam, to_glam, to_na};
+
+/// Clearance (m) up to which an anchored body stands on its supports.
+const TOUCH: f32 = 1e-6;
 
 /// How a body takes part.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -80,9 +84,19 @@ pub(crate) struct BodyProxy {
     impulse: Vector3<f32>,
     angular: Vector3<f32>,
     /// Mean contact normal of an anchored body's rigid supports (unit, towards the body;
-    /// zero for any other body): an impulse pressing the body into them does not move it
-    /// and is left to the supports (`support` module docs).
+    /// zero for any other body): the soft load they hold and impulses pressing the body
+    /// into them are left to them (`support` module docs).
     support_normal: Vector3<f32>,
+    /// An anchored body's clearance above its supports (m, the smallest support constraint
+    /// value, `support` module docs) when it was last measured, and its centre of mass then.
+    clearance: (f32, Vector3<f32>),
+    /// The soft positional impulses on an anchored body (kg·m), moving it or not, summed
+    /// over the current and over the previous substep.
+    soft_load: (Vector3<f32>, Vector3<f32>),
+    /// The smallest friction coefficient of an anchored body's supports.
+    friction: f32,
+    /// Whether an anchored body is held on its supports in this substep ([`Self::hold`]).
+    held: bool,
     /// Linear and angular velocity at the start of the current substep (before any soft
     /// correction), and the centre of mass they refer to.
     pre: (Vector3<f32>, Vector3<f32>, Vector3<f32>),
@@ -169,34 +183,93 @@ impl BodyProxy {
             impulse: Vector3::zeros(),
             angular: Vector3::zeros(),
             support_normal: Vector3::zeros(),
+            clearance: (0.0, Vector3::zeros()),
+            soft_load: (Vector3::zeros(), Vector3::zeros()),
+            friction: 0.0,
+            held: false,
             pre: (Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
         }
     }
 
     /// Makes a supported body *anchored* (`support` module docs): it takes part with its
-    /// generalized inverse mass, except against impulses pressing it into its supports,
-    /// whose mean contact normal (towards the body) is `normal`. It is written back every
-    /// frame, which also keeps rapier from putting it to sleep: left at rapier's result in
-    /// a frame where the soft body only pressed it into its supports, the scene of
-    /// `tests/issue_3_attachment_with_contacts.rs` (a) diverged after about 2 s.
-    pub fn anchor(&mut self, normal: Vector3<f32>) {
+    /// generalized inverse mass, except while its supports hold it ([`Self::hold`]) and
+    /// against impulses pressing it into supports it stands on; `normal` is their mean
+    /// contact normal (towards the body), `friction` their smallest friction coefficient.
+    /// It is written back every frame, which also keeps rapier from putting it to sleep:
+    /// left at rapier's result in a frame where the soft body only pressed it into its
+    /// supports, the scene of `tests/issue_3_attachment_with_contacts.rs` (a) diverged
+    /// after about 2 s.
+    pub fn anchor(&mut self, normal: Vector3<f32>, friction: f32) {
         if self.kind == BodyKind::Supported {
+            self.friction = friction;
             self.kind = BodyKind::Dynamic;
             self.touched = true;
             self.support_normal = normal.try_normalize(1e-6).unwrap_or_default();
         }
     }
 
+    /// Records an anchored body's clearance `gap` (m) above its supports at its current pose.
+    pub fn set_clearance(&mut self, gap: f32) {
+        self.clearance = (gap, self.com());
+    }
+
+    /// Lowers the recorded clearance to `gap` (m) if it is smaller.
+    pub fn lower_clearance(&mut self, gap: f32) {
+        self.clearance.0 = self.clearance.0.min(gap);
+    }
+
+    /// The anchored body's clearance above its supports now, m: the last measured one plus
+    /// the motion of its centre of mass along their mean normal since (its turn is left out).
+    fn clearance(&self) -> f32 {
+        let (gap, com) = self.clearance;
+        gap + self.support_normal.dot(&(self.com() - com))
+    }
+
+    /// `true` for an anchored body.
+    fn is_anchored(&self) -> bool {
+        self.kind == BodyKind::Dynamic && self.support_normal != Vector3::zeros()
+    }
+
     /// Whether an impulse along `push` presses an anchored body into its supports (more
     /// than 60° against their mean normal).
-    fn pressed(&self, push: &Vector3<f32>) -> bool {
+    fn presses(&self, push: &Vector3<f32>) -> bool {
         self.support_normal.dot(push) < -0.5 * push.norm()
     }
 
+    /// Whether a soft impulse along `push` moves the body: not on an anchored body that is
+    /// held, nor when it presses an anchored body that stands on its supports.
+    fn moves(&self, push: &Vector3<f32>) -> bool {
+        !self.is_anchored() || !(self.held || (self.presses(push) && self.clearance() <= TOUCH))
+    }
+
+    /// Starts a substep of an anchored body, its clearance measured at its new pose: it is
+    /// *held* when it stands on its supports and the soft impulses of the previous substep,
+    /// summed, lie in their friction cone (pressing it into them, their tangential part at
+    /// most μ times their normal part). A held body keeps its offset from the previous
+    /// substep (it moves along rapier's path only) and soft impulses do not move it.
+    pub fn hold(&mut self) {
+        let n = self.support_normal;
+        let load = self.soft_load.1;
+        let press = -n.dot(&load);
+        self.held = self.is_anchored()
+            && self.clearance() <= TOUCH
+            && press >= 0.0
+            && (load + n * press).norm() <= self.friction * press;
+        if self.held {
+            self.dx = self.dx_sub;
+            self.dq = self.dq_sub;
+            self.dv = Vector3::zeros();
+            self.dw = Vector3::zeros();
+            let frac = self.frac;
+            self.set_pose(frac);
+            self.record_substep_start();
+        }
+    }
+
     /// [`Self::inv_mass_at`] for a constraint that pushes the body along `push`: 0 when the
-    /// push presses an anchored body into its supports.
+    /// push does not move it.
     pub fn inv_mass_pushed(&self, q: &Vector3<f32>, push: &Vector3<f32>) -> f32 {
-        if self.pressed(push) {
+        if !self.moves(push) {
             return 0.0;
         }
         self.inv_mass_at(q, &push.try_normalize(1e-12).unwrap_or_default())
@@ -211,6 +284,8 @@ impl BodyProxy {
     pub fn begin_substep(&mut self, frac: f32, h: f32) {
         self.h = h;
         self.prev = self.pose;
+        self.soft_load = (Vector3::zeros(), self.soft_load.0);
+        self.held = false;
         if self.kind == BodyKind::Dynamic {
             self.dx_sub = self.dx;
             self.dq_sub = self.dq;
@@ -218,6 +293,11 @@ impl BodyProxy {
             self.dq = UnitQuaternion::from_scaled_axis(self.dw * h) * self.dq;
         }
         self.set_pose(frac);
+        self.record_substep_start();
+    }
+
+    /// Records how far the body moves in the current substep and its velocity at the start.
+    fn record_substep_start(&mut self) {
         self.substep_motion = if self.kind == BodyKind::Fixed {
             (0.0, 0.0)
         } else {
@@ -286,12 +366,28 @@ impl BodyProxy {
         n.dot(&self.inv_mass.component_mul(n)) + rn.dot(&(self.inv_inertia * rn))
     }
 
-    /// Applies a positional impulse `p` (kg·m: direction × Δλ) at the world point `q` (an
-    /// anchored body ignores one pressing it into its supports).
+    /// Applies a soft positional impulse `p` (kg·m: direction × Δλ) at the world point `q`.
+    /// An anchored body ignores it when it does not move the body ([`Self::moves`]), and
+    /// one pressing it into its supports moves it at most down to them.
     pub fn apply_position_impulse(&mut self, p: &Vector3<f32>, q: &Vector3<f32>) {
-        if self.kind == BodyKind::Dynamic && self.pressed(p) {
-            return;
+        if self.is_anchored() {
+            self.soft_load.0 += p;
+            if !self.moves(p) {
+                return;
+            }
+            let sink = -self.support_normal.dot(&self.inv_mass.component_mul(p));
+            let room = self.clearance();
+            if self.presses(p) && sink > room {
+                self.apply_support_impulse(&(p * (room / sink)), q);
+                return;
+            }
         }
+        self.apply_support_impulse(p, q);
+    }
+
+    /// Applies a positional impulse `p` (kg·m) of an anchored body's support (or a soft one
+    /// that moves the body) at the world point `q`.
+    pub fn apply_support_impulse(&mut self, p: &Vector3<f32>, q: &Vector3<f32>) {
         if self.kind == BodyKind::Supported {
             self.sub_impulse += p;
             self.sub_angular += (q - self.com()).cross(p);
@@ -339,9 +435,9 @@ impl BodyProxy {
     }
 
     /// Applies a velocity impulse `j` (N·s) at the world point `q` (an anchored body ignores
-    /// one pressing it into its supports).
+    /// one that does not move it, [`Self::moves`]).
     pub fn apply_velocity_impulse(&mut self, j: &Vector3<f32>, q: &Vector3<f32>) {
-        if self.kind == BodyKind::Dynamic && self.pressed(j) {
+        if !self.moves(j) {
             return;
         }
         if self.kind == BodyKind::Supported {

@@ -481,7 +481,11 @@ impl Frame {
                     input.narrow_phase,
                 );
                 let normal = self.supports[first..].iter().map(|s| s.normal).sum();
-                self.bodies[b].anchor(normal);
+                let friction = self.supports[first..]
+                    .iter()
+                    .map(|s| s.friction)
+                    .fold(f32::INFINITY, f32::min);
+                self.bodies[b].anchor(normal, friction);
             }
         }
         self.stats.candidates = self.contacts.len();

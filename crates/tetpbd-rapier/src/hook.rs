@@ -16,7 +16,7 @@ use crate::restitution::{com_velocity, end_episodes, restitution_pass};
 use crate::rolling::rolling_pass;
 use crate::shape_query::surface_point;
 use crate::stacking::{stacked_velocity_pass, stacking_pass, Stacking};
-use crate::support::{end_substep_supports, project_supports};
+use crate::support::{end_substep_supports, hold_supported, measure_clearance, project_supports};
 
 /// Borrows the frame state and rapier's query pipeline for one soft step.
 pub(crate) struct CouplingHook<'q, 'a> {
@@ -62,6 +62,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
         for b in &mut self.frame.bodies {
             b.begin_substep(frac, h);
         }
+        hold_supported(&self.frame.supports, &mut self.frame.bodies);
         for a in &mut self.frame.attachments {
             a.lambda = 0.0;
         }
@@ -85,6 +86,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
         if layers.len() < soft.len() {
             layers.resize_with(soft.len(), Default::default);
         }
+        measure_clearance(supports, bodies);
         for (s, cache) in soft.iter_mut().zip(layers.iter_mut()) {
             let Ok((p, surface)) = world.query_one_mut::<(&mut Particles, &Surface)>(s.entity)
             else {
