@@ -11,7 +11,8 @@ use tetpbd_bench::ContactScene;
 
 use crate::contacts::{contacts_csv, ContactRow};
 use crate::engines::Model;
-use crate::metrics::{Deviation, Reference, RunResult};
+use crate::metrics::{Deviation, RunResult};
+use crate::reference::Reference;
 use crate::scenes::{Scene, DT};
 
 /// Largest last change (relative to the body size) of a numerical reference whose deviations
@@ -27,10 +28,17 @@ pub struct RefInfo {
     pub model: Model,
     /// Substeps of the reference (0: the exact answer).
     pub substeps: u32,
-    /// Its last change when its substeps were doubled, relative to the body size.
+    /// The last change of the answer kept, relative to the body size (see
+    /// [`Reference::change`]).
     pub change: f32,
-    /// The change at the doubling before (NaN when there was only one).
+    /// The same change at the doubling before (NaN when there was none).
     pub prev_change: f32,
+    /// The answer kept is the Richardson extrapolation of the last two runs.
+    pub extrapolated: bool,
+    /// The plain change of the last doubling.
+    pub plain_change: f32,
+    /// The plain change at the doubling before (NaN when there was none).
+    pub plain_prev_change: f32,
     /// Run by the `f64` stepper.
     pub f64: bool,
 }
