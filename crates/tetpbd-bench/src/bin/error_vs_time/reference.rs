@@ -271,11 +271,12 @@ mod tests {
 
     /// The report's extrapolated reference is right: on a small hanging beam, for every soft
     /// constraint set, the reference from 512, 1024 and 2048 substeps (the report's cap)
-    /// agrees with a plain 16384-substep f64 run to about 1e-6 (that run's own error is about
-    /// a third of its last change, which the doublings put near 2e-7), while the plain 2048
-    /// run is more than ten times as far off.
+    /// agrees with the plain 16384-substep f64 run to better than 1e-6 of the beam's length
+    /// (a plain run's own error is about a third of its last change, which falls about 4
+    /// times per doubling), while the plain 2048-substep run is more than ten times as far
+    /// from it.
     #[test]
-    #[ignore = "about a minute in release"]
+    #[ignore = "about 90 s in release"]
     fn extrapolated_beam_reference_matches_a_plain_16384_substep_run() {
         let scene = Scene::small_hanging_beam();
         for set in [

@@ -177,16 +177,16 @@ fn convergence(s: &mut String, references: &[RefInfo]) {
                 );
                 let kept = if r.extrapolated {
                     format!(
-                        "extrapolated from {} and {} substeps: {:.1e}{}; the plain runs: {plain}",
+                        "extrapolated from {} and {} substeps, changed {:.1e}{} (plain runs: {plain})",
                         r.substeps / 2,
                         r.substeps,
                         r.change,
                         ratio(r.prev_change, r.change)
                     )
                 } else {
-                    format!("plain: {plain}")
+                    format!("plain, {plain}")
                 };
-                format!("{} on {}, {kept}", r.model.label(), r.scene)
+                format!("{} on {}: {kept}", r.model.label(), r.scene)
             })
             .collect();
         let _ = writeln!(
