@@ -159,7 +159,7 @@ fn repeats(quick: bool) -> usize {
 /// (slower than the f32 solver, but not stopped by rounding). The beam's static answer
 /// converges at second order (the plain change falls about 4 times per doubling, 1.2e-5 to
 /// 4.2e-5 of its length at 2048 substeps), so its Richardson-extrapolated answer meets the
-/// 1e-6 criterion by 2048 (see [`reference`]); the squash does not converge at these substeps
+/// 1e-6 criterion by 2048 (see [`mod@reference`]); the squash does not converge at these substeps
 /// and is capped lower. The quick run starts at 32 so that its three runs can be checked for
 /// second order too.
 fn reference_range(model: &Model, scene: &Scene, quick: bool) -> (u32, u32) {
