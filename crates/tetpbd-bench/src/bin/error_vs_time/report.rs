@@ -87,8 +87,11 @@ pub struct Row {
     pub finite: bool,
     /// Substeps of the reference.
     pub ref_substeps: u32,
-    /// The reference's last change when its substeps were doubled (relative to size).
+    /// The last change of the reference's answer when its substeps were doubled (relative
+    /// to size; see [`Reference::change`]).
     pub ref_change: f32,
+    /// The reference is Richardson-extrapolated (see [`crate::reference`]).
+    pub ref_extrapolated: bool,
     /// Volume error after every frame, %.
     pub volume_series: Vec<f32>,
 }
@@ -145,6 +148,7 @@ impl Row {
             finite: res.finite,
             ref_substeps: reference.substeps,
             ref_change: reference.change,
+            ref_extrapolated: reference.extrapolated,
             volume_series: res.volume_series.clone(),
         }
     }
@@ -175,7 +179,7 @@ pub fn results_csv(rows: &[Row]) -> String {
          dev_max_rel,dev_rms_rel,volume_err_pct,late_volume_err_pct_max,edge_strain_rms,\
          edge_strain_max,inverted,inverted_max,edge_c_rms_m,edge_c_max_m,vertex_face_c_rms_m,\
          vertex_face_c_max_m,volume_c_rms_m3,volume_c_max_m3,recover_s,final_speed_m_s,finite,\
-         ref_substeps,ref_change_rel\n",
+         ref_substeps,ref_change_rel,ref_extrapolated\n",
     );
     for r in rows {
         let f = |k: usize| {
@@ -185,7 +189,7 @@ pub fn results_csv(rows: &[Row]) -> String {
         };
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{:.6},{:.6},{:.4},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{},{},{:e}",
+            "{},{},{},{},{},{},{:.6},{:.6},{:.4},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{},{},{:e},{}",
             r.scene,
             r.model.engine(),
             r.model.label(),
@@ -212,6 +216,7 @@ pub fn results_csv(rows: &[Row]) -> String {
             r.finite,
             r.ref_substeps,
             r.ref_change,
+            r.ref_extrapolated,
         );
     }
     s
