@@ -7,7 +7,9 @@
 //! squash_volume.csv, plot.png, plot.svg, contacts.png, contacts.svg, squash_volume.png,
 //! squash_volume.svg, summary.md);
 //! `--quick` (a smoke run) writes `target/error-vs-time-quick/`. With `--features parallel`
-//! the contact sweep adds a 12³-cell drop run by tetpbd on 1 and 2 threads.
+//! the references of scenes a and b (see [`mod@reference`]) are computed on rayon's threads
+//! before the timed runs, and the contact sweep adds a 12³-cell drop run by tetpbd on 1 and 2
+//! threads.
 
 mod contacts;
 mod engines;
