@@ -1,12 +1,10 @@
 //! Running one configuration and measuring it: observables both engines share (volume kept,
 //! edge stretch, inverted tetrahedra, shape), tetpbd's own per-family |C|, and the deviation
-//! from a converged reference run.
+//! from a reference run (the references themselves: [`crate::reference`]).
 
 use nalgebra::{Matrix3, Vector3};
 
-use tetpbd_bench::Xpbd64;
-
-use crate::engines::{build, ours_body, ours_settings, ConstraintSet, Model, Sim};
+use crate::engines::Sim;
 use crate::scenes::{tet_volume, Scene, SceneKind, DT};
 
 /// Observables computed the same way from either engine's positions.
@@ -298,83 +296,6 @@ pub fn align(x: &[Vector3<f64>], target: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
     x.iter().map(|p| r * (p - cx) + ct).collect()
 }
 
-/// The reference a model's runs are compared with.
-#[derive(Clone, Debug)]
-pub struct Reference {
-    /// Substeps of the run kept as reference (one iteration each); 0 for the exact answer.
-    pub substeps: u32,
-    /// Max deviation between it and the run with half as many substeps (relative to size);
-    /// 0 for the exact answer.
-    pub change: f32,
-    /// The change at the doubling before (NaN when there was only one): `prev_change / change`
-    /// shows how fast the doubling converges (about 4 for second order, 2 for first order).
-    pub prev_change: f32,
-    /// `true` when it was run by the `f64` stepper ([`tetpbd_bench::Xpbd64`]), `false` for
-    /// the engine's own `f32` solver (or the exact answer).
-    pub f64: bool,
-    /// Its positions after every frame.
-    pub trajectory: Trajectory64,
-}
-
-/// The exact answer of a hard model (every edge and volume at rest): the rest shape in every
-/// frame (pinned beam: exactly there; free block: compared after rigid alignment).
-pub fn exact_rest(scene: &Scene) -> Reference {
-    let rest: Vec<Vector3<f64>> = scene.mesh.vertices.iter().map(|p| p.cast()).collect();
-    Reference {
-        substeps: 0,
-        change: 0.0,
-        prev_change: f32::NAN,
-        f64: false,
-        trajectory: vec![rest; scene.frames],
-    }
-}
-
-/// The converged reference of a numerical model: tetpbd's models in `f64` (same model, see
-/// [`run64`]), rapier's with its own `f32` solver. Doubles the substeps (one iteration each)
-/// from `start` until the answer changes by less than 1e-6 of the body size, or `max` is
-/// reached.
-pub fn converged(model: Model, scene: &Scene, start: u32, max: u32) -> Reference {
-    let trajectory = |s: u32| match model {
-        Model::Ours { set, soft } => run64(set, soft, scene, s),
-        Model::Rapier { .. } => widen(&run(build(model, scene, s, 1).as_mut(), scene).trajectory),
-    };
-    let mut s = start;
-    let mut prev = trajectory(s);
-    let mut prev_change = f32::NAN;
-    loop {
-        s *= 2;
-        let next = trajectory(s);
-        let change = deviation(scene, &next, &prev).max;
-        if change < 1e-6 || s >= max {
-            return Reference {
-                substeps: s,
-                change,
-                prev_change,
-                f64: matches!(model, Model::Ours { .. }),
-                trajectory: next,
-            };
-        }
-        prev = next;
-        prev_change = change;
-    }
-}
-
-/// tetpbd's model `set` on `scene` run by the `f64` stepper at `substeps × 1`: the same
-/// body and settings the `f32` solver gets ([`ours_body`], [`ours_settings`]).
-pub fn run64(set: ConstraintSet, soft: bool, scene: &Scene, substeps: u32) -> Trajectory64 {
-    let mut sim = Xpbd64::new(
-        &ours_body(set, soft, scene),
-        &ours_settings(scene, substeps, 1),
-    )
-    .expect("valid settings");
-    (0..scene.frames)
-        .map(|_| {
-            sim.step();
-            sim.positions()
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -412,41 +333,5 @@ mod tests {
         };
         assert_eq!(recovery_time(&[bad, good, bad, good, good]), Some(4.0 * DT));
         assert_eq!(recovery_time(&[good, bad]), None);
-    }
-
-    /// The f64 stepper is the same model as the f32 solver: at a moderate budget the two
-    /// agree far below the model's own discretisation error, on both scenes and every soft
-    /// constraint set, and the comparison tells a different model (no damping) apart.
-    #[test]
-    fn xpbd64_matches_the_f32_solver() {
-        const SUBSTEPS: u32 = 8;
-        for scene in [Scene::hanging_beam(true), Scene::squash(true)] {
-            let scene = Scene {
-                frames: 30,
-                ..scene
-            };
-            for set in [
-                ConstraintSet::EdgesVolume,
-                ConstraintSet::VertexFace,
-                ConstraintSet::VertexFaceEdges,
-            ] {
-                let model = Model::Ours { set, soft: true };
-                let f32_run =
-                    widen(&run(build(model, &scene, SUBSTEPS, 1).as_mut(), &scene).trajectory);
-                let f64_run = run64(set, true, &scene, SUBSTEPS);
-                let same = deviation(&scene, &f32_run, &f64_run).max;
-                assert!(same < 1e-5, "{} {set:?}: f64 vs f32 {same:e}", scene.name);
-                let other = Scene {
-                    damping: 0.0,
-                    ..scene.clone()
-                };
-                let differs = deviation(&scene, &f32_run, &run64(set, true, &other, SUBSTEPS)).max;
-                assert!(
-                    differs > 100.0 * same,
-                    "{} {set:?}: undamped {differs:e}, same model {same:e}",
-                    scene.name
-                );
-            }
-        }
     }
 }

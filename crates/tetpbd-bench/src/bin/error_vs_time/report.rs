@@ -11,7 +11,8 @@ use tetpbd_bench::ContactScene;
 
 use crate::contacts::{contacts_csv, ContactRow};
 use crate::engines::Model;
-use crate::metrics::{Deviation, Reference, RunResult};
+use crate::metrics::{Deviation, RunResult};
+use crate::reference::Reference;
 use crate::scenes::{Scene, DT};
 
 /// Largest last change (relative to the body size) of a numerical reference whose deviations
@@ -27,10 +28,17 @@ pub struct RefInfo {
     pub model: Model,
     /// Substeps of the reference (0: the exact answer).
     pub substeps: u32,
-    /// Its last change when its substeps were doubled, relative to the body size.
+    /// The last change of the answer kept, relative to the body size (see
+    /// [`Reference::change`]).
     pub change: f32,
-    /// The change at the doubling before (NaN when there was only one).
+    /// The same change at the doubling before (NaN when there was none).
     pub prev_change: f32,
+    /// The answer kept is the Richardson extrapolation of the last two runs.
+    pub extrapolated: bool,
+    /// The plain change of the last doubling.
+    pub plain_change: f32,
+    /// The plain change at the doubling before (NaN when there was none).
+    pub plain_prev_change: f32,
     /// Run by the `f64` stepper.
     pub f64: bool,
 }
@@ -79,8 +87,11 @@ pub struct Row {
     pub finite: bool,
     /// Substeps of the reference.
     pub ref_substeps: u32,
-    /// The reference's last change when its substeps were doubled (relative to size).
+    /// The last change of the reference's answer when its substeps were doubled (relative
+    /// to size; see [`Reference::change`]).
     pub ref_change: f32,
+    /// The reference is Richardson-extrapolated (see [`crate::reference`]).
+    pub ref_extrapolated: bool,
     /// Volume error after every frame, %.
     pub volume_series: Vec<f32>,
 }
@@ -137,6 +148,7 @@ impl Row {
             finite: res.finite,
             ref_substeps: reference.substeps,
             ref_change: reference.change,
+            ref_extrapolated: reference.extrapolated,
             volume_series: res.volume_series.clone(),
         }
     }
@@ -167,7 +179,7 @@ pub fn results_csv(rows: &[Row]) -> String {
          dev_max_rel,dev_rms_rel,volume_err_pct,late_volume_err_pct_max,edge_strain_rms,\
          edge_strain_max,inverted,inverted_max,edge_c_rms_m,edge_c_max_m,vertex_face_c_rms_m,\
          vertex_face_c_max_m,volume_c_rms_m3,volume_c_max_m3,recover_s,final_speed_m_s,finite,\
-         ref_substeps,ref_change_rel\n",
+         ref_substeps,ref_change_rel,ref_extrapolated\n",
     );
     for r in rows {
         let f = |k: usize| {
@@ -177,7 +189,7 @@ pub fn results_csv(rows: &[Row]) -> String {
         };
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{:.6},{:.6},{:.4},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{},{},{:e}",
+            "{},{},{},{},{},{},{:.6},{:.6},{:.4},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{},{},{:e},{}",
             r.scene,
             r.model.engine(),
             r.model.label(),
@@ -204,6 +216,7 @@ pub fn results_csv(rows: &[Row]) -> String {
             r.finite,
             r.ref_substeps,
             r.ref_change,
+            r.ref_extrapolated,
         );
     }
     s

@@ -70,6 +70,27 @@ impl Scene {
         )
     }
 
+    /// A 1 m × 0.1 m beam, 10 × 1 × 1 cells, otherwise as [`Scene::hanging_beam`] (full
+    /// length run): small enough for tests to run it at many substeps.
+    #[cfg(test)]
+    pub fn small_hanging_beam() -> Scene {
+        let mesh =
+            generators::beam(1.0, 0.1, 10, 1, CellSplit::Six).expect("valid beam parameters");
+        let pinned = generators::beam_root(&mesh);
+        let start = mesh.vertices.clone();
+        Scene::new(
+            SceneKind::HangingBeam,
+            "small_hanging_beam",
+            mesh,
+            pinned,
+            start,
+            -9.81,
+            10.0,
+            180,
+            1.0,
+        )
+    }
+
     /// b) A 1 m cube, 4 × 4 × 4 cells of six tetrahedra, squashed to 50 % height about its
     /// centre (x and z unchanged, so half its volume) and released at rest, without gravity.
     pub fn squash(quick: bool) -> Scene {
