@@ -82,8 +82,6 @@ pub(crate) struct CornerContact {
     /// into the soft body's contacts).
     pub vertex_contacts: [Option<usize>; 3],
     pub thickness: f32,
-    /// The soft collider's own thickness (`thickness` less the rigid shape's border radius).
-    pub skin: f32,
     pub restitution: f32,
     pub active: bool,
     pub mu_d: f32,
@@ -189,7 +187,6 @@ pub(crate) fn gather_corners(
                 triangle: t as u32,
                 vertex_contacts: vc,
                 thickness: thickness + extra,
-                skin: thickness,
                 restitution,
                 active: false,
                 mu_d,
@@ -298,9 +295,12 @@ fn sweep_corners(
             continue;
         }
         let n = m / area2;
-        // In the ordinary pass a vertex holding the collider leaves the triangle's skin to
-        // its particle contact (a crossing there is only taken in the crossing pass).
-        let held = pass == CornerPass::Ordinary && vertex_holds(k, contacts, &n);
+        // In the ordinary pass a vertex holding a smooth collider rules the triangle out (a
+        // crossing there is only taken in the crossing pass); a polyhedral corner is never
+        // left to a vertex (module docs).
+        if pass == CornerPass::Ordinary && k.corner.is_none() && vertex_holds(k, contacts, &n) {
+            continue;
+        }
         let cp = &colliders[k.collider];
         let shortest = || (b - a).norm().min((c - b).norm()).min((a - c).norm());
         // The crossing pass only takes fast points; the others only need to know once the
@@ -331,13 +331,13 @@ fn sweep_corners(
             continue;
         }
         let s = (v - a).dot(&n);
-        let c_val = s - if held { k.thickness - k.skin } else { k.thickness };
+        let c_val = s - k.thickness;
         if c_val >= 0.0 {
             continue;
         }
         let (shortest, fast) = early.unwrap_or_else(|| {
             let shortest = shortest();
-            (shortest, !held && is_fast(k, cp, set, moved, shortest))
+            (shortest, is_fast(k, cp, set, moved, shortest))
         });
         // Crossed the plane from the front within this substep (a fast rigid point, one that
         // itself moved more than a tenth of the shortest edge): caught at any depth, at the
