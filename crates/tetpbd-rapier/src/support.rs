@@ -67,8 +67,8 @@
 //! moved by up to 3 mm sideways: with the rigid pin (100 and 1000 kg) every run stays in
 //! place (box drift ≤ 0.2 mm). With the 1e-5 m/N attachment, over 28 shifts (−3 to 3 mm
 //! along x, −2 to 3 mm along z), the cube stays on the box, its particles below 0.42 m/s
-//! and the scene within 0.24 J of its start, the box drifting up to 1 cm in 10 s as the
-//! cube rocks on its top. The cube used to tip off the box top in most of them, with the
+//! and its energy (with the spring's) at most 0.24 J over its start, the box drifting up to
+//! 1 cm in 10 s as the cube rocks on its top. The cube used to tip off the box top in most of them, with the
 //! box made fixed too, and swing on the spring at up to 200 m/s: the box's top corners sank
 //! unchecked into the cube's bottom triangles (`corner` module docs, issue 3), a limit of
 //! the soft side, not of the anchored body.
