@@ -33,16 +33,32 @@
 //! collider: one particle alone cannot stop a fast body, and its contact normal may be tilted
 //! enough to let the body slip past it.
 //!
-//! A triangle with a vertex that *holds* the collider is skipped in the ordinary pass: a
-//! vertex in contact with the collider (in the same iteration) whose contact normal lies
-//! within 30° of the triangle's normal. There the particle contact holds the surface, and two
-//! sets of constraints on the same spot only fight. A vertex touching the collider's side
-//! (its normal tilted further) does not hold it: the body slides past that particle into the
-//! triangle. Issue 6: a ball at 100 m/s pushed a vertex of a compliant slab into its side, the
-//! vertex's normal was about 45° off the triangle's, and with every touching vertex ruling
-//! its triangles out the ball sank into the slab (and, under soft edges + volume, through it
-//! and the ground); the triangle now stops it. The smooth parts of a compound take no part
-//! (their contacts with the soft particles still act). `v` is only caught while its projection
+//! A support point over a triangle with a vertex that *holds* the collider is skipped in the
+//! ordinary pass: a vertex in contact with the collider (in the same iteration) whose contact
+//! normal lies within 30° of the triangle's normal. There the particle contact holds the
+//! surface, and two sets of constraints on the same spot only fight. A vertex touching the
+//! collider's side (its normal tilted further) does not hold it: the body slides past that
+//! particle into the triangle. Issue 6: a ball at 100 m/s pushed a vertex of a compliant slab
+//! into its side, the vertex's normal was about 45° off the triangle's, and with every
+//! touching vertex ruling its triangles out the ball sank into the slab (and, under soft
+//! edges + volume, through it and the ground); the triangle now stops it.
+//!
+//! Only a smooth shape's support point is left to a holding vertex: it lies on the same
+//! smooth surface as the vertex's contact, near it (projecting it as well let the ball of
+//! issue 6 bounce off a compliant slab, 5.5–6.5 m/s after 10 frames). A polyhedral corner is
+//! a feature of its own, which a vertex resting on a face beside it does not keep out of the
+//! triangle (where the vertex rests on the corner itself, the triangle's constraint is about
+//! met already), so it is always projected. Issue 3: a soft cube whose 2 × 2 bottom face met
+//! a smaller box top only at its centre particle rested on that particle alone, the box's
+//! top corners sinking unchecked into the bottom triangles around it (16 cm deep); the cube
+//! tipped over like an inverted pendulum, and when its tilt passed the holding angle a
+//! triangle pushed the whole depth out in one substep (particles at up to 160 m/s).
+//! Tolerating the corner within the triangle's skin (the thickness) while a vertex holds
+//! does not do either: the skin is pushed out whenever the vertex lets go, 2 mm in one
+//! substep, which kept the cube rattling at up to 1.5 m/s.
+//!
+//! The smooth parts of a compound take no part (their contacts with the soft particles
+//! still act). `v` is only caught while its projection
 //! falls inside the triangle (within 0.1 % of its barycentric range, so a point on a shared
 //! edge is not lost between two triangles) and it is less than half the triangle's shortest
 //! edge behind it, so triangles on the far side of the body never grab it. A corner of a
@@ -295,9 +311,10 @@ fn sweep_corners(
             continue;
         }
         let n = m / area2;
-        // In the ordinary pass a vertex holding the collider rules the triangle out (a
-        // crossing there is only taken in the crossing pass).
-        if pass == CornerPass::Ordinary && vertex_holds(k, contacts, &n) {
+        // In the ordinary pass a vertex holding the collider rules the triangle out for a
+        // support point (a crossing there is only taken in the crossing pass); a polyhedral
+        // corner is never left to a vertex (module docs).
+        if pass == CornerPass::Ordinary && k.corner.is_none() && vertex_holds(k, contacts, &n) {
             continue;
         }
         let cp = &colliders[k.collider];
@@ -402,8 +419,8 @@ fn sweep_corners(
 
 /// Whether a vertex of the triangle (unit outward normal `n`) already touches the collider
 /// with a contact normal close to the triangle's: that particle contact then holds the body
-/// against the surface, and the triangle only stops what slips between particles (and what
-/// crosses it within the substep). A vertex touching the body's side, its normal tilted more
+/// against the surface, and the triangle only stops a support point that slips between
+/// particles (and what crosses it within the substep). A vertex touching the body's side, its normal tilted more
 /// than `HOLDING_ANGLE_COS` from the triangle's, does not hold it: the body slides past that
 /// particle into the triangle.
 fn vertex_holds(k: &CornerContact, contacts: &[ParticleContact], n: &Vector3<f32>) -> bool {
