@@ -87,26 +87,72 @@ impl V3 {
     }
 }
 
-/// Positions and inverse masses of particles `idx`, one per lane.
-#[inline(always)]
-fn gather<A: ParticleAccess>(acc: &A, idx: [usize; LANES]) -> (V3, f32x4) {
-    let [x, y, z, w] = f32x4::transpose([
-        acc.row(idx[0]),
-        acc.row(idx[1]),
-        acc.row(idx[2]),
-        acc.row(idx[3]),
-    ]);
-    (V3 { x, y, z }, w)
+/// The items of one run (edges or tetrahedra as particle indices) with the particles they
+/// index, every index checked once against the particle count: the kernels then read and
+/// move the items' particles without a bounds check per access.
+pub(crate) struct Bounded<'a, A, const N: usize> {
+    acc: &'a mut A,
+    items: &'a [[u32; N]],
 }
 
-/// The four corners of four tetrahedra: positions and inverse masses per corner.
-#[inline(always)]
-fn gather_corners<A: ParticleAccess>(acc: &A, idx: &[[usize; LANES]; 4]) -> ([V3; 4], [f32x4; 4]) {
-    let (p0, w0) = gather(acc, idx[0]);
-    let (p1, w1) = gather(acc, idx[1]);
-    let (p2, w2) = gather(acc, idx[2]);
-    let (p3, w3) = gather(acc, idx[3]);
-    ([p0, p1, p2, p3], [w0, w1, w2, w3])
+impl<'a, A: ParticleAccess, const N: usize> Bounded<'a, A, N> {
+    /// Checks that every index of `items` is below `acc.len()` (one vectorised pass over the
+    /// run; panics on an index out of range, as a checked access would).
+    #[inline(always)]
+    pub(crate) fn new(acc: &'a mut A, items: &'a [[u32; N]]) -> Self {
+        let max = items.as_flattened().iter().fold(0, |m, &i| m.max(i));
+        assert!(
+            items.is_empty() || (max as usize) < acc.len(),
+            "particle index {max} out of range ({} particles)",
+            acc.len()
+        );
+        Bounded { acc, items }
+    }
+
+    /// The particles, for the scalar kernels (bounds-checked).
+    #[inline(always)]
+    pub(crate) fn acc(&mut self) -> &mut A {
+        self.acc
+    }
+
+    /// The items.
+    #[inline(always)]
+    pub(crate) fn items(&self) -> &'a [[u32; N]] {
+        self.items
+    }
+
+    /// Corner `k` of the `LANES` items from `at`: positions and inverse masses, one per lane.
+    #[inline(always)]
+    fn gather(&self, at: usize, k: usize) -> (V3, f32x4) {
+        let it = chunk(self.items, at);
+        // SAFETY: `it[l][k]` is an index of `self.items`, all of which are below
+        // `self.acc.len()` (checked in `new`; neither changes afterwards: both are borrowed
+        // for `'a`, the access mutably).
+        let row = |l: usize| unsafe { self.acc.row_unchecked(it[l][k] as usize) };
+        let [x, y, z, w] = f32x4::transpose([row(0), row(1), row(2), row(3)]);
+        (V3 { x, y, z }, w)
+    }
+
+    /// The four corners of the four tetrahedra from `at`.
+    #[inline(always)]
+    fn gather_corners(&self, at: usize) -> ([V3; 4], [f32x4; 4]) {
+        let (p0, w0) = self.gather(at, 0);
+        let (p1, w1) = self.gather(at, 1);
+        let (p2, w2) = self.gather(at, 2);
+        let (p3, w3) = self.gather(at, 3);
+        ([p0, p1, p2, p3], [w0, w1, w2, w3])
+    }
+
+    /// Moves corner `k` of item `at + l` by lane `l` of `d` (compensated).
+    #[inline(always)]
+    fn scatter(&mut self, at: usize, k: usize, d: V3) {
+        let it = chunk(self.items, at);
+        let rows = f32x4::transpose([d.x, d.y, d.z, f32x4::ZERO]);
+        for (item, row) in it.iter().zip(rows) {
+            // SAFETY: as in `gather`: an index of `self.items`, below `self.acc.len()`.
+            unsafe { self.acc.add_row_unchecked(item[k] as usize, row) };
+        }
+    }
 }
 
 /// Four rows of four values, transposed: item `k` of every row as lanes.
@@ -120,15 +166,6 @@ fn transpose_rows(rows: &[[f32; 4]; LANES]) -> [f32x4; 4] {
     ])
 }
 
-/// Moves particle `idx[l]` by lane `l` of `d` (compensated).
-#[inline(always)]
-fn scatter<A: ParticleAccess>(acc: &mut A, idx: [usize; LANES], d: V3) {
-    let rows = f32x4::transpose([d.x, d.y, d.z, f32x4::ZERO]);
-    for (i, row) in idx.into_iter().zip(rows) {
-        acc.add_row(i, row);
-    }
-}
-
 /// `Δλ` on every lane; 0 where the denominator is not positive. Returns the mask of
 /// applied lanes.
 #[inline(always)]
@@ -140,17 +177,6 @@ fn delta_lambda(c: f32x4, lambda: f32x4, alpha_tilde: f32x4, w_grad_sq: f32x4) -
         ok.select((-c - alpha_tilde * lambda) / safe, f32x4::ZERO),
         ok,
     )
-}
-
-/// Corner `k` of each of the `LANES` items.
-#[inline(always)]
-fn corner<const N: usize>(items: &[[u32; N]; LANES], k: usize) -> [usize; LANES] {
-    [
-        items[0][k] as usize,
-        items[1][k] as usize,
-        items[2][k] as usize,
-        items[3][k] as usize,
-    ]
 }
 
 /// Four consecutive values as lanes.
@@ -178,23 +204,23 @@ pub(crate) fn chunk_mut<T>(s: &mut [T], at: usize) -> &mut [T; LANES] {
 /// Four edges. See [`projection::edge`].
 #[inline(always)]
 pub(crate) fn edges<A: ParticleAccess>(
-    acc: &mut A,
-    edges: &[[u32; 2]; LANES],
+    b: &mut Bounded<'_, A, 2>,
+    at: usize,
     rest: &[f32; LANES],
     lambdas: &mut [f32; LANES],
     alpha_tilde: f32,
 ) -> ProjectionCount {
-    let (ia, ib) = (corner(edges, 0), corner(edges, 1));
     let d = lanes_of(rest);
-    let (pa, wa) = gather(acc, ia);
-    let (pb, wb) = gather(acc, ib);
+    let (pa, wa) = b.gather(at, 0);
+    let (pb, wb) = b.gather(at, 1);
     let delta = pa.sub(pb);
     let len = delta.dot(delta).sqrt();
     if !len.simd_gt(d * f32x4::splat(1e-6)).all() {
+        let edges = chunk(b.items(), at);
         let mut count = ProjectionCount::default();
         for l in 0..LANES {
             count.add(projection::edge(
-                acc,
+                b.acc(),
                 edges[l],
                 rest[l],
                 &mut lambdas[l],
@@ -207,8 +233,8 @@ pub(crate) fn edges<A: ParticleAccess>(
     let lam = lanes_of(lambdas);
     let (dl, ok) = delta_lambda(len - d, lam, f32x4::splat(alpha_tilde), wa + wb);
     *lambdas = (lam + dl).to_array();
-    scatter(acc, ia, n.scale(wa * dl));
-    scatter(acc, ib, n.scale(-wb * dl));
+    b.scatter(at, 0, n.scale(wa * dl));
+    b.scatter(at, 1, n.scale(-wb * dl));
     ProjectionCount {
         applied: ok.to_bitmask().count_ones() as u64,
         degenerate: 0,
@@ -218,19 +244,13 @@ pub(crate) fn edges<A: ParticleAccess>(
 /// Four volume constraints. See [`projection::volume`].
 #[inline(always)]
 pub(crate) fn volumes<A: ParticleAccess>(
-    acc: &mut A,
-    tets: &[[u32; 4]; LANES],
+    bd: &mut Bounded<'_, A, 4>,
+    at: usize,
     rest: &[f32; LANES],
     lambdas: &mut [f32; LANES],
     alpha_tilde: f32,
 ) -> ProjectionCount {
-    let idx = [
-        corner(tets, 0),
-        corner(tets, 1),
-        corner(tets, 2),
-        corner(tets, 3),
-    ];
-    let (p, w) = gather_corners(acc, &idx);
+    let (p, w) = bd.gather_corners(at);
     let sixth = f32x4::splat(1.0 / 6.0);
     let (a, b, c) = (p[1].sub(p[0]), p[2].sub(p[0]), p[3].sub(p[0]));
     let bc = b.cross(c);
@@ -245,7 +265,7 @@ pub(crate) fn volumes<A: ParticleAccess>(
     let (dl, ok) = delta_lambda(cval, lam, f32x4::splat(alpha_tilde), w_grad_sq);
     *lambdas = (lam + dl).to_array();
     for k in 0..4 {
-        scatter(acc, idx[k], g[k].scale(w[k] * dl));
+        bd.scatter(at, k, g[k].scale(w[k] * dl));
     }
     let any_free = (w[0] + w[1] + w[2] + w[3]).simd_gt(f32x4::ZERO);
     ProjectionCount {
@@ -263,19 +283,13 @@ pub(crate) fn volumes<A: ParticleAccess>(
 /// projection and counts it as degenerate.
 #[inline(always)]
 pub(crate) fn vertex_faces<A: ParticleAccess>(
-    acc: &mut A,
-    tets: &[[u32; 4]; LANES],
+    bd: &mut Bounded<'_, A, 4>,
+    at: usize,
     heights: &[[f32; 4]; LANES],
     lambdas: &mut [[f32; 4]; LANES],
     alpha_tilde: f32,
 ) -> ProjectionCount {
-    let idx = [
-        corner(tets, 0),
-        corner(tets, 1),
-        corner(tets, 2),
-        corner(tets, 3),
-    ];
-    let (p0, w) = gather_corners(acc, &idx);
+    let (p0, w) = bd.gather_corners(at);
     let kappa = f32x4::splat(VERTEX_FACE_KAPPA);
     // Pre-check every face at the start of the chunk: healthy with a margin of 2.
     for order in VERTEX_FACE_ORDER {
@@ -287,10 +301,11 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
         let twice_k = kappa * (b.dot(b) + c.dot(c));
         let ok = m.dot(m).simd_gt(twice_k * twice_k);
         if !ok.all() {
+            let tets = chunk(bd.items(), at);
             let mut count = ProjectionCount::default();
             for l in 0..LANES {
                 let (a, d) = projection::vertex_face(
-                    acc,
+                    bd.acc(),
                     tets[l],
                     &heights[l],
                     &mut lambdas[l],
@@ -302,7 +317,7 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
             return count;
         }
     }
-    let at = f32x4::splat(alpha_tilde);
+    let alpha = f32x4::splat(alpha_tilde);
     // Per constraint k, the four tetrahedra's heights and multipliers as lanes.
     let h = transpose_rows(heights);
     let mut lam = transpose_rows(lambdas);
@@ -330,7 +345,7 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
         let g = [g0, g1, g2, g3];
         let wo = [w[order[0]], w[order[1]], w[order[2]], w[order[3]]];
         let w_grad_sq = (0..4).fold(f32x4::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
-        let (dl, ok) = delta_lambda(na - h[k], lam[k], at, w_grad_sq);
+        let (dl, ok) = delta_lambda(na - h[k], lam[k], alpha, w_grad_sq);
         let dl = valid.select(dl, f32x4::ZERO);
         let ok = ok & valid;
         lam[k] += dl;
@@ -344,8 +359,8 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
     for (row, l) in lambdas.iter_mut().zip(lam) {
         *row = l.to_array();
     }
-    for (corner, d) in idx.into_iter().zip(dp) {
-        scatter(acc, corner, d);
+    for (k, d) in dp.into_iter().enumerate() {
+        bd.scatter(at, k, d);
     }
     count
 }

@@ -14,19 +14,26 @@ use crate::projection::{self, ParticleAccess};
 use crate::systems::{Kernel, ProjectionCount};
 
 /// Projects a run of constraints of one colour class: in chunks of [`lanes::LANES`] when the
-/// class is independent and the kernel is SIMD, the rest one by one.
+/// class is independent and the kernel is SIMD (on the run's items with their indices checked
+/// once, [`lanes::Bounded`]), the rest one by one.
 macro_rules! run_class {
-    ($kernel:expr, $independent:expr, $len:expr, |$s:ident| $lanes:expr, |$k:ident| $scalar:expr) => {{
+    ($kernel:expr, $independent:expr, $acc:expr, $items:expr,
+     |$b:ident, $s:ident| $lanes:expr, |$a:ident, $k:ident| $scalar:expr) => {{
         let mut count = ProjectionCount::default();
         let mut start = 0;
-        if $kernel == Kernel::Simd && $independent {
-            while start + lanes::LANES <= $len {
+        let (acc, items) = ($acc, $items);
+        let len = items.len();
+        if $kernel == Kernel::Simd && $independent && len >= lanes::LANES {
+            let mut bounded = lanes::Bounded::new(acc, items);
+            let $b = &mut bounded;
+            while start + lanes::LANES <= len {
                 let $s = start;
                 count += $lanes;
                 start += lanes::LANES;
             }
         }
-        for $k in start..$len {
+        let $a = acc;
+        for $k in start..len {
             count += $scalar;
         }
         count
@@ -47,16 +54,17 @@ fn edge_run_base<A: ParticleAccess>(
     run_class!(
         kernel,
         independent,
-        edges.len(),
-        |s| lanes::edges(
-            acc,
-            lanes::chunk(edges, s),
+        acc,
+        edges,
+        |b, s| lanes::edges(
+            b,
+            s,
             lanes::chunk(rest, s),
             lanes::chunk_mut(lambdas, s),
             alpha_tilde
         ),
-        |k| one(projection::edge(
-            acc,
+        |a, k| one(projection::edge(
+            a,
             edges[k],
             rest[k],
             &mut lambdas[k],
@@ -79,16 +87,17 @@ fn volume_run_base<A: ParticleAccess>(
     run_class!(
         kernel,
         independent,
-        tets.len(),
-        |s| lanes::volumes(
-            acc,
-            lanes::chunk(tets, s),
+        acc,
+        tets,
+        |b, s| lanes::volumes(
+            b,
+            s,
             lanes::chunk(rest, s),
             lanes::chunk_mut(lambdas, s),
             alpha_tilde
         ),
-        |k| one(projection::volume(
-            acc,
+        |a, k| one(projection::volume(
+            a,
             tets[k],
             rest[k],
             &mut lambdas[k],
@@ -111,19 +120,20 @@ fn vertex_face_run_base<A: ParticleAccess>(
     run_class!(
         kernel,
         independent,
-        tets.len(),
-        |s| lanes::vertex_faces(
-            acc,
-            lanes::chunk(tets, s),
+        acc,
+        tets,
+        |b, s| lanes::vertex_faces(
+            b,
+            s,
             lanes::chunk(heights, s),
             lanes::chunk_mut(lambdas, s),
             alpha_tilde
         ),
-        |k| {
-            let (a, d) =
-                projection::vertex_face(acc, tets[k], &heights[k], &mut lambdas[k], alpha_tilde);
+        |a, k| {
+            let (ap, d) =
+                projection::vertex_face(a, tets[k], &heights[k], &mut lambdas[k], alpha_tilde);
             ProjectionCount {
-                applied: u64::from(a),
+                applied: u64::from(ap),
                 degenerate: u64::from(d),
             }
         }
