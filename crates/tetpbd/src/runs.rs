@@ -9,26 +9,33 @@
 //! results: which one runs changes the speed only, never the trajectory (and the serial and
 //! parallel sweeps, on any number of threads, stay bit-identical).
 
+use wide::f32x4;
+
 use crate::lanes;
 use crate::projection::{self, ParticleAccess};
+use crate::simd::X2;
 use crate::systems::{Kernel, ProjectionCount};
 
-/// Projects a run of constraints of one colour class: in chunks of [`lanes::LANES`] when the
-/// class is independent and the kernel is SIMD (on the run's items with their indices checked
-/// once, [`lanes::Bounded`]), the rest one by one.
+/// Projects a run of constraints of one colour class: when the class is independent and the
+/// kernel is SIMD, in pairs of chunks of [`lanes::LANES`] ([`X2`]), then one chunk of four,
+/// on the run's items with their indices checked once ([`lanes::Bounded`]); the rest one by
+/// one. A pair gives the bits of its two chunks one after the other, so the results do not
+/// depend on where a run starts (serial class or parallel part).
 macro_rules! run_class {
     ($kernel:expr, $independent:expr, $acc:expr, $items:expr,
-     |$b:ident, $s:ident| $lanes:expr, |$a:ident, $k:ident| $scalar:expr) => {{
+     $lanes:ident($($arg:expr),*), |$a:ident, $k:ident| $scalar:expr) => {{
         let mut count = ProjectionCount::default();
         let mut start = 0;
         let (acc, items) = ($acc, $items);
         let len = items.len();
         if $kernel == Kernel::Simd && $independent && len >= lanes::LANES {
             let mut bounded = lanes::Bounded::new(acc, items);
-            let $b = &mut bounded;
-            while start + lanes::LANES <= len {
-                let $s = start;
-                count += $lanes;
+            while start + 2 * lanes::LANES <= len {
+                count += lanes::$lanes::<X2, _>(&mut bounded, start, $($arg),*);
+                start += 2 * lanes::LANES;
+            }
+            if start + lanes::LANES <= len {
+                count += lanes::$lanes::<f32x4, _>(&mut bounded, start, $($arg),*);
                 start += lanes::LANES;
             }
         }
@@ -56,13 +63,7 @@ fn edge_run_base<A: ParticleAccess>(
         independent,
         acc,
         edges,
-        |b, s| lanes::edges(
-            b,
-            s,
-            lanes::chunk(rest, s),
-            lanes::chunk_mut(lambdas, s),
-            alpha_tilde
-        ),
+        edges(rest, lambdas, alpha_tilde),
         |a, k| one(projection::edge(
             a,
             edges[k],
@@ -89,13 +90,7 @@ fn volume_run_base<A: ParticleAccess>(
         independent,
         acc,
         tets,
-        |b, s| lanes::volumes(
-            b,
-            s,
-            lanes::chunk(rest, s),
-            lanes::chunk_mut(lambdas, s),
-            alpha_tilde
-        ),
+        volumes(rest, lambdas, alpha_tilde),
         |a, k| one(projection::volume(
             a,
             tets[k],
@@ -122,13 +117,7 @@ fn vertex_face_run_base<A: ParticleAccess>(
         independent,
         acc,
         tets,
-        |b, s| lanes::vertex_faces(
-            b,
-            s,
-            lanes::chunk(heights, s),
-            lanes::chunk_mut(lambdas, s),
-            alpha_tilde
-        ),
+        vertex_faces(heights, lambdas, alpha_tilde),
         |a, k| {
             let (ap, d) =
                 projection::vertex_face(a, tets[k], &heights[k], &mut lambdas[k], alpha_tilde);
