@@ -189,10 +189,10 @@ fn transpose_rows<L: Lane>(rows: &[[f32; 4]], at: usize) -> [L; 4] {
 /// The inverse of [`transpose_rows`]: lane `l` of `lanes[k]` to value `k` of row `at + l`.
 #[inline(always)]
 fn untranspose_rows<L: Lane>(lanes: [L; 4], rows: &mut [[f32; 4]], at: usize) {
-    let q = lanes.map(L::quarters);
+    let [q0, q1, q2, q3] = lanes.map(L::quarters);
     for c in 0..L::WIDTH / LANES {
         let r = chunk_mut(rows, at + c * LANES);
-        let t = f32x4::transpose([q[0][c], q[1][c], q[2][c], q[3][c]]);
+        let t = f32x4::transpose([q0[c], q1[c], q2[c], q3[c]]);
         for (row, l) in r.iter_mut().zip(t) {
             *row = l.to_array();
         }
