@@ -13,7 +13,9 @@ use wide::f32x4;
 
 use crate::lanes;
 use crate::projection::{self, ParticleAccess};
-use crate::simd::X2;
+#[cfg(target_arch = "x86_64")]
+use crate::simd::Y8;
+use crate::simd::{Lane, X2};
 use crate::systems::{Kernel, ProjectionCount};
 
 /// Projects a run of constraints of one colour class: when the class is independent and the
@@ -22,7 +24,7 @@ use crate::systems::{Kernel, ProjectionCount};
 /// one. A pair gives the bits of its two chunks one after the other, so the results do not
 /// depend on where a run starts (serial class or parallel part).
 macro_rules! run_class {
-    ($kernel:expr, $independent:expr, $acc:expr, $items:expr,
+    ($pair:ty, $kernel:expr, $independent:expr, $acc:expr, $items:expr,
      $lanes:ident($($arg:expr),*), |$a:ident, $k:ident| $scalar:expr) => {{
         let mut count = ProjectionCount::default();
         let mut start = 0;
@@ -31,7 +33,7 @@ macro_rules! run_class {
         if $kernel == Kernel::Simd && $independent && len >= lanes::LANES {
             let mut bounded = lanes::Bounded::new(acc, items);
             while start + 2 * lanes::LANES <= len {
-                count += lanes::$lanes::<X2, _>(&mut bounded, start, $($arg),*);
+                count += lanes::$lanes::<$pair, _>(&mut bounded, start, $($arg),*);
                 start += 2 * lanes::LANES;
             }
             if start + lanes::LANES <= len {
@@ -49,7 +51,7 @@ macro_rules! run_class {
 
 /// Edges `edges[i]` with their rest lengths and multipliers, all of one colour class.
 #[inline(always)]
-fn edge_run_base<A: ParticleAccess>(
+fn edge_run_base<P: Lane, A: ParticleAccess>(
     acc: &mut A,
     edges: &[[u32; 2]],
     rest: &[f32],
@@ -59,6 +61,7 @@ fn edge_run_base<A: ParticleAccess>(
     independent: bool,
 ) -> ProjectionCount {
     run_class!(
+        P,
         kernel,
         independent,
         acc,
@@ -76,7 +79,7 @@ fn edge_run_base<A: ParticleAccess>(
 
 /// Volume constraints of a run of tetrahedra of one colour class.
 #[inline(always)]
-fn volume_run_base<A: ParticleAccess>(
+fn volume_run_base<P: Lane, A: ParticleAccess>(
     acc: &mut A,
     tets: &[[u32; 4]],
     rest: &[f32],
@@ -86,6 +89,7 @@ fn volume_run_base<A: ParticleAccess>(
     independent: bool,
 ) -> ProjectionCount {
     run_class!(
+        P,
         kernel,
         independent,
         acc,
@@ -103,7 +107,7 @@ fn volume_run_base<A: ParticleAccess>(
 
 /// Vertex–face constraints of a run of tetrahedra of one colour class.
 #[inline(always)]
-fn vertex_face_run_base<A: ParticleAccess>(
+fn vertex_face_run_base<P: Lane, A: ParticleAccess>(
     acc: &mut A,
     tets: &[[u32; 4]],
     heights: &[[f32; 4]],
@@ -113,6 +117,7 @@ fn vertex_face_run_base<A: ParticleAccess>(
     independent: bool,
 ) -> ProjectionCount {
     run_class!(
+        P,
         kernel,
         independent,
         acc,
@@ -158,7 +163,7 @@ macro_rules! dispatched {
                 // SAFETY: the CPU has AVX2 and FMA (checked just above).
                 return unsafe { $fast(acc, $($arg,)* alpha_tilde) };
             }
-            $base(acc, $($arg,)* alpha_tilde, kernel, independent)
+            $base::<X2, A>(acc, $($arg,)* alpha_tilde, kernel, independent)
         }
 
         /// The same, compiled for AVX2 + FMA.
@@ -172,7 +177,7 @@ macro_rules! dispatched {
             $($arg: $ty,)*
             alpha_tilde: f32,
         ) -> ProjectionCount {
-            $base(acc, $($arg,)* alpha_tilde, Kernel::Simd, true)
+            $base::<Y8, A>(acc, $($arg,)* alpha_tilde, Kernel::Simd, true)
         }
     };
 }
@@ -261,7 +266,7 @@ mod tests {
                     // SAFETY: `avx2()` checked above.
                     unsafe { edge_run_avx2(&mut acc, x, d, l, at) };
                 } else {
-                    edge_run_base(&mut acc, x, d, l, at, Kernel::Simd, ind);
+                    edge_run_base::<X2, _>(&mut acc, x, d, l, at, Kernel::Simd, ind);
                 }
             }
             for (r, ind) in tets.classes.ranges() {
@@ -274,14 +279,14 @@ mod tests {
                     // SAFETY: `avx2()` checked above.
                     unsafe { volume_run_avx2(&mut acc, t, v, l, at) };
                 } else {
-                    volume_run_base(&mut acc, t, v, l, at, Kernel::Simd, ind);
+                    volume_run_base::<X2, _>(&mut acc, t, v, l, at, Kernel::Simd, ind);
                 }
                 let (h, l) = (&vf.rest_heights[r.clone()], &mut lam_f[r]);
                 if fast && ind {
                     // SAFETY: `avx2()` checked above.
                     unsafe { vertex_face_run_avx2(&mut acc, t, h, l, at) };
                 } else {
-                    vertex_face_run_base(&mut acc, t, h, l, at, Kernel::Simd, ind);
+                    vertex_face_run_base::<X2, _>(&mut acc, t, h, l, at, Kernel::Simd, ind);
                 }
             }
             let lam: Vec<u32> = lam_e
