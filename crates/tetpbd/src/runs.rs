@@ -302,3 +302,94 @@ mod tests {
         assert!(sse2 == avx2, "the AVX2 build differs from the SSE2 build");
     }
 }
+
+#[cfg(test)]
+mod pair_tests {
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::generators::{box_grid, CellSplit};
+    use crate::work::{self, WorkAccess};
+    use crate::SoftBodyBuilder;
+
+    /// Pairs of chunks move every particle and multiplier exactly as chunks of four alone
+    /// do: each colour class swept as one run (pairs of chunks, then a chunk, then the scalar
+    /// tail) and as runs of four items from the class start (one chunk each), on a sheared
+    /// body and on one squashed to 0.2 % of its height (faces across the squashed axis have
+    /// `|b × c| / Q` about 0.002, below κ: the pair and chunk fallbacks to the scalar kernel
+    /// run).
+    #[test]
+    fn pairs_are_bit_identical_to_chunks_of_four() {
+        for squash in [0.7, 0.002] {
+            let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [5; 3], CellSplit::Six).unwrap();
+            let mut body = SoftBodyBuilder::new(mesh)
+                .edges(1e-6)
+                .volume(1e-9)
+                .vertex_face(1e-6)
+                .build()
+                .unwrap();
+            for (i, x) in body.particles.positions.iter_mut().enumerate() {
+                let jitter = ((i * 7919) % 13) as f32 * 3e-5;
+                *x = Vector3::new(x.x + 0.1 * x.y, squash * x.y + jitter, x.z - 0.05 * x.x);
+            }
+            work::load(&mut body.particles);
+            let (tets, p) = (&body.tetrahedra, &body.particles);
+            let (e, vf) = (
+                body.edges.as_ref().unwrap(),
+                body.vertex_face.as_ref().unwrap(),
+            );
+            let sweep = |split: bool| {
+                let mut slots = p.work.0.clone();
+                let mut acc = WorkAccess {
+                    slots: &mut slots,
+                    rest: &p.rest_positions,
+                };
+                let mut lam_e = vec![0.0; e.edges.len()];
+                let mut lam_v = vec![0.0; tets.len()];
+                let mut lam_f = vec![[0.0; 4]; tets.len()];
+                let mut count = ProjectionCount::default();
+                let at = 1e-3;
+                let parts = |r: std::ops::Range<usize>| {
+                    let step = if split { lanes::LANES } else { r.len().max(1) };
+                    (r.start..r.end)
+                        .step_by(step)
+                        .map(move |s| s..(s + step).min(r.end))
+                };
+                let k = Kernel::Simd;
+                for (r, ind) in e.classes.ranges() {
+                    for q in parts(r) {
+                        let (x, d) = (&e.edges[q.clone()], &e.rest_lengths[q.clone()]);
+                        count += edge_run(&mut acc, x, d, &mut lam_e[q], at, k, ind);
+                    }
+                }
+                for (r, ind) in tets.classes.ranges() {
+                    for q in parts(r.clone()) {
+                        let (t, v) = (&tets.indices[q.clone()], &tets.rest_volumes[q.clone()]);
+                        count += volume_run(&mut acc, t, v, &mut lam_v[q], at, k, ind);
+                    }
+                    for q in parts(r) {
+                        let (t, h) = (&tets.indices[q.clone()], &vf.rest_heights[q.clone()]);
+                        count += vertex_face_run(&mut acc, t, h, &mut lam_f[q], at, k, ind);
+                    }
+                }
+                let lam: Vec<u32> = lam_e
+                    .iter()
+                    .chain(&lam_v)
+                    .chain(lam_f.iter().flatten())
+                    .map(|x| x.to_bits())
+                    .collect();
+                let bits: Vec<[u32; 8]> = slots
+                    .iter()
+                    .map(|s| {
+                        let [a, b, c, d] = s.xw.to_array();
+                        let [e, f, g, h] = s.r.to_array();
+                        [a, b, c, d, e, f, g, h].map(f32::to_bits)
+                    })
+                    .collect();
+                (bits, lam, count)
+            };
+            let (pairs, chunks) = (sweep(false), sweep(true));
+            assert!(pairs == chunks, "pairs differ from chunks (squash {squash})");
+        }
+    }
+}
