@@ -130,24 +130,17 @@ impl<'a, A: ParticleAccess, const N: usize> Bounded<'a, A, N> {
     /// lane.
     #[inline(always)]
     fn gather<L: Lane>(&self, at: usize, k: usize) -> (V3<L>, L) {
-        let mut q = [[f32x4::ZERO; 4]; 2];
-        for (c, quarter) in q.iter_mut().enumerate().take(L::WIDTH / LANES) {
+        let mut rows = [[f32x4::ZERO; 4]; 2];
+        for (c, r) in rows.iter_mut().enumerate().take(L::WIDTH / LANES) {
             let it = chunk(self.items, at + c * LANES);
             // SAFETY: `it[l][k]` is an index of `self.items`, all of which are below
             // `self.acc.len()` (checked in `new`; neither changes afterwards: both are
             // borrowed for `'a`, the access mutably).
             let row = |l: usize| unsafe { self.acc.row_unchecked(it[l][k] as usize) };
-            *quarter = f32x4::transpose([row(0), row(1), row(2), row(3)]);
+            *r = [row(0), row(1), row(2), row(3)];
         }
-        let lane = |j: usize| L::from_quarters([q[0][j], q[1][j]]);
-        (
-            V3 {
-                x: lane(0),
-                y: lane(1),
-                z: lane(2),
-            },
-            lane(3),
-        )
+        let [x, y, z, w] = L::transpose_in(rows);
+        (V3 { x, y, z }, w)
     }
 
     /// The four corners of the tetrahedra from `at`.
@@ -163,11 +156,10 @@ impl<'a, A: ParticleAccess, const N: usize> Bounded<'a, A, N> {
     /// Moves corner `k` of item `at + l` by lane `l` of `d` (compensated).
     #[inline(always)]
     fn scatter<L: Lane>(&mut self, at: usize, k: usize, d: V3<L>) {
-        let (x, y, z) = (d.x.quarters(), d.y.quarters(), d.z.quarters());
-        for c in 0..L::WIDTH / LANES {
+        let rows = L::transpose_out([d.x, d.y, d.z]);
+        for (c, r) in rows.iter().enumerate().take(L::WIDTH / LANES) {
             let it = chunk(self.items, at + c * LANES);
-            let rows = f32x4::transpose([x[c], y[c], z[c], f32x4::ZERO]);
-            for (item, row) in it.iter().zip(rows) {
+            for (item, &row) in it.iter().zip(r) {
                 // SAFETY: as in `gather`: an index of `self.items`, below `self.acc.len()`.
                 unsafe { self.acc.add_row_unchecked(item[k] as usize, row) };
             }

@@ -389,7 +389,10 @@ mod pair_tests {
                 (bits, lam, count)
             };
             let (pairs, chunks) = (sweep(false), sweep(true));
-            assert!(pairs == chunks, "pairs differ from chunks (squash {squash})");
+            assert!(
+                pairs == chunks,
+                "pairs differ from chunks (squash {squash})"
+            );
         }
     }
 }
