@@ -1,13 +1,15 @@
 //! Runs of one colour class through the kernels, and the choice of instruction set.
 //!
-//! The SIMD kernels are written once on `wide::f32x4` (SSE2 on x86-64, the baseline). On a
-//! CPU with AVX2 and FMA, the same code is also compiled with those features enabled
-//! (`#[target_feature]`) and chosen at run time (`is_x86_feature_detected!`): VEX-encoded
-//! three-operand instructions drop most of the register copies and spills SSE2's
-//! two-operand forms need. Rust never contracts `a * b + c` into a fused multiply–add on its
-//! own, so both builds do the same IEEE operations in the same order and give bit-identical
-//! results: which one runs changes the speed only, never the trajectory (and the serial and
-//! parallel sweeps, on any number of threads, stay bit-identical).
+//! The SIMD kernels are written once over a lane type ([`crate::simd::Lane`]). On a CPU with
+//! AVX2 and FMA, the runs are also compiled with those features enabled (`#[target_feature]`)
+//! and chosen at run time (`is_x86_feature_detected!`): VEX-encoded three-operand
+//! instructions drop most of the register copies SSE2's two-operand forms need, and pairs of
+//! chunks run on one 256-bit register ([`crate::simd::Y8`]) instead of two 128-bit halves
+//! ([`crate::simd::X2`], the SSE2 build). Rust never contracts `a * b + c` into a fused
+//! multiply–add on its own, and both pair types do the same IEEE operations on every lane in
+//! the same order, so both builds give bit-identical results: which one runs changes the
+//! speed only, never the trajectory (and the serial and parallel sweeps, on any number of
+//! threads, stay bit-identical).
 
 use wide::f32x4;
 
