@@ -15,7 +15,8 @@ pub(crate) trait ParticleAccess {
     /// Moves particle `i` by `d = [dx, dy, dz, 0]`, compensated (see
     /// [`crate::systems::add_compensated`]).
     fn add_row(&mut self, i: usize, d: f32x4);
-    /// Number of particles: `i < len()` is in range.
+    /// Number of particles: `i < len()` is in range. Constant while the access lives (the
+    /// unchecked accesses below rely on it).
     fn len(&self) -> usize;
     /// [`ParticleAccess::row`] without the bounds check.
     ///
