@@ -1,43 +1,48 @@
-//! SIMD kernels: four constraints of one colour class projected at once, one per lane.
+//! SIMD kernels: four or eight constraints of one colour class projected at once, one per
+//! lane.
 //!
 //! Constraints of one colour class share no particle (see [`crate::ordering`]), so four of
 //! them are independent: the `[x, y, z, w]` rows of their particles (see [`crate::work`])
 //! are loaded and transposed into lanes (`wide::f32x4`), the same formulas as
 //! [`crate::constraint`] run on all lanes, and the corrections are transposed back into
-//! rows and added with the compensated update. The scalar kernels in
-//! [`crate::projection`] are the reference these are tested against (`tests/lanes.rs`).
+//! rows and added with the compensated update. The kernels are written over a [`Lane`] type:
+//! a chunk of four (`f32x4`) or two chunks side by side ([`crate::simd::X2`]), which gives
+//! the same bits as the two chunks one after the other (see [`crate::simd`]). The scalar
+//! kernels in [`crate::projection`] are the reference these are tested against
+//! (`tests/lanes.rs`).
 //!
 //! A chunk whose lanes hit a degenerate configuration (a zero-length edge, a face too close
 //! to collinear) or, for vertex–face, a thin face (the thin branch of
 //! [`crate::constraint::vertex_face_bounded`]) is handed to the scalar kernel, which owns the
-//! documented fallbacks.
+//! documented fallbacks; a pair of chunks that has one goes back to chunks of four.
 
 use wide::f32x4;
 
 use crate::constraint::{VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
 use crate::projection::{self, ParticleAccess};
+use crate::simd::Lane;
 use crate::systems::ProjectionCount;
 
 /// Lanes per chunk.
 pub(crate) const LANES: usize = 4;
 
-/// Four 3-vectors, one per lane.
+/// 3-vectors, one per lane.
 #[derive(Clone, Copy)]
-struct V3 {
-    x: f32x4,
-    y: f32x4,
-    z: f32x4,
+struct V3<L> {
+    x: L,
+    y: L,
+    z: L,
 }
 
-impl V3 {
-    const ZERO: V3 = V3 {
-        x: f32x4::ZERO,
-        y: f32x4::ZERO,
-        z: f32x4::ZERO,
+impl<L: Lane> V3<L> {
+    const ZERO: V3<L> = V3 {
+        x: L::ZERO,
+        y: L::ZERO,
+        z: L::ZERO,
     };
 
     #[inline(always)]
-    fn add(self, o: V3) -> V3 {
+    fn add(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.x + o.x,
             y: self.y + o.y,
@@ -46,7 +51,7 @@ impl V3 {
     }
 
     #[inline(always)]
-    fn sub(self, o: V3) -> V3 {
+    fn sub(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.x - o.x,
             y: self.y - o.y,
@@ -55,7 +60,7 @@ impl V3 {
     }
 
     #[inline(always)]
-    fn scale(self, s: f32x4) -> V3 {
+    fn scale(self, s: L) -> V3<L> {
         V3 {
             x: self.x * s,
             y: self.y * s,
@@ -64,7 +69,7 @@ impl V3 {
     }
 
     #[inline(always)]
-    fn neg(self) -> V3 {
+    fn neg(self) -> V3<L> {
         V3 {
             x: -self.x,
             y: -self.y,
@@ -73,12 +78,12 @@ impl V3 {
     }
 
     #[inline(always)]
-    fn dot(self, o: V3) -> f32x4 {
+    fn dot(self, o: V3<L>) -> L {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
     #[inline(always)]
-    fn cross(self, o: V3) -> V3 {
+    fn cross(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.y * o.z - self.z * o.y,
             y: self.z * o.x - self.x * o.z,
@@ -87,76 +92,132 @@ impl V3 {
     }
 }
 
-/// Positions and inverse masses of particles `idx`, one per lane.
-#[inline(always)]
-fn gather<A: ParticleAccess>(acc: &A, idx: [usize; LANES]) -> (V3, f32x4) {
-    let [x, y, z, w] = f32x4::transpose([
-        acc.row(idx[0]),
-        acc.row(idx[1]),
-        acc.row(idx[2]),
-        acc.row(idx[3]),
-    ]);
-    (V3 { x, y, z }, w)
+/// The items of one run (edges or tetrahedra as particle indices) with the particles they
+/// index, every index checked once against the particle count: the kernels then read and
+/// move the items' particles without a bounds check per access.
+pub(crate) struct Bounded<'a, A, const N: usize> {
+    acc: &'a mut A,
+    items: &'a [[u32; N]],
 }
 
-/// The four corners of four tetrahedra: positions and inverse masses per corner.
-#[inline(always)]
-fn gather_corners<A: ParticleAccess>(acc: &A, idx: &[[usize; LANES]; 4]) -> ([V3; 4], [f32x4; 4]) {
-    let (p0, w0) = gather(acc, idx[0]);
-    let (p1, w1) = gather(acc, idx[1]);
-    let (p2, w2) = gather(acc, idx[2]);
-    let (p3, w3) = gather(acc, idx[3]);
-    ([p0, p1, p2, p3], [w0, w1, w2, w3])
+impl<'a, A: ParticleAccess, const N: usize> Bounded<'a, A, N> {
+    /// Checks that every index of `items` is below `acc.len()` (one vectorised pass over the
+    /// run; panics on an index out of range, as a checked access would).
+    #[inline(always)]
+    pub(crate) fn new(acc: &'a mut A, items: &'a [[u32; N]]) -> Self {
+        let max = items.as_flattened().iter().fold(0, |m, &i| m.max(i));
+        assert!(
+            items.is_empty() || (max as usize) < acc.len(),
+            "particle index {max} out of range ({} particles)",
+            acc.len()
+        );
+        Bounded { acc, items }
+    }
+
+    /// The particles, for the scalar kernels (bounds-checked).
+    #[inline(always)]
+    pub(crate) fn acc(&mut self) -> &mut A {
+        self.acc
+    }
+
+    /// The items.
+    #[inline(always)]
+    pub(crate) fn items(&self) -> &'a [[u32; N]] {
+        self.items
+    }
+
+    /// Corner `k` of the `L::WIDTH` items from `at`: positions and inverse masses, one per
+    /// lane.
+    #[inline(always)]
+    fn gather<L: Lane>(&self, at: usize, k: usize) -> (V3<L>, L) {
+        let mut rows = [[f32x4::ZERO; 4]; 2];
+        for (c, r) in rows.iter_mut().enumerate().take(L::WIDTH / LANES) {
+            let it = chunk(self.items, at + c * LANES);
+            // SAFETY: `it[l][k]` is an index of `self.items`, all of which are below
+            // `self.acc.len()` (checked in `new`; neither changes afterwards: both are
+            // borrowed for `'a`, the access mutably).
+            let row = |l: usize| unsafe { self.acc.row_unchecked(it[l][k] as usize) };
+            *r = [row(0), row(1), row(2), row(3)];
+        }
+        let [x, y, z, w] = L::transpose_in(rows);
+        (V3 { x, y, z }, w)
+    }
+
+    /// The four corners of the tetrahedra from `at`.
+    #[inline(always)]
+    fn gather_corners<L: Lane>(&self, at: usize) -> ([V3<L>; 4], [L; 4]) {
+        let (p0, w0) = self.gather(at, 0);
+        let (p1, w1) = self.gather(at, 1);
+        let (p2, w2) = self.gather(at, 2);
+        let (p3, w3) = self.gather(at, 3);
+        ([p0, p1, p2, p3], [w0, w1, w2, w3])
+    }
+
+    /// Moves corner `k` of item `at + l` by lane `l` of `d` (compensated).
+    #[inline(always)]
+    fn scatter<L: Lane>(&mut self, at: usize, k: usize, d: V3<L>) {
+        let rows = L::transpose_out([d.x, d.y, d.z]);
+        for (c, r) in rows.iter().enumerate().take(L::WIDTH / LANES) {
+            let it = chunk(self.items, at + c * LANES);
+            for (item, &row) in it.iter().zip(r) {
+                // SAFETY: as in `gather`: an index of `self.items`, below `self.acc.len()`.
+                unsafe { self.acc.add_row_unchecked(item[k] as usize, row) };
+            }
+        }
+    }
 }
 
-/// Four rows of four values, transposed: item `k` of every row as lanes.
+/// Rows of four values from `at`, transposed: value `k` of every row as lanes.
 #[inline(always)]
-fn transpose_rows(rows: &[[f32; 4]; LANES]) -> [f32x4; 4] {
-    f32x4::transpose([
-        f32x4::new(rows[0]),
-        f32x4::new(rows[1]),
-        f32x4::new(rows[2]),
-        f32x4::new(rows[3]),
-    ])
+fn transpose_rows<L: Lane>(rows: &[[f32; 4]], at: usize) -> [L; 4] {
+    let mut q = [[f32x4::ZERO; 4]; 2];
+    for (c, quarter) in q.iter_mut().enumerate().take(L::WIDTH / LANES) {
+        let r = chunk(rows, at + c * LANES);
+        *quarter = f32x4::transpose(r.map(f32x4::new));
+    }
+    [0, 1, 2, 3].map(|k| L::from_quarters([q[0][k], q[1][k]]))
 }
 
-/// Moves particle `idx[l]` by lane `l` of `d` (compensated).
+/// The inverse of [`transpose_rows`]: lane `l` of `lanes[k]` to value `k` of row `at + l`.
 #[inline(always)]
-fn scatter<A: ParticleAccess>(acc: &mut A, idx: [usize; LANES], d: V3) {
-    let rows = f32x4::transpose([d.x, d.y, d.z, f32x4::ZERO]);
-    for (i, row) in idx.into_iter().zip(rows) {
-        acc.add_row(i, row);
+fn untranspose_rows<L: Lane>(lanes: [L; 4], rows: &mut [[f32; 4]], at: usize) {
+    let [q0, q1, q2, q3] = lanes.map(L::quarters);
+    for c in 0..L::WIDTH / LANES {
+        let r = chunk_mut(rows, at + c * LANES);
+        let t = f32x4::transpose([q0[c], q1[c], q2[c], q3[c]]);
+        for (row, l) in r.iter_mut().zip(t) {
+            *row = l.to_array();
+        }
+    }
+}
+
+/// `L::WIDTH` consecutive values from `at` as lanes.
+#[inline(always)]
+fn lanes_of<L: Lane>(v: &[f32], at: usize) -> L {
+    let mut q = [f32x4::ZERO; 2];
+    for (c, quarter) in q.iter_mut().enumerate().take(L::WIDTH / LANES) {
+        *quarter = f32x4::new(*chunk(v, at + c * LANES));
+    }
+    L::from_quarters(q)
+}
+
+/// Stores lanes to `L::WIDTH` consecutive values from `at`.
+#[inline(always)]
+fn store_lanes<L: Lane>(l: L, v: &mut [f32], at: usize) {
+    let q = l.quarters();
+    for (c, quarter) in q.iter().enumerate().take(L::WIDTH / LANES) {
+        *chunk_mut(v, at + c * LANES) = quarter.to_array();
     }
 }
 
 /// `Δλ` on every lane; 0 where the denominator is not positive. Returns the mask of
 /// applied lanes.
 #[inline(always)]
-fn delta_lambda(c: f32x4, lambda: f32x4, alpha_tilde: f32x4, w_grad_sq: f32x4) -> (f32x4, f32x4) {
+fn delta_lambda<L: Lane>(c: L, lambda: L, alpha_tilde: L, w_grad_sq: L) -> (L, L) {
     let denom = w_grad_sq + alpha_tilde;
-    let ok = denom.simd_gt(f32x4::splat(f32::EPSILON * f32::EPSILON));
-    let safe = ok.select(denom, f32x4::ONE);
-    (
-        ok.select((-c - alpha_tilde * lambda) / safe, f32x4::ZERO),
-        ok,
-    )
-}
-
-/// Corner `k` of each of the `LANES` items.
-#[inline(always)]
-fn corner<const N: usize>(items: &[[u32; N]; LANES], k: usize) -> [usize; LANES] {
-    [
-        items[0][k] as usize,
-        items[1][k] as usize,
-        items[2][k] as usize,
-        items[3][k] as usize,
-    ]
-}
-
-/// Four consecutive values as lanes.
-#[inline(always)]
-fn lanes_of(v: &[f32; LANES]) -> f32x4 {
-    f32x4::new(*v)
+    let ok = denom.vgt(L::splat(f32::EPSILON * f32::EPSILON));
+    let safe = ok.vsel(denom, L::ONE);
+    (ok.vsel((-c - alpha_tilde * lambda) / safe, L::ZERO), ok)
 }
 
 /// `LANES` items of `s` from `at` (the caller keeps `at + LANES ≤ s.len()`).
@@ -175,108 +236,112 @@ pub(crate) fn chunk_mut<T>(s: &mut [T], at: usize) -> &mut [T; LANES] {
         .expect("a chunk of LANES items")
 }
 
-/// Four edges. See [`projection::edge`].
+/// Bits of the `L::WIDTH` lanes.
 #[inline(always)]
-pub(crate) fn edges<A: ParticleAccess>(
-    acc: &mut A,
-    edges: &[[u32; 2]; LANES],
-    rest: &[f32; LANES],
-    lambdas: &mut [f32; LANES],
+fn all_lanes<L: Lane>() -> u32 {
+    (1 << L::WIDTH) - 1
+}
+
+/// `L::WIDTH` edges from `at` of the run. See [`projection::edge`]. A pair of chunks with a
+/// zero-length edge goes to [`edges`] chunk by chunk, a chunk of four with one to the scalar
+/// kernel.
+#[inline(always)]
+pub(crate) fn edges<L: Lane, A: ParticleAccess>(
+    b: &mut Bounded<'_, A, 2>,
+    at: usize,
+    rest: &[f32],
+    lambdas: &mut [f32],
     alpha_tilde: f32,
 ) -> ProjectionCount {
-    let (ia, ib) = (corner(edges, 0), corner(edges, 1));
-    let d = lanes_of(rest);
-    let (pa, wa) = gather(acc, ia);
-    let (pb, wb) = gather(acc, ib);
+    let d: L = lanes_of(rest, at);
+    let (pa, wa) = b.gather::<L>(at, 0);
+    let (pb, wb) = b.gather::<L>(at, 1);
     let delta = pa.sub(pb);
-    let len = delta.dot(delta).sqrt();
-    if !len.simd_gt(d * f32x4::splat(1e-6)).all() {
+    let len = delta.dot(delta).vsqrt();
+    if !len.vgt(d * L::splat(1e-6)).vall() {
         let mut count = ProjectionCount::default();
-        for l in 0..LANES {
+        if L::WIDTH > LANES {
+            for c in (0..L::WIDTH).step_by(LANES) {
+                count += edges::<f32x4, A>(b, at + c, rest, lambdas, alpha_tilde);
+            }
+            return count;
+        }
+        let edges = chunk(b.items(), at);
+        for (l, &e) in edges.iter().enumerate() {
+            let k = at + l;
             count.add(projection::edge(
-                acc,
-                edges[l],
-                rest[l],
-                &mut lambdas[l],
+                b.acc(),
+                e,
+                rest[k],
+                &mut lambdas[k],
                 alpha_tilde,
             ));
         }
         return count;
     }
-    let n = delta.scale(f32x4::ONE / len);
-    let lam = lanes_of(lambdas);
-    let (dl, ok) = delta_lambda(len - d, lam, f32x4::splat(alpha_tilde), wa + wb);
-    *lambdas = (lam + dl).to_array();
-    scatter(acc, ia, n.scale(wa * dl));
-    scatter(acc, ib, n.scale(-wb * dl));
+    let n = delta.scale(L::ONE / len);
+    let lam: L = lanes_of(lambdas, at);
+    let (dl, ok) = delta_lambda(len - d, lam, L::splat(alpha_tilde), wa + wb);
+    store_lanes(lam + dl, lambdas, at);
+    b.scatter(at, 0, n.scale(wa * dl));
+    b.scatter(at, 1, n.scale(-wb * dl));
     ProjectionCount {
-        applied: ok.to_bitmask().count_ones() as u64,
+        applied: u64::from(ok.vbits().count_ones()),
         degenerate: 0,
     }
 }
 
-/// Four volume constraints. See [`projection::volume`].
+/// `L::WIDTH` volume constraints from `at` of the run. See [`projection::volume`].
 #[inline(always)]
-pub(crate) fn volumes<A: ParticleAccess>(
-    acc: &mut A,
-    tets: &[[u32; 4]; LANES],
-    rest: &[f32; LANES],
-    lambdas: &mut [f32; LANES],
+pub(crate) fn volumes<L: Lane, A: ParticleAccess>(
+    bd: &mut Bounded<'_, A, 4>,
+    at: usize,
+    rest: &[f32],
+    lambdas: &mut [f32],
     alpha_tilde: f32,
 ) -> ProjectionCount {
-    let idx = [
-        corner(tets, 0),
-        corner(tets, 1),
-        corner(tets, 2),
-        corner(tets, 3),
-    ];
-    let (p, w) = gather_corners(acc, &idx);
-    let sixth = f32x4::splat(1.0 / 6.0);
+    let (p, w) = bd.gather_corners::<L>(at);
+    let sixth = L::splat(1.0 / 6.0);
     let (a, b, c) = (p[1].sub(p[0]), p[2].sub(p[0]), p[3].sub(p[0]));
     let bc = b.cross(c);
     let g1 = bc.scale(sixth);
     let g2 = c.cross(a).scale(sixth);
     let g3 = a.cross(b).scale(sixth);
     let g0 = g1.add(g2).add(g3).neg();
-    let cval = a.dot(bc) * sixth - lanes_of(rest);
+    let cval = a.dot(bc) * sixth - lanes_of(rest, at);
     let g = [g0, g1, g2, g3];
-    let w_grad_sq = (0..4).fold(f32x4::ZERO, |s, k| s + w[k] * g[k].dot(g[k]));
-    let lam = lanes_of(lambdas);
-    let (dl, ok) = delta_lambda(cval, lam, f32x4::splat(alpha_tilde), w_grad_sq);
-    *lambdas = (lam + dl).to_array();
+    let w_grad_sq = (0..4).fold(L::ZERO, |s, k| s + w[k] * g[k].dot(g[k]));
+    let lam: L = lanes_of(lambdas, at);
+    let (dl, ok) = delta_lambda(cval, lam, L::splat(alpha_tilde), w_grad_sq);
+    store_lanes(lam + dl, lambdas, at);
     for k in 0..4 {
-        scatter(acc, idx[k], g[k].scale(w[k] * dl));
+        bd.scatter(at, k, g[k].scale(w[k] * dl));
     }
-    let any_free = (w[0] + w[1] + w[2] + w[3]).simd_gt(f32x4::ZERO);
+    let any_free = (w[0] + w[1] + w[2] + w[3]).vgt(L::ZERO);
     ProjectionCount {
-        applied: ok.to_bitmask().count_ones() as u64,
-        degenerate: (!ok.to_bitmask() & any_free.to_bitmask() & 0xf).count_ones() as u64,
+        applied: u64::from(ok.vbits().count_ones()),
+        degenerate: u64::from((!ok.vbits() & any_free.vbits() & all_lanes::<L>()).count_ones()),
     }
 }
 
-/// The four vertex–face constraints of four tetrahedra, the four one after another on all
-/// lanes, corrections accumulated in registers and scattered once. See
-/// [`projection::vertex_face`]: on healthy faces [`crate::constraint::vertex_face_bounded`]
-/// is the seed's height, which these lanes compute. A chunk with a face not healthy by a
-/// margin of 2 at its start (`|b × c| ≤ 2κQ`, κ = [`VERTEX_FACE_KAPPA`]) goes to the scalar
-/// kernel; a lane whose face turns thin (`|b × c| < κQ`) within the chunk skips that
-/// projection and counts it as degenerate.
+/// The four vertex–face constraints of `L::WIDTH` tetrahedra from `at` of the run, the four
+/// one after another on all lanes, corrections accumulated in registers and scattered once.
+/// See [`projection::vertex_face`]: on healthy faces
+/// [`crate::constraint::vertex_face_bounded`] is the seed's height, which these lanes
+/// compute. A chunk of four with a face not healthy by a margin of 2 at its start
+/// (`|b × c| ≤ 2κQ`, κ = [`VERTEX_FACE_KAPPA`]) goes to the scalar kernel (a pair of chunks
+/// with one, to this kernel chunk by chunk); a lane whose face turns thin (`|b × c| < κQ`)
+/// within the chunk skips that projection and counts it as degenerate.
 #[inline(always)]
-pub(crate) fn vertex_faces<A: ParticleAccess>(
-    acc: &mut A,
-    tets: &[[u32; 4]; LANES],
-    heights: &[[f32; 4]; LANES],
-    lambdas: &mut [[f32; 4]; LANES],
+pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
+    bd: &mut Bounded<'_, A, 4>,
+    at: usize,
+    heights: &[[f32; 4]],
+    lambdas: &mut [[f32; 4]],
     alpha_tilde: f32,
 ) -> ProjectionCount {
-    let idx = [
-        corner(tets, 0),
-        corner(tets, 1),
-        corner(tets, 2),
-        corner(tets, 3),
-    ];
-    let (p0, w) = gather_corners(acc, &idx);
-    let kappa = f32x4::splat(VERTEX_FACE_KAPPA);
+    let (p0, w) = bd.gather_corners::<L>(at);
+    let kappa = L::splat(VERTEX_FACE_KAPPA);
     // Pre-check every face at the start of the chunk: healthy with a margin of 2.
     for order in VERTEX_FACE_ORDER {
         let (b, c) = (
@@ -285,28 +350,31 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
         );
         let m = b.cross(c);
         let twice_k = kappa * (b.dot(b) + c.dot(c));
-        let ok = m.dot(m).simd_gt(twice_k * twice_k);
-        if !ok.all() {
+        let ok = m.dot(m).vgt(twice_k * twice_k);
+        if !ok.vall() {
             let mut count = ProjectionCount::default();
-            for l in 0..LANES {
-                let (a, d) = projection::vertex_face(
-                    acc,
-                    tets[l],
-                    &heights[l],
-                    &mut lambdas[l],
-                    alpha_tilde,
-                );
+            if L::WIDTH > LANES {
+                for c in (0..L::WIDTH).step_by(LANES) {
+                    count += vertex_faces::<f32x4, A>(bd, at + c, heights, lambdas, alpha_tilde);
+                }
+                return count;
+            }
+            let tets = chunk(bd.items(), at);
+            for (l, &t) in tets.iter().enumerate() {
+                let k = at + l;
+                let (a, d) =
+                    projection::vertex_face(bd.acc(), t, &heights[k], &mut lambdas[k], alpha_tilde);
                 count.applied += u64::from(a);
                 count.degenerate += u64::from(d);
             }
             return count;
         }
     }
-    let at = f32x4::splat(alpha_tilde);
-    // Per constraint k, the four tetrahedra's heights and multipliers as lanes.
-    let h = transpose_rows(heights);
-    let mut lam = transpose_rows(lambdas);
-    let mut dp = [V3::ZERO; 4];
+    let alpha = L::splat(alpha_tilde);
+    // Per constraint k, the tetrahedra's heights and multipliers as lanes.
+    let h: [L; 4] = transpose_rows(heights, at);
+    let mut lam: [L; 4] = transpose_rows(lambdas, at);
+    let mut dp = [V3::<L>::ZERO; 4];
     let mut count = ProjectionCount::default();
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
         let q = [
@@ -317,10 +385,10 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
         ];
         let (a, b, c) = (q[1].sub(q[0]), q[2].sub(q[0]), q[3].sub(q[0]));
         let m = b.cross(c);
-        let m_len = m.dot(m).sqrt();
+        let m_len = m.dot(m).vsqrt();
         // Healthy (`s ≥ κQ`, Q = (|b|² + |c|²)/2): the seed's height.
-        let valid = m_len.simd_ge((b.dot(b) + c.dot(c)) * kappa * f32x4::splat(0.5));
-        let inv = valid.select(f32x4::ONE / m_len, f32x4::ZERO);
+        let valid = m_len.vge((b.dot(b) + c.dot(c)) * kappa * L::splat(0.5));
+        let inv = valid.vsel(L::ONE / m_len, L::ZERO);
         let n = m.scale(inv);
         let na = n.dot(a);
         let g1 = n;
@@ -329,23 +397,20 @@ pub(crate) fn vertex_faces<A: ParticleAccess>(
         let g0 = g1.add(g2).add(g3).neg();
         let g = [g0, g1, g2, g3];
         let wo = [w[order[0]], w[order[1]], w[order[2]], w[order[3]]];
-        let w_grad_sq = (0..4).fold(f32x4::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
-        let (dl, ok) = delta_lambda(na - h[k], lam[k], at, w_grad_sq);
-        let dl = valid.select(dl, f32x4::ZERO);
+        let w_grad_sq = (0..4).fold(L::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
+        let (dl, ok) = delta_lambda(na - h[k], lam[k], alpha, w_grad_sq);
+        let dl = valid.vsel(dl, L::ZERO);
         let ok = ok & valid;
         lam[k] += dl;
         for s in 0..4 {
             dp[order[s]] = dp[order[s]].add(g[s].scale(wo[s] * dl));
         }
-        count.applied += ok.to_bitmask().count_ones() as u64;
-        count.degenerate += (!valid.to_bitmask() & 0xf).count_ones() as u64;
+        count.applied += u64::from(ok.vbits().count_ones());
+        count.degenerate += u64::from((!valid.vbits() & all_lanes::<L>()).count_ones());
     }
-    let lam = f32x4::transpose(lam);
-    for (row, l) in lambdas.iter_mut().zip(lam) {
-        *row = l.to_array();
-    }
-    for (corner, d) in idx.into_iter().zip(dp) {
-        scatter(acc, corner, d);
+    untranspose_rows(lam, lambdas, at);
+    for (k, d) in dp.into_iter().enumerate() {
+        bd.scatter(at, k, d);
     }
     count
 }

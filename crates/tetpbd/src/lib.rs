@@ -41,6 +41,7 @@ mod projection;
 mod runs;
 #[cfg(feature = "parallel")]
 mod schedule;
+mod simd;
 mod solver;
 mod stacking;
 mod stats;

@@ -190,6 +190,22 @@ impl ParticleAccess for SharedAccess {
         // running colour class, so this is the only reference to it.
         unsafe { (*self.slots.add(i)).add(d) }
     }
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.len
+    }
+    #[inline(always)]
+    unsafe fn row_unchecked(&self, i: usize) -> f32x4 {
+        // SAFETY: `i < self.len` (the caller's contract); no other thread writes particle
+        // `i` (colour class, as in `row`).
+        unsafe { (*self.slots.add(i)).xw }
+    }
+    #[inline(always)]
+    unsafe fn add_row_unchecked(&mut self, i: usize, d: f32x4) {
+        // SAFETY: `i < self.len` (the caller's contract); particle `i` is this item's alone
+        // within the running colour class, as in `add_row`.
+        unsafe { (*self.slots.add(i)).add(d) }
+    }
 }
 
 /// Runs `f` over every class, classes in order, in one parallel region

@@ -15,6 +15,25 @@ pub(crate) trait ParticleAccess {
     /// Moves particle `i` by `d = [dx, dy, dz, 0]`, compensated (see
     /// [`crate::systems::add_compensated`]).
     fn add_row(&mut self, i: usize, d: f32x4);
+    /// Number of particles: `i < len()` is in range. Constant while the access lives (the
+    /// unchecked accesses below rely on it).
+    fn len(&self) -> usize;
+    /// [`ParticleAccess::row`] without the bounds check.
+    ///
+    /// # Safety
+    /// `i < self.len()`.
+    #[inline(always)]
+    unsafe fn row_unchecked(&self, i: usize) -> f32x4 {
+        self.row(i)
+    }
+    /// [`ParticleAccess::add_row`] without the bounds check.
+    ///
+    /// # Safety
+    /// `i < self.len()`.
+    #[inline(always)]
+    unsafe fn add_row_unchecked(&mut self, i: usize, d: f32x4) {
+        self.add_row(i, d);
+    }
 
     /// Position of particle `i`.
     #[inline(always)]

@@ -1,32 +1,50 @@
 //! Runs of one colour class through the kernels, and the choice of instruction set.
 //!
-//! The SIMD kernels are written once on `wide::f32x4` (SSE2 on x86-64, the baseline). On a
-//! CPU with AVX2 and FMA, the same code is also compiled with those features enabled
-//! (`#[target_feature]`) and chosen at run time (`is_x86_feature_detected!`): VEX-encoded
-//! three-operand instructions drop most of the register copies and spills SSE2's
-//! two-operand forms need. Rust never contracts `a * b + c` into a fused multiply–add on its
-//! own, so both builds do the same IEEE operations in the same order and give bit-identical
-//! results: which one runs changes the speed only, never the trajectory (and the serial and
-//! parallel sweeps, on any number of threads, stay bit-identical).
+//! The SIMD kernels are written once over a lane type ([`crate::simd::Lane`]). On a CPU with
+//! AVX2 and FMA, the runs are also compiled with those features enabled (`#[target_feature]`)
+//! and chosen at run time (`is_x86_feature_detected!`): VEX-encoded three-operand
+//! instructions drop most of the register copies SSE2's two-operand forms need, and pairs of
+//! chunks run on one 256-bit register ([`crate::simd::Y8`]) instead of two 128-bit halves
+//! ([`crate::simd::X2`], the SSE2 build). Rust never contracts `a * b + c` into a fused
+//! multiply–add on its own, and both pair types do the same IEEE operations on every lane in
+//! the same order, so both builds give bit-identical results: which one runs changes the
+//! speed only, never the trajectory (and the serial and parallel sweeps, on any number of
+//! threads, stay bit-identical).
+
+use wide::f32x4;
 
 use crate::lanes;
 use crate::projection::{self, ParticleAccess};
+#[cfg(target_arch = "x86_64")]
+use crate::simd::Y8;
+use crate::simd::{Lane, X2};
 use crate::systems::{Kernel, ProjectionCount};
 
-/// Projects a run of constraints of one colour class: in chunks of [`lanes::LANES`] when the
-/// class is independent and the kernel is SIMD, the rest one by one.
+/// Projects a run of constraints of one colour class: when the class is independent and the
+/// kernel is SIMD, in pairs of chunks of [`lanes::LANES`] ([`X2`]), then one chunk of four,
+/// on the run's items with their indices checked once ([`lanes::Bounded`]); the rest one by
+/// one. A pair gives the bits of its two chunks one after the other, so the results do not
+/// depend on where a run starts (serial class or parallel part).
 macro_rules! run_class {
-    ($kernel:expr, $independent:expr, $len:expr, |$s:ident| $lanes:expr, |$k:ident| $scalar:expr) => {{
+    ($pair:ty, $kernel:expr, $independent:expr, $acc:expr, $items:expr,
+     $lanes:ident($($arg:expr),*), |$a:ident, $k:ident| $scalar:expr) => {{
         let mut count = ProjectionCount::default();
         let mut start = 0;
-        if $kernel == Kernel::Simd && $independent {
-            while start + lanes::LANES <= $len {
-                let $s = start;
-                count += $lanes;
+        let (acc, items) = ($acc, $items);
+        let len = items.len();
+        if $kernel == Kernel::Simd && $independent && len >= lanes::LANES {
+            let mut bounded = lanes::Bounded::new(acc, items);
+            while start + 2 * lanes::LANES <= len {
+                count += lanes::$lanes::<$pair, _>(&mut bounded, start, $($arg),*);
+                start += 2 * lanes::LANES;
+            }
+            if start + lanes::LANES <= len {
+                count += lanes::$lanes::<f32x4, _>(&mut bounded, start, $($arg),*);
                 start += lanes::LANES;
             }
         }
-        for $k in start..$len {
+        let $a = acc;
+        for $k in start..len {
             count += $scalar;
         }
         count
@@ -35,7 +53,7 @@ macro_rules! run_class {
 
 /// Edges `edges[i]` with their rest lengths and multipliers, all of one colour class.
 #[inline(always)]
-fn edge_run_base<A: ParticleAccess>(
+fn edge_run_base<P: Lane, A: ParticleAccess>(
     acc: &mut A,
     edges: &[[u32; 2]],
     rest: &[f32],
@@ -45,18 +63,14 @@ fn edge_run_base<A: ParticleAccess>(
     independent: bool,
 ) -> ProjectionCount {
     run_class!(
+        P,
         kernel,
         independent,
-        edges.len(),
-        |s| lanes::edges(
-            acc,
-            lanes::chunk(edges, s),
-            lanes::chunk(rest, s),
-            lanes::chunk_mut(lambdas, s),
-            alpha_tilde
-        ),
-        |k| one(projection::edge(
-            acc,
+        acc,
+        edges,
+        edges(rest, lambdas, alpha_tilde),
+        |a, k| one(projection::edge(
+            a,
             edges[k],
             rest[k],
             &mut lambdas[k],
@@ -67,7 +81,7 @@ fn edge_run_base<A: ParticleAccess>(
 
 /// Volume constraints of a run of tetrahedra of one colour class.
 #[inline(always)]
-fn volume_run_base<A: ParticleAccess>(
+fn volume_run_base<P: Lane, A: ParticleAccess>(
     acc: &mut A,
     tets: &[[u32; 4]],
     rest: &[f32],
@@ -77,18 +91,14 @@ fn volume_run_base<A: ParticleAccess>(
     independent: bool,
 ) -> ProjectionCount {
     run_class!(
+        P,
         kernel,
         independent,
-        tets.len(),
-        |s| lanes::volumes(
-            acc,
-            lanes::chunk(tets, s),
-            lanes::chunk(rest, s),
-            lanes::chunk_mut(lambdas, s),
-            alpha_tilde
-        ),
-        |k| one(projection::volume(
-            acc,
+        acc,
+        tets,
+        volumes(rest, lambdas, alpha_tilde),
+        |a, k| one(projection::volume(
+            a,
             tets[k],
             rest[k],
             &mut lambdas[k],
@@ -99,7 +109,7 @@ fn volume_run_base<A: ParticleAccess>(
 
 /// Vertex–face constraints of a run of tetrahedra of one colour class.
 #[inline(always)]
-fn vertex_face_run_base<A: ParticleAccess>(
+fn vertex_face_run_base<P: Lane, A: ParticleAccess>(
     acc: &mut A,
     tets: &[[u32; 4]],
     heights: &[[f32; 4]],
@@ -109,21 +119,17 @@ fn vertex_face_run_base<A: ParticleAccess>(
     independent: bool,
 ) -> ProjectionCount {
     run_class!(
+        P,
         kernel,
         independent,
-        tets.len(),
-        |s| lanes::vertex_faces(
-            acc,
-            lanes::chunk(tets, s),
-            lanes::chunk(heights, s),
-            lanes::chunk_mut(lambdas, s),
-            alpha_tilde
-        ),
-        |k| {
-            let (a, d) =
-                projection::vertex_face(acc, tets[k], &heights[k], &mut lambdas[k], alpha_tilde);
+        acc,
+        tets,
+        vertex_faces(heights, lambdas, alpha_tilde),
+        |a, k| {
+            let (ap, d) =
+                projection::vertex_face(a, tets[k], &heights[k], &mut lambdas[k], alpha_tilde);
             ProjectionCount {
-                applied: u64::from(a),
+                applied: u64::from(ap),
                 degenerate: u64::from(d),
             }
         }
@@ -159,7 +165,7 @@ macro_rules! dispatched {
                 // SAFETY: the CPU has AVX2 and FMA (checked just above).
                 return unsafe { $fast(acc, $($arg,)* alpha_tilde) };
             }
-            $base(acc, $($arg,)* alpha_tilde, kernel, independent)
+            $base::<X2, A>(acc, $($arg,)* alpha_tilde, kernel, independent)
         }
 
         /// The same, compiled for AVX2 + FMA.
@@ -173,7 +179,7 @@ macro_rules! dispatched {
             $($arg: $ty,)*
             alpha_tilde: f32,
         ) -> ProjectionCount {
-            $base(acc, $($arg,)* alpha_tilde, Kernel::Simd, true)
+            $base::<Y8, A>(acc, $($arg,)* alpha_tilde, Kernel::Simd, true)
         }
     };
 }
@@ -262,7 +268,7 @@ mod tests {
                     // SAFETY: `avx2()` checked above.
                     unsafe { edge_run_avx2(&mut acc, x, d, l, at) };
                 } else {
-                    edge_run_base(&mut acc, x, d, l, at, Kernel::Simd, ind);
+                    edge_run_base::<X2, _>(&mut acc, x, d, l, at, Kernel::Simd, ind);
                 }
             }
             for (r, ind) in tets.classes.ranges() {
@@ -275,14 +281,14 @@ mod tests {
                     // SAFETY: `avx2()` checked above.
                     unsafe { volume_run_avx2(&mut acc, t, v, l, at) };
                 } else {
-                    volume_run_base(&mut acc, t, v, l, at, Kernel::Simd, ind);
+                    volume_run_base::<X2, _>(&mut acc, t, v, l, at, Kernel::Simd, ind);
                 }
                 let (h, l) = (&vf.rest_heights[r.clone()], &mut lam_f[r]);
                 if fast && ind {
                     // SAFETY: `avx2()` checked above.
                     unsafe { vertex_face_run_avx2(&mut acc, t, h, l, at) };
                 } else {
-                    vertex_face_run_base(&mut acc, t, h, l, at, Kernel::Simd, ind);
+                    vertex_face_run_base::<X2, _>(&mut acc, t, h, l, at, Kernel::Simd, ind);
                 }
             }
             let lam: Vec<u32> = lam_e
@@ -296,5 +302,99 @@ mod tests {
         let (sse2, avx2) = (sweep(false), sweep(true));
         assert!(sse2.0 != bits(&p.work.0), "the sweep moves particles");
         assert!(sse2 == avx2, "the AVX2 build differs from the SSE2 build");
+    }
+}
+
+#[cfg(test)]
+mod pair_tests {
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::generators::{box_grid, CellSplit};
+    use crate::work::{self, WorkAccess};
+    use crate::SoftBodyBuilder;
+
+    /// Pairs of chunks move every particle and multiplier exactly as chunks of four alone
+    /// do: each colour class swept as one run (pairs of chunks, then a chunk, then the scalar
+    /// tail) and as runs of four items from the class start (one chunk each), on a sheared
+    /// body and on one squashed to 0.2 % of its height (faces across the squashed axis have
+    /// `|b × c| / Q` about 0.002, below κ: the pair and chunk fallbacks to the scalar kernel
+    /// run).
+    #[test]
+    fn pairs_are_bit_identical_to_chunks_of_four() {
+        for squash in [0.7, 0.002] {
+            let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [5; 3], CellSplit::Six).unwrap();
+            let mut body = SoftBodyBuilder::new(mesh)
+                .edges(1e-6)
+                .volume(1e-9)
+                .vertex_face(1e-6)
+                .build()
+                .unwrap();
+            for (i, x) in body.particles.positions.iter_mut().enumerate() {
+                let jitter = ((i * 7919) % 13) as f32 * 3e-5;
+                *x = Vector3::new(x.x + 0.1 * x.y, squash * x.y + jitter, x.z - 0.05 * x.x);
+            }
+            work::load(&mut body.particles);
+            let (tets, p) = (&body.tetrahedra, &body.particles);
+            let (e, vf) = (
+                body.edges.as_ref().unwrap(),
+                body.vertex_face.as_ref().unwrap(),
+            );
+            let sweep = |split: bool| {
+                let mut slots = p.work.0.clone();
+                let mut acc = WorkAccess {
+                    slots: &mut slots,
+                    rest: &p.rest_positions,
+                };
+                let mut lam_e = vec![0.0; e.edges.len()];
+                let mut lam_v = vec![0.0; tets.len()];
+                let mut lam_f = vec![[0.0; 4]; tets.len()];
+                let mut count = ProjectionCount::default();
+                let at = 1e-3;
+                let parts = |r: std::ops::Range<usize>| {
+                    let step = if split { lanes::LANES } else { r.len().max(1) };
+                    (r.start..r.end)
+                        .step_by(step)
+                        .map(move |s| s..(s + step).min(r.end))
+                };
+                let k = Kernel::Simd;
+                for (r, ind) in e.classes.ranges() {
+                    for q in parts(r) {
+                        let (x, d) = (&e.edges[q.clone()], &e.rest_lengths[q.clone()]);
+                        count += edge_run(&mut acc, x, d, &mut lam_e[q], at, k, ind);
+                    }
+                }
+                for (r, ind) in tets.classes.ranges() {
+                    for q in parts(r.clone()) {
+                        let (t, v) = (&tets.indices[q.clone()], &tets.rest_volumes[q.clone()]);
+                        count += volume_run(&mut acc, t, v, &mut lam_v[q], at, k, ind);
+                    }
+                    for q in parts(r) {
+                        let (t, h) = (&tets.indices[q.clone()], &vf.rest_heights[q.clone()]);
+                        count += vertex_face_run(&mut acc, t, h, &mut lam_f[q], at, k, ind);
+                    }
+                }
+                let lam: Vec<u32> = lam_e
+                    .iter()
+                    .chain(&lam_v)
+                    .chain(lam_f.iter().flatten())
+                    .map(|x| x.to_bits())
+                    .collect();
+                let bits: Vec<[u32; 8]> = slots
+                    .iter()
+                    .map(|s| {
+                        let [a, b, c, d] = s.xw.to_array();
+                        let [e, f, g, h] = s.r.to_array();
+                        [a, b, c, d, e, f, g, h].map(f32::to_bits)
+                    })
+                    .collect();
+                (bits, lam, count)
+            };
+            let (pairs, chunks) = (sweep(false), sweep(true));
+            assert!(
+                pairs == chunks,
+                "pairs differ from chunks (squash {squash})"
+            );
+        }
     }
 }

@@ -263,6 +263,10 @@ impl ParticleAccess for Frozen<'_, '_> {
     fn add_row(&mut self, i: usize, d: wide::f32x4) {
         self.inner.add_row(i, d);
     }
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.inner.len()
+    }
 }
 
 /// The constraint families of one body, as [`project_stacked`] borrows them.

@@ -172,6 +172,20 @@ impl ParticleAccess for WorkAccess<'_> {
     fn add_row(&mut self, i: usize, d: f32x4) {
         self.slots[i].add(d);
     }
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.slots.len()
+    }
+    #[inline(always)]
+    unsafe fn row_unchecked(&self, i: usize) -> f32x4 {
+        // SAFETY: `i < self.slots.len()` (the caller's contract).
+        unsafe { self.slots.get_unchecked(i).xw }
+    }
+    #[inline(always)]
+    unsafe fn add_row_unchecked(&mut self, i: usize, d: f32x4) {
+        // SAFETY: `i < self.slots.len()` (the caller's contract).
+        unsafe { self.slots.get_unchecked_mut(i).add(d) }
+    }
 }
 
 /// Runs `f` on the body's slots: between [`load`] and [`store`] in [`CopyMode::PerSweep`],
