@@ -202,13 +202,13 @@ fn all_references(scenes: &[Scene], quick: bool) -> Vec<Reference> {
                 "{:<18} {:<36} reference {:>5} substeps{}, change {:.2e} ({:.1} s)",
                 scene.name,
                 model.label(),
-                r.substeps,
-                match (r.f64, r.extrapolated) {
+                r.conv.substeps,
+                match (r.conv.f64, r.conv.extrapolated) {
                     (true, true) => " (f64, extrapolated)",
                     (true, false) => " (f64)",
                     _ => "",
                 },
-                r.change,
+                r.conv.change,
                 t.elapsed().as_secs_f64()
             )
         });
@@ -266,13 +266,7 @@ fn main() {
             references.push(report::RefInfo {
                 scene: scene.name,
                 model,
-                substeps: r.substeps,
-                change: r.change,
-                prev_change: r.prev_change,
-                extrapolated: r.extrapolated,
-                plain_change: r.plain_change,
-                plain_prev_change: r.plain_prev_change,
-                f64: r.f64,
+                conv: r.conv,
             });
             progress.inc(1);
         }

@@ -36,9 +36,9 @@ pub const TARGET_CHANGE: f32 = 1e-6;
 /// (4 for exact second order; log₂ of the bounds is 1.81 and 2.20).
 pub const SECOND_ORDER_RATIO: (f32, f32) = (3.5, 4.6);
 
-/// The reference a model's runs are compared with.
-#[derive(Clone, Debug)]
-pub struct Reference {
+/// How far a reference is from converged: what the summary lists of it.
+#[derive(Clone, Copy, Debug)]
+pub struct Convergence {
     /// Substeps of the finest run behind it (one iteration each); 0 for the exact answer.
     pub substeps: u32,
     /// The last change of the answer kept (relative to size): plain, the deviation from the
@@ -57,6 +57,13 @@ pub struct Reference {
     /// `true` when it was run by the `f64` stepper ([`tetpbd_bench::Xpbd64`]), `false` for
     /// the engine's own `f32` solver (or the exact answer).
     pub f64: bool,
+}
+
+/// The reference a model's runs are compared with.
+#[derive(Clone, Debug)]
+pub struct Reference {
+    /// How far it is from converged.
+    pub conv: Convergence,
     /// Its positions after every frame.
     pub trajectory: Trajectory64,
 }
@@ -66,13 +73,15 @@ pub struct Reference {
 pub fn exact_rest(scene: &Scene) -> Reference {
     let rest: Vec<Vector3<f64>> = scene.mesh.vertices.iter().map(|p| p.cast()).collect();
     Reference {
-        substeps: 0,
-        change: 0.0,
-        prev_change: f32::NAN,
-        extrapolated: false,
-        plain_change: 0.0,
-        plain_prev_change: f32::NAN,
-        f64: false,
+        conv: Convergence {
+            substeps: 0,
+            change: 0.0,
+            prev_change: f32::NAN,
+            extrapolated: false,
+            plain_change: 0.0,
+            plain_prev_change: f32::NAN,
+            f64: false,
+        },
         trajectory: vec![rest; scene.frames],
     }
 }
@@ -86,7 +95,7 @@ pub fn converged(model: Model, scene: &Scene, start: u32, max: u32) -> Reference
         Model::Ours { set, soft } => run64(set, soft, scene, s),
         Model::Rapier { .. } => widen(&run(build(model, scene, s, 1).as_mut(), scene).trajectory),
     });
-    r.f64 = f64;
+    r.conv.f64 = f64;
     r
 }
 
@@ -128,13 +137,15 @@ pub fn converge(
             _ => None,
         };
         let reference = |extrapolated: bool, change: f32, prev_change: f32, trajectory| Reference {
-            substeps: s,
-            change,
-            prev_change,
-            extrapolated,
-            plain_change: plain,
-            plain_prev_change: plain_prev,
-            f64: false,
+            conv: Convergence {
+                substeps: s,
+                change,
+                prev_change,
+                extrapolated,
+                plain_change: plain,
+                plain_prev_change: plain_prev,
+                f64: false,
+            },
             trajectory,
         };
         let ext_change = ext.as_ref().map_or(f32::NAN, |e| e.1);
@@ -241,31 +252,40 @@ mod tests {
     fn extrapolation_only_where_second_order_is_observed() {
         let scene = Scene::hanging_beam(true);
         let second = converge(&scene, 64, 4096, true, |s| synthetic(&scene, 2, s));
-        assert!(second.extrapolated, "{second:?}");
-        assert!(second.change < TARGET_CHANGE && second.plain_change > 10.0 * TARGET_CHANGE);
-        assert!(second.substeps < 4096, "stopped early: {}", second.substeps);
-        let ratio = second.plain_prev_change / second.plain_change;
+        assert!(second.conv.extrapolated, "{second:?}");
+        assert!(
+            second.conv.change < TARGET_CHANGE && second.conv.plain_change > 10.0 * TARGET_CHANGE
+        );
+        assert!(
+            second.conv.substeps < 4096,
+            "stopped early: {}",
+            second.conv.substeps
+        );
+        let ratio = second.conv.plain_prev_change / second.conv.plain_change;
         assert!((ratio - 4.0).abs() < 0.1, "plain ratio {ratio}");
         assert!(
-            error_of(&scene, &second) < second.change,
+            error_of(&scene, &second) < second.conv.change,
             "{}",
             error_of(&scene, &second)
         );
         let plain = converge(&scene, 64, 4096, false, |s| synthetic(&scene, 2, s));
-        assert!(!plain.extrapolated && plain.substeps == 4096);
+        assert!(!plain.conv.extrapolated && plain.conv.substeps == 4096);
         assert!(error_of(&scene, &plain) > 10.0 * error_of(&scene, &second));
 
         let limit = synthetic(&scene, 1, u32::MAX);
         let first = converge(&scene, 64, 1024, true, |s| synthetic(&scene, 1, s));
-        assert!(!first.extrapolated && first.substeps == 1024, "{first:?}");
-        let ratio = first.plain_prev_change / first.plain_change;
+        assert!(
+            !first.conv.extrapolated && first.conv.substeps == 1024,
+            "{first:?}"
+        );
+        let ratio = first.conv.plain_prev_change / first.conv.plain_change;
         assert!((ratio - 2.0).abs() < 0.1, "first-order ratio {ratio}");
-        assert_eq!(first.change, first.plain_change);
+        assert_eq!(first.conv.change, first.conv.plain_change);
         let err = deviation(&scene, &first.trajectory, &limit).max;
         assert!(
-            err > first.change * 0.5,
+            err > first.conv.change * 0.5,
             "plain error {err}, change {}",
-            first.change
+            first.conv.change
         );
     }
 
@@ -285,13 +305,16 @@ mod tests {
             ConstraintSet::VertexFaceEdges,
         ] {
             let r = converged(Model::Ours { set, soft: true }, &scene, 512, 2048);
-            assert!(r.extrapolated && r.f64, "{set:?}: not extrapolated ({r:?})");
+            assert!(
+                r.conv.extrapolated && r.conv.f64,
+                "{set:?}: not extrapolated ({r:?})"
+            );
             let fine = run64(set, true, &scene, 16384);
             let gap = deviation(&scene, &r.trajectory, &fine).max;
             let plain = deviation(&scene, &run64(set, true, &scene, 2048), &fine).max;
             eprintln!(
                 "{set:?}: change {:.2e} at {} substeps, vs 16384: extrapolated {gap:.2e}, plain 2048 {plain:.2e}",
-                r.change, r.substeps
+                r.conv.change, r.conv.substeps
             );
             assert!(gap < 1e-6, "{set:?}: extrapolated vs 16384 {gap:e}");
             assert!(

@@ -12,7 +12,7 @@ use tetpbd_bench::ContactScene;
 use crate::contacts::{contacts_csv, ContactRow};
 use crate::engines::Model;
 use crate::metrics::{Deviation, RunResult};
-use crate::reference::Reference;
+use crate::reference::{Convergence, Reference};
 use crate::scenes::{Scene, DT};
 
 /// Largest last change (relative to the body size) of a numerical reference whose deviations
@@ -26,21 +26,8 @@ pub struct RefInfo {
     pub scene: &'static str,
     /// The model.
     pub model: Model,
-    /// Substeps of the reference (0: the exact answer).
-    pub substeps: u32,
-    /// The last change of the answer kept, relative to the body size (see
-    /// [`Reference::change`]).
-    pub change: f32,
-    /// The same change at the doubling before (NaN when there was none).
-    pub prev_change: f32,
-    /// The answer kept is the Richardson extrapolation of the last two runs.
-    pub extrapolated: bool,
-    /// The plain change of the last doubling.
-    pub plain_change: f32,
-    /// The plain change at the doubling before (NaN when there was none).
-    pub plain_prev_change: f32,
-    /// Run by the `f64` stepper.
-    pub f64: bool,
+    /// How far the reference is from converged.
+    pub conv: Convergence,
 }
 
 /// One run of one configuration, summarised.
@@ -146,9 +133,9 @@ impl Row {
             recover_s: res.recover_s,
             final_speed: res.final_speed,
             finite: res.finite,
-            ref_substeps: reference.substeps,
-            ref_change: reference.change,
-            ref_extrapolated: reference.extrapolated,
+            ref_substeps: reference.conv.substeps,
+            ref_change: reference.conv.change,
+            ref_extrapolated: reference.conv.extrapolated,
             volume_series: res.volume_series.clone(),
         }
     }

@@ -49,18 +49,18 @@ pub fn setup(s: &mut String, scenes: &[Scene], rows: &[Row], references: &[RefIn
         let refs: Vec<String> = references
             .iter()
             .filter(|r| r.model == *m)
-            .map(|r| match r.substeps {
+            .map(|r| match r.conv.substeps {
                 0 => format!("{}: exact (rest shape)", r.scene),
                 n => format!(
                     "{}: {} {n}{} ({:.1e})",
                     r.scene,
-                    if r.f64 { "f64" } else { "f32" },
-                    if r.extrapolated {
+                    if r.conv.f64 { "f64" } else { "f32" },
+                    if r.conv.extrapolated {
                         " Richardson-extrapolated"
                     } else {
                         ""
                     },
-                    r.change
+                    r.conv.change
                 ),
             })
             .collect();
@@ -129,7 +129,7 @@ pub fn setup(s: &mut String, scenes: &[Scene], rows: &[Row], references: &[RefIn
 /// How far the numerical references got towards the issue's "until the answer stops changing
 /// at 1e-6", from the references themselves.
 fn convergence(s: &mut String, references: &[RefInfo]) {
-    let numeric: Vec<&RefInfo> = references.iter().filter(|r| r.substeps > 0).collect();
+    let numeric: Vec<&RefInfo> = references.iter().filter(|r| r.conv.substeps > 0).collect();
     let exact = references.len() - numeric.len();
     let _ = writeln!(s, "### Convergence of the references\n");
     let _ = writeln!(
@@ -153,12 +153,12 @@ fn convergence(s: &mut String, references: &[RefInfo]) {
             "rapier's soft models, run by rapier's own f32 solver",
         ),
     ] {
-        let mine: Vec<&&RefInfo> = numeric.iter().filter(|r| r.f64 == f64_).collect();
+        let mine: Vec<&&RefInfo> = numeric.iter().filter(|r| r.conv.f64 == f64_).collect();
         if mine.is_empty() {
             continue;
         }
         let target = crate::reference::TARGET_CHANGE;
-        let reached = mine.iter().filter(|r| r.change < target).count();
+        let reached = mine.iter().filter(|r| r.conv.change < target).count();
         let ratio = |prev: f32, now: f32| {
             if prev.is_finite() {
                 format!(", {:.1} times less than at the doubling before", prev / now)
@@ -171,17 +171,17 @@ fn convergence(s: &mut String, references: &[RefInfo]) {
             .map(|r| {
                 let plain = format!(
                     "{:.1e} at {} substeps{}",
-                    r.plain_change,
-                    r.substeps,
-                    ratio(r.plain_prev_change, r.plain_change)
+                    r.conv.plain_change,
+                    r.conv.substeps,
+                    ratio(r.conv.plain_prev_change, r.conv.plain_change)
                 );
-                let kept = if r.extrapolated {
+                let kept = if r.conv.extrapolated {
                     format!(
                         "extrapolated from {} and {} substeps, changed {:.1e}{} (plain runs: {plain})",
-                        r.substeps / 2,
-                        r.substeps,
-                        r.change,
-                        ratio(r.prev_change, r.change)
+                        r.conv.substeps / 2,
+                        r.conv.substeps,
+                        r.conv.change,
+                        ratio(r.conv.prev_change, r.conv.change)
                     )
                 } else {
                     format!("plain, {plain}")
