@@ -75,7 +75,7 @@ pub struct Row {
     /// Substeps of the reference.
     pub ref_substeps: u32,
     /// The last change of the reference's answer when its substeps were doubled (relative
-    /// to size; see [`Reference::change`]).
+    /// to size; see [`Convergence::change`]).
     pub ref_change: f32,
     /// The reference is Richardson-extrapolated (see [`crate::reference`]).
     pub ref_extrapolated: bool,
