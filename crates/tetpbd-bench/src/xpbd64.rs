@@ -7,7 +7,8 @@
 //! It reuses the core's constraint math ([`tetpbd::constraint`], generic over the scalar)
 //! and mirrors [`tetpbd::systems`]: prediction with `v ← (v + h g)·max(0, 1 − damping·h)`,
 //! multipliers reset every substep, `iterations` Gauss–Seidel sweeps over the families in
-//! [`SolverSettings::order`], each in the body's stored (colour) order, then `v = (x − x_prev)/h`.
+//! [`SolverSettings::order`], each in the body's stored (colour) order, then `v = (x − x_prev)/h`
+//! (with the correction-speed safety net's clamp and momentum restoration when it is set).
 //! Degenerate configurations get the core's fallbacks (edge: rest direction; vertex–face: rest
 //! normal; volume: skipped). Not mirrored: `f32` compensated summation (not needed in `f64`),
 //! SIMD lanes (the same sweep to rounding), external accelerations and hooks (no scene of the
@@ -165,6 +166,7 @@ impl Xpbd64 {
                     }
                 }
             }
+            let mut clamped = false;
             for i in 0..self.x.len() {
                 let mut v = (self.x[i] - self.prev[i]) / h;
                 if let Some(limit) = self.max_correction_speed {
@@ -172,10 +174,51 @@ impl Xpbd64 {
                     let n = dv.norm();
                     if n > limit {
                         v = self.v[i] + dv * (limit / n);
+                        clamped = true;
                     }
                 }
                 self.v[i] = v;
             }
+            if clamped && self.w.iter().all(|&w| w > 0.0) {
+                self.restore_momentum(h);
+            }
+        }
+    }
+
+    /// The safety net's momentum restoration (as tetpbd's): the linear and angular momentum
+    /// (about the centre of mass) the clamp removed from the free body, given back as a
+    /// rigid velocity change; the angular part through the pseudo-inverse of the inertia
+    /// tensor (eigenvalues below 1e-9 of the largest dropped).
+    fn restore_momentum(&mut self, h: f64) {
+        let m: Vec<f64> = self.w.iter().map(|w| 1.0 / w).collect();
+        let total: f64 = m.iter().sum();
+        let c = self
+            .x
+            .iter()
+            .zip(&m)
+            .fold(V3::zeros(), |a, (x, mi)| a + x * *mi)
+            / total;
+        let (mut dp, mut dl, mut inertia) = (V3::zeros(), V3::zeros(), nalgebra::Matrix3::zeros());
+        for i in 0..self.x.len() {
+            let r = self.x[i] - c;
+            let dv = self.v[i] - (self.x[i] - self.prev[i]) / h;
+            dp += dv * m[i];
+            dl += r.cross(&dv) * m[i];
+            inertia +=
+                (nalgebra::Matrix3::identity() * r.norm_squared() - r * r.transpose()) * m[i];
+        }
+        let eig = nalgebra::SymmetricEigen::new(inertia);
+        let largest = eig.eigenvalues.max();
+        let mut omega = V3::zeros();
+        for k in 0..3 {
+            if eig.eigenvalues[k] > 1e-9 * largest {
+                let q = eig.eigenvectors.column(k);
+                omega -= q * (q.dot(&dl) / eig.eigenvalues[k]);
+            }
+        }
+        let u = -dp / total;
+        for i in 0..self.x.len() {
+            self.v[i] += u + omega.cross(&(self.x[i] - c));
         }
     }
 

@@ -344,8 +344,11 @@ pub struct VelocityUpdate {
 /// serial passes over the body's particles, only in substeps where the net clamped one of
 /// them; bodies it leaves alone are bit-identical to running without it. A body with pinned
 /// particles (inverse mass 0) gets the per-particle clamp alone: its pins exchange momentum
-/// with the outside anyway. So does whatever a [`crate::SubstepHook`] adds (e.g. collision
-/// corrections), which is clamped and given back with the rest.
+/// with the outside anyway. A [`crate::SubstepHook`]'s corrections (e.g. collision push-out)
+/// are clamped and given back like the projections': the net bounds how fast a body deforms,
+/// not how fast it moves as a whole. The restoration removes only what the clamp created: a
+/// snap-back violent enough to spin the body through the projections themselves (PBD's
+/// gradients are taken before each finite correction) spins it with or without the net.
 ///
 /// A particle whose position became non-finite is put back to its substep start with zero
 /// velocity and counted (a safety net that never acts in a healthy run).
