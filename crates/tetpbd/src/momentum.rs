@@ -17,6 +17,13 @@
 //! pseudo-inverse), so the angular part about a degenerate axis is dropped rather than made
 //! infinite.
 //!
+//! What this does not remove: the projections conserve angular momentum only to second
+//! order in the correction (each gradient is taken before its finite correction), so a
+//! snap-back violent enough to be clamped (corrections of up to the body's size per substep)
+//! can spin the body up through the projections themselves, with or without the net (a
+//! mirrored 1 m cube: 8e3 kg·m²/s after one frame without the net). Giving back what the
+//! clamp removed keeps that spin, where the per-particle clamp used to cut part of it.
+//!
 //! The sums run over the particles in index order, in f64, on one thread: the result does
 //! not depend on the thread count.
 
