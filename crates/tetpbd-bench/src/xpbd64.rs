@@ -199,13 +199,12 @@ impl Xpbd64 {
             .fold(V3::zeros(), |a, (x, mi)| a + x * *mi)
             / total;
         let (mut dp, mut dl, mut inertia) = (V3::zeros(), V3::zeros(), nalgebra::Matrix3::zeros());
-        for i in 0..self.x.len() {
-            let r = self.x[i] - c;
-            let dv = self.v[i] - (self.x[i] - self.prev[i]) / h;
-            dp += dv * m[i];
-            dl += r.cross(&dv) * m[i];
-            inertia +=
-                (nalgebra::Matrix3::identity() * r.norm_squared() - r * r.transpose()) * m[i];
+        for (((x, p), v), &mi) in self.x.iter().zip(&self.prev).zip(&self.v).zip(&m) {
+            let r = x - c;
+            let dv = v - (x - p) / h;
+            dp += dv * mi;
+            dl += r.cross(&dv) * mi;
+            inertia += (nalgebra::Matrix3::identity() * r.norm_squared() - r * r.transpose()) * mi;
         }
         let eig = nalgebra::SymmetricEigen::new(inertia);
         let largest = eig.eigenvalues.max();
