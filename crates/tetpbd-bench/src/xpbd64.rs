@@ -185,39 +185,23 @@ impl Xpbd64 {
         }
     }
 
-    /// The safety net's momentum restoration (as tetpbd's): the linear and angular momentum
-    /// (about the centre of mass) the clamp removed from the free body, given back as a
-    /// rigid velocity change; the angular part through the pseudo-inverse of the inertia
-    /// tensor (eigenvalues below 1e-9 of the largest dropped).
+    /// The safety net's momentum restoration (as tetpbd's): the linear momentum the clamp
+    /// removed from the free body, given back as a uniform velocity change.
     fn restore_momentum(&mut self, h: f64) {
-        let m: Vec<f64> = self.w.iter().map(|w| 1.0 / w).collect();
-        let total: f64 = m.iter().sum();
-        let c = self
+        let (mut total, mut dp) = (0.0, V3::zeros());
+        for ((x, p), (v, w)) in self
             .x
             .iter()
-            .zip(&m)
-            .fold(V3::zeros(), |a, (x, mi)| a + x * *mi)
-            / total;
-        let (mut dp, mut dl, mut inertia) = (V3::zeros(), V3::zeros(), nalgebra::Matrix3::zeros());
-        for (((x, p), v), &mi) in self.x.iter().zip(&self.prev).zip(&self.v).zip(&m) {
-            let r = x - c;
-            let dv = v - (x - p) / h;
-            dp += dv * mi;
-            dl += r.cross(&dv) * mi;
-            inertia += (nalgebra::Matrix3::identity() * r.norm_squared() - r * r.transpose()) * mi;
-        }
-        let eig = nalgebra::SymmetricEigen::new(inertia);
-        let largest = eig.eigenvalues.max();
-        let mut omega = V3::zeros();
-        for k in 0..3 {
-            if eig.eigenvalues[k] > 1e-9 * largest {
-                let q = eig.eigenvectors.column(k);
-                omega -= q * (q.dot(&dl) / eig.eigenvalues[k]);
-            }
+            .zip(&self.prev)
+            .zip(self.v.iter().zip(&self.w))
+        {
+            let mi = 1.0 / w;
+            total += mi;
+            dp += (v - (x - p) / h) * mi;
         }
         let u = -dp / total;
-        for i in 0..self.x.len() {
-            self.v[i] += u + omega.cross(&(self.x[i] - c));
+        for v in &mut self.v {
+            *v += u;
         }
     }
 

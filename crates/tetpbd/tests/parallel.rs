@@ -73,7 +73,7 @@ fn large_body_agrees_bit_for_bit_with_and_without_a_slow_hook() {
 /// Positions and velocities, as bits, after 2 frames of 3 substeps of a free mirrored cube
 /// of 16³ cells (4913 particles, above the particle passes' threshold) released with the
 /// safety net at 5 m/s on a pool of `threads` threads: the net clamps, and gives the
-/// momentum back, every substep.
+/// linear momentum back, every substep.
 fn run_free_mirrored(threads: usize) -> Vec<[u32; 3]> {
     use nalgebra::Vector3;
     use tetpbd::generators::{box_grid, CellSplit};
