@@ -7,7 +7,8 @@
 //! It reuses the core's constraint math ([`tetpbd::constraint`], generic over the scalar)
 //! and mirrors [`tetpbd::systems`]: prediction with `v ← (v + h g)·max(0, 1 − damping·h)`,
 //! multipliers reset every substep, `iterations` Gauss–Seidel sweeps over the families in
-//! [`SolverSettings::order`], each in the body's stored (colour) order, then `v = (x − x_prev)/h`.
+//! [`SolverSettings::order`], each in the body's stored (colour) order, then `v = (x − x_prev)/h`
+//! (with the correction-speed safety net's clamp and momentum restoration when it is set).
 //! Degenerate configurations get the core's fallbacks (edge: rest direction; vertex–face: rest
 //! normal; volume: skipped). Not mirrored: `f32` compensated summation (not needed in `f64`),
 //! SIMD lanes (the same sweep to rounding), external accelerations and hooks (no scene of the
@@ -165,6 +166,7 @@ impl Xpbd64 {
                     }
                 }
             }
+            let mut clamped = false;
             for i in 0..self.x.len() {
                 let mut v = (self.x[i] - self.prev[i]) / h;
                 if let Some(limit) = self.max_correction_speed {
@@ -172,10 +174,34 @@ impl Xpbd64 {
                     let n = dv.norm();
                     if n > limit {
                         v = self.v[i] + dv * (limit / n);
+                        clamped = true;
                     }
                 }
                 self.v[i] = v;
             }
+            if clamped && self.w.iter().all(|&w| w > 0.0) {
+                self.restore_momentum(h);
+            }
+        }
+    }
+
+    /// The safety net's momentum restoration (as tetpbd's): the linear momentum the clamp
+    /// removed from the free body, given back as a uniform velocity change.
+    fn restore_momentum(&mut self, h: f64) {
+        let (mut total, mut dp) = (0.0, V3::zeros());
+        for ((x, p), (v, w)) in self
+            .x
+            .iter()
+            .zip(&self.prev)
+            .zip(self.v.iter().zip(&self.w))
+        {
+            let mi = 1.0 / w;
+            total += mi;
+            dp += (v - (x - p) / h) * mi;
+        }
+        let u = -dp / total;
+        for v in &mut self.v {
+            *v += u;
         }
     }
 

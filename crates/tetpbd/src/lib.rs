@@ -33,6 +33,7 @@ pub mod generators;
 mod lanes;
 pub mod locality;
 mod mesh;
+mod momentum;
 pub mod ordering;
 #[cfg(feature = "parallel")]
 mod parallel;

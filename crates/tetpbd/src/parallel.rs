@@ -86,7 +86,9 @@ pub(crate) fn predict(run: PredictRun<'_>, a: Vector3<f32>, h: f32, keep: f32) {
 }
 
 /// [`crate::systems::update_velocities`] of one body, in runs of particles (the counts are
-/// sums, whatever the split).
+/// sums, whatever the split). The safety net's momentum restoration that may follow runs on
+/// one thread, after this pass (its sums in particle order, so the result does not depend on
+/// the thread count).
 pub(crate) fn update_velocities(
     run: VelocityRun<'_>,
     h: f32,

@@ -31,7 +31,12 @@ pub struct SolverSettings {
     /// vertex–face, edge — edges last, so lengths are closest to rest at the end.
     pub order: [Family; 3],
     /// Safety net: the velocity a substep's projections add to a particle is clamped to this
-    /// length, m/s (positions keep their full correction). `None` = no clamp. See
+    /// length, m/s (positions keep their full correction). `None` = no clamp. On a body
+    /// without pinned particles, the linear momentum the clamps removed is given back as a
+    /// uniform velocity change of the whole body, so the net never changes the body's linear
+    /// momentum (angular momentum it may damp); a body with pinned particles gets the
+    /// per-particle clamp alone. Cost: a compare per particle per substep, plus two serial
+    /// passes over a body's particles in substeps where it clamped one of them. See
     /// [`systems::update_velocities`]; clamps are counted in
     /// [`StepStats::velocity_clamps`].
     pub max_correction_speed: Option<f32>,

@@ -109,7 +109,8 @@ pub struct StepStats {
     /// substep start with zero velocity (a safety net; 0 in every healthy run).
     pub non_finite_resets: u64,
     /// Particle velocity updates clamped by
-    /// [`crate::SolverSettings::max_correction_speed`] (summed over substeps).
+    /// [`crate::SolverSettings::max_correction_speed`] (summed over substeps; the momentum
+    /// restoration that follows a body's clamps is not counted separately).
     pub velocity_clamps: u64,
     /// Time in prediction (gravity, damping, integration).
     pub predict_time: Duration,

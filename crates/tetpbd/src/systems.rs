@@ -329,10 +329,25 @@ pub struct VelocityUpdate {
 ///
 /// With `max_correction_speed = Some(s)`, the part of the new velocity that the constraint
 /// projections added, `(x − x_prev)/h − v_pred` (with `v_pred` the predicted velocity, still
-/// in the velocity array during the projections), is clamped to length `s` (m/s). The
-/// positions keep their full correction; only the velocity it would have created is limited.
-/// This is a safety net for large errors corrected in one substep (an inverted body snapping
-/// back), which otherwise turn into a velocity of `Δx/h`; each clamp is counted.
+/// in the velocity array during the projections), is clamped to length `s` (m/s) per
+/// particle. The positions keep their full correction; only the velocity it would have
+/// created is limited. This is a safety net for large errors corrected in one substep (an
+/// inverted body snapping back), which otherwise turn into a velocity of `Δx/h`; each clamp
+/// is counted.
+///
+/// Clamping particles one by one removes linear momentum (an asymmetric snap-back would
+/// push the body). So when at least one particle of a body was clamped and the body has no
+/// pinned particle, the linear momentum the clamp removed is given back as a uniform
+/// velocity change of the whole body (see the `momentum` module): the net never changes a
+/// free body's linear momentum. That costs two more serial passes over the body's
+/// particles, only in substeps where the net clamped one of them; bodies it leaves alone are
+/// bit-identical to running without it. A body with pinned particles (inverse mass 0) gets
+/// the per-particle clamp alone: its pins exchange momentum with the outside anyway. A
+/// [`crate::SubstepHook`]'s corrections (e.g. collision push-out) are clamped and given back
+/// like the projections'. The angular momentum the clamp removes is not given back: in the
+/// violent snap-backs the net is for, it is mostly spin the projections themselves create
+/// (PBD's gradients are taken before each finite correction), and giving it back made the
+/// stability matrix worse (`momentum` module docs).
 ///
 /// A particle whose position became non-finite is put back to its substep start with zero
 /// velocity and counted (a safety net that never acts in a healthy run).
@@ -348,6 +363,8 @@ pub fn update_velocities(
             prev_positions,
             velocities,
             residuals,
+            inv_masses,
+            masses,
             ..
         } = p;
         let run = VelocityRun {
@@ -357,11 +374,24 @@ pub fn update_velocities(
             residuals,
         };
         #[cfg(feature = "parallel")]
-        if crate::parallel::particles_worth_it(run.positions.len()) {
-            out += crate::parallel::update_velocities(run, h, max_correction_speed);
-            continue;
+        let u = if crate::parallel::particles_worth_it(run.positions.len()) {
+            crate::parallel::update_velocities(run, h, max_correction_speed)
+        } else {
+            run.update(h, max_correction_speed)
+        };
+        #[cfg(not(feature = "parallel"))]
+        let u = run.update(h, max_correction_speed);
+        if u.clamped > 0 && !inv_masses.contains(&0.0) {
+            let run = crate::momentum::RestoreRun {
+                positions,
+                prev_positions,
+                residuals,
+                velocities,
+                masses,
+            };
+            crate::momentum::restore(run, h);
         }
-        out += run.update(h, max_correction_speed);
+        out += u;
     }
     out
 }
@@ -393,6 +423,7 @@ impl VelocityRun<'_> {
         let mut out = VelocityUpdate::default();
         for i in 0..positions.len() {
             // Divide, not multiply by 1/h: h · (1/h) ≠ 1 in f32, a bias every substep.
+            // `momentum::restore` recomputes this expression; keep the two the same.
             let mut v = ((positions[i] - prev_positions[i]) + residuals[i]) / h;
             if let Some(limit) = max_correction_speed {
                 let dv = v - velocities[i];
