@@ -37,6 +37,7 @@ pub mod ordering;
 #[cfg(feature = "parallel")]
 mod parallel;
 mod particles;
+pub mod partition;
 mod projection;
 mod runs;
 #[cfg(feature = "parallel")]
@@ -45,6 +46,8 @@ mod simd;
 mod solver;
 mod stacking;
 mod stats;
+#[cfg(feature = "sync-stats")]
+pub mod sync_stats;
 pub mod systems;
 #[cfg(feature = "parallel")]
 mod team;
