@@ -1,9 +1,10 @@
 //! Parallel Gauss–Seidel (feature `parallel`): within a colour class no two constraints
 //! share a particle, so a class's projections run concurrently and the result is
 //! bit-identical to the serial sweep, for any number of threads. A family's sweep is one
-//! parallel region whose phases are the classes, run one after another
-//! ([`crate::schedule::run_phases`]); the overflow class (see [`crate::ordering`]) runs on
-//! one thread. The passes over the particles of a large body (prediction, the copies into
+//! parallel region whose phases are those of its [`ColourClasses`], run one after another
+//! ([`crate::schedule::run_phases`]): a class alone in its phase is split among the threads
+//! (the overflow class, see [`crate::ordering`], runs on one thread); the tasks of a
+//! partitioned body ([`crate::partition`]) run each whole on one thread, on disjoint slabs. The passes over the particles of a large body (prediction, the copies into
 //! and out of the working copy, the velocity update) run the same way as one phase of runs
 //! of particles: each particle's update is independent, so they are bit-identical too.
 //! Inside [`crate::Solver::step`] every region is posted to the step's team

@@ -2,8 +2,9 @@
 //! colour classes of a family, or the particles of a copy) that must run one after another,
 //! each phase's items split among the threads of rayon's pool.
 //!
-//! Why not one rayon parallel iterator per phase: a sweep of a 100k-tetrahedron body has
-//! 30 classes of tetrahedra (14 of edges), each a few hundred microseconds of work or less.
+//! Why not one rayon parallel iterator per phase: a sweep of a 100k-tetrahedron body in the
+//! plain layout has 30 classes of tetrahedra (14 of edges), each a few hundred microseconds
+//! of work or less (a partitioned body has 3 phases per family, see [`crate::partition`]).
 //! Between two parallel iterators rayon's idle thread goes to sleep and has to be woken, which
 //! on this virtual machine costs tens of microseconds each time (measured in
 //! docs/performance.md, "Scaling"). Here every thread of the pool enters once per sweep and
@@ -15,7 +16,8 @@
 //! owns region `i`: consecutive classes of a family cover the mesh in the same order, so the
 //! particles a thread touches stay in its cache from one phase to the next), then takes the
 //! chunks left in other regions. A phase that is not independent (the overflow class) is one
-//! chunk.
+//! chunk. A phase of *units* (the tasks of a partitioned sweep, [`crate::partition`]) is cut
+//! the same way with one unit per chunk and no lane alignment: a task is never split.
 //!
 //! **Claiming and waiting.** Each region has a claim counter and a done counter, both
 //! counting its chunks over all phases so far. A thread claims a chunk of phase `k` with a
@@ -28,8 +30,8 @@
 //! the sweep serially. No deadlock, whatever the pool does.
 //!
 //! **Determinism.** The chunks cut a phase at multiples of [`LANES`] from the phase's start,
-//! so the SIMD kernels group the same four items as the serial sweep does, and the items of a
-//! phase are independent: the result is bit-identical to the serial sweep for any number of
+//! so the SIMD kernels group the same four items as the serial sweep does; a unit runs whole
+//! on one thread, in the serial order; and the items (units) of a phase are independent: the result is bit-identical to the serial sweep for any number of
 //! threads and any assignment of chunks to threads.
 
 use std::ops::{AddAssign, Range};

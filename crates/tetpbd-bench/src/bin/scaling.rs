@@ -2,7 +2,7 @@
 //! 1/60 s frame), for edges + volume and for vertex–face, on 1 and 2 threads.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --sequential --shuffle --spatial-order on|off|both --breakdown]
+//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown]
 //! ```
 //!
 //! With `--features parallel` the 1-thread and the 2-thread runs are *interleaved*: two
@@ -12,6 +12,16 @@
 //! 1-thread frame to the 2-thread frame after it, with the lower and upper quartiles of
 //! those ratios beside it. `--sequential` runs all the 1-thread frames first, then all the
 //! 2-thread ones (the older way; the speed-up is then the ratio of the medians).
+//!
+//! Each row ends with the CPU other processes used while it was measured, in cores (from
+//! `/proc/stat` less this process's own time): on a shared 2-core machine anything above a
+//! few hundredths of a core takes time from the 2-thread column.
+//!
+//! `--error` prints, after the measured frames, the constraint error of the 1-thread body
+//! (one more frame with [`tetpbd::SolverSettings::measure_error`]): how well the sweep
+//! order converges, e.g. to compare `--parts 1` with a partitioned order.
+//!
+//! `--set` measures one family set only (default both).
 //!
 //! `--parts P` builds the bodies cut into `P` slabs for the sweep order
 //! ([`tetpbd::SoftBodyBuilder::parts`]; default 0, the builder's choice).
@@ -154,6 +164,36 @@ fn median(v: &[f64]) -> f64 {
     quantile(v, 0.5)
 }
 
+/// CPU time, s, used so far by every process of the machine (`/proc/stat`, user + nice +
+/// system + irq + softirq + steal; 0 where unreadable) and by this one (`getrusage`).
+fn cpu_seconds() -> (f64, f64) {
+    let all = std::fs::read_to_string("/proc/stat")
+        .ok()
+        .and_then(|s| {
+            let line = s.lines().next()?.to_string();
+            let v: Vec<f64> = line
+                .split_whitespace()
+                .skip(1)
+                .filter_map(|x| x.parse().ok())
+                .collect();
+            // user nice system idle iowait irq softirq steal
+            let busy = [0, 1, 2, 5, 6, 7]
+                .iter()
+                .filter_map(|&i| v.get(i))
+                .sum::<f64>();
+            Some(busy / 100.0)
+        })
+        .unwrap_or(0.0);
+    // SAFETY: `getrusage` fills the zeroed struct it is given; RUSAGE_SELF is valid.
+    let own = unsafe {
+        let mut u: libc::rusage = std::mem::zeroed();
+        libc::getrusage(libc::RUSAGE_SELF, &mut u);
+        let t = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+        t(u.ru_utime) + t(u.ru_stime)
+    };
+    (all, own)
+}
+
 /// Runs `f` on `pool` (on this thread without one).
 #[cfg(feature = "parallel")]
 fn on<T: Send>(pool: &Option<rayon::ThreadPool>, f: impl FnOnce() -> T + Send) -> T {
@@ -213,6 +253,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames = arg("--frames", 15).max(1);
     let parts = arg("--parts", 0);
     let sequential = flag("--sequential");
+    let args: Vec<String> = std::env::args().collect();
+    let only = args
+        .iter()
+        .position(|a| a == "--set")
+        .and_then(|i| args.get(i + 1).cloned());
     let shuffle = flag("--shuffle");
     let breakdown = flag("--breakdown");
     let parallel = cfg!(feature = "parallel");
@@ -236,6 +281,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         for (set, spatial) in ["edges+volume", "vertex-face"]
             .into_iter()
+            .filter(|s| only.as_ref().is_none_or(|o| o == s))
             .flat_map(|s| orders().into_iter().map(move |o| (s, o)))
         {
             let mut one = body(&mesh, set, spatial, parts)?;
@@ -244,7 +290,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             } else {
                 None
             };
+            let (all0, own0, wall0) = {
+                let (a, o) = cpu_seconds();
+                (a, o, Instant::now())
+            };
             measure(&mut one, two.as_mut(), frames, sequential)?;
+            let (all1, own1) = cpu_seconds();
+            let wall = wall0.elapsed().as_secs_f64();
+            // Cores' worth of CPU other processes used meanwhile (/proc/stat counts in
+            // 10 ms ticks: about ±0.01 s over the run).
+            let others = ((all1 - all0) - (own1 - own0)).max(0.0) / wall;
             let one_ms = median(&one.times);
             let per_tet = one_ms * 1e6 / (mesh.tets.len() as f64 * 10.0);
             let (two_s, speed) = match &two {
@@ -267,11 +322,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 None => ("-".to_string(), "-".to_string()),
             };
             println!(
-                "{set:13} {:13} {:9} {:10}   {one_ms:17.2}  {per_tet:14.1}   {two_s:>18}  {speed}",
+                "{set:13} {:13} {:9} {:10}   {one_ms:17.2}  {per_tet:14.1}   {two_s:>18}  {speed}  others {others:.2} cores over {wall:.1} s",
                 if spatial { "on" } else { "off" },
                 mesh.tets.len(),
                 mesh.vertices.len()
             );
+            if flag("--error") {
+                one.solver.settings.measure_error = true;
+                let s = one.solver.step(&mut one.world)?;
+                let f = |e: Option<tetpbd::ErrorStats>| {
+                    e.map_or("-".to_string(), |e| {
+                        format!("rms {:.3e} max {:.3e}", e.rms, e.max)
+                    })
+                };
+                println!(
+                    "    error after {} frames: edges {}  volume {}  vertex-face {}",
+                    frames + WARM_UP + 1,
+                    f(s.edge.after),
+                    f(s.volume.after),
+                    f(s.vertex_face.after)
+                );
+            }
             if breakdown {
                 let (e, t) = one.sweep_phases;
                 println!("    phases per sweep: {e} of edges, {t} of tetrahedra");
