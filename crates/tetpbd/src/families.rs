@@ -78,6 +78,12 @@ impl EdgeConstraints {
         self.edges.is_empty()
     }
 
+    /// The sweep order of the edges: colour classes, tasks and phases (see
+    /// [`crate::ordering::ColourClasses`]).
+    pub fn classes(&self) -> &crate::ordering::ColourClasses {
+        &self.classes
+    }
+
     /// The edges as particle index pairs.
     pub fn edges(&self) -> &[[u32; 2]] {
         &self.edges

@@ -38,6 +38,7 @@ pub mod ordering;
 #[cfg(feature = "parallel")]
 mod parallel;
 mod particles;
+pub mod partition;
 mod projection;
 mod runs;
 #[cfg(feature = "parallel")]
@@ -46,6 +47,8 @@ mod simd;
 mod solver;
 mod stacking;
 mod stats;
+#[cfg(feature = "sync-stats")]
+pub mod sync_stats;
 pub mod systems;
 #[cfg(feature = "parallel")]
 mod team;

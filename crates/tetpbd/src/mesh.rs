@@ -35,6 +35,12 @@ impl Tetrahedra {
         self.indices.is_empty()
     }
 
+    /// The sweep order of the tetrahedra: colour classes, tasks and phases (see
+    /// [`crate::ordering::ColourClasses`]).
+    pub fn classes(&self) -> &crate::ordering::ColourClasses {
+        &self.classes
+    }
+
     /// Particle indices of each tetrahedron.
     pub fn indices(&self) -> &[[u32; 4]] {
         &self.indices

@@ -6,8 +6,9 @@
 //! root and two divisions); sorted edges `[a, b]` share `a` almost every time. Greedy
 //! colouring (each item gets the lowest colour none of its particles has used yet) and a
 //! stable sort by colour turn that chain into independent work the CPU overlaps. Within a
-//! colour the original order, and with it memory locality, is kept. The same classes are
-//! what a parallel solver would run concurrently.
+//! colour the original order, and with it memory locality, is kept. The items of a class
+//! are what the parallel sweep runs concurrently; a large body's classes are grouped by the
+//! parts of the body first ([`crate::partition`]).
 
 /// Greedy colour of each item (an edge or a tetrahedron given by its particle indices).
 /// Colours above 63 share the last class; the order stays valid, only less independent.
@@ -26,19 +27,57 @@ pub fn greedy_colours<const N: usize>(items: &[[u32; N]], particles: usize) -> V
         .collect()
 }
 
-/// Items sorted into colour classes.
+/// Items sorted into colour classes, and the classes grouped into the tasks and phases of a
+/// sweep.
+///
+/// A sweep runs the phases one after another. The tasks of one phase touch pairwise disjoint
+/// particles, and a task's classes run in order (on one thread, with the `parallel`
+/// feature). In the plain layout of [`colour_order`] every class is a task and a phase of its
+/// own (its items, independent, are split among the threads); [`crate::partition`] groups
+/// the classes of each part of a body into one task. Serially, the classes run in storage
+/// order, which is phase order, task order within a phase and class order within a task: the
+/// same operations in the same order on any number of threads.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ColourClasses {
     /// Start of each class in the sorted order, then the total: class `k` is
     /// `starts[k]..starts[k + 1]`.
     pub starts: Vec<u32>,
-    /// Whether the last class is the overflow class (colour 63), whose items may share
-    /// particles and must run serially.
-    pub overflow: bool,
+    /// The classes (ascending) whose items may share particles (colour 63 of a greedy
+    /// colouring, the overflow) and must run one after another.
+    pub dependent: Vec<u32>,
+    /// First class of each task, then the class count.
+    pub tasks: Vec<u32>,
+    /// First task of each phase, then the task count.
+    pub phases: Vec<u32>,
+}
+
+/// What one phase of a sweep is.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) enum Phase {
+    /// One class, alone in its task (its items may be split among threads when independent).
+    Class(usize),
+    /// Tasks of several classes or several tasks: each task runs whole on one thread.
+    Tasks(std::ops::Range<usize>),
 }
 
 impl ColourClasses {
+    /// The plain layout of classes `starts` (every class its own task and phase); the last
+    /// class is dependent when `overflow`.
+    pub fn plain(starts: Vec<u32>, overflow: bool) -> ColourClasses {
+        let classes = starts.len().saturating_sub(1) as u32;
+        ColourClasses {
+            starts,
+            dependent: if overflow && classes > 0 {
+                vec![classes - 1]
+            } else {
+                Vec::new()
+            },
+            tasks: (0..=classes).collect(),
+            phases: (0..=classes).collect(),
+        }
+    }
+
     /// Number of classes.
     pub fn len(&self) -> usize {
         self.starts.len().saturating_sub(1)
@@ -49,13 +88,39 @@ impl ColourClasses {
         self.len() == 0
     }
 
+    /// Number of phases of a sweep.
+    pub fn phase_count(&self) -> usize {
+        self.phases.len().saturating_sub(1)
+    }
+
+    /// Number of tasks.
+    pub fn task_count(&self) -> usize {
+        self.tasks.len().saturating_sub(1)
+    }
+
     /// Class `k` (`k < len()`) as a range, with `true` when its items are independent.
     pub fn class(&self, k: usize) -> (std::ops::Range<usize>, bool) {
         let range = self.starts[k] as usize..self.starts[k + 1] as usize;
-        (range, !(self.overflow && k + 1 == self.len()))
+        (range, self.dependent.binary_search(&(k as u32)).is_err())
     }
 
-    /// The classes as ranges, each with `true` when its items are independent.
+    /// The classes of task `t`.
+    pub fn task(&self, t: usize) -> std::ops::Range<usize> {
+        self.tasks[t] as usize..self.tasks[t + 1] as usize
+    }
+
+    /// Phase `j` (`j < phase_count()`).
+    pub(crate) fn phase(&self, j: usize) -> Phase {
+        let tasks = self.phases[j] as usize..self.phases[j + 1] as usize;
+        if tasks.len() == 1 && self.task(tasks.start).len() == 1 {
+            Phase::Class(self.tasks[tasks.start] as usize)
+        } else {
+            Phase::Tasks(tasks)
+        }
+    }
+
+    /// The classes as ranges, in storage (and sweep) order, each with `true` when its items
+    /// are independent.
     pub fn ranges(&self) -> impl Iterator<Item = (std::ops::Range<usize>, bool)> + '_ {
         (0..self.len()).map(|k| self.class(k))
     }
@@ -80,5 +145,5 @@ pub fn colour_order<const N: usize>(
     }
     starts.push(items.len() as u32);
     let overflow = last == Some(63);
-    (order, ColourClasses { starts, overflow })
+    (order, ColourClasses::plain(starts, overflow))
 }

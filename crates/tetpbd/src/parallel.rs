@@ -1,22 +1,26 @@
 //! Parallel Gauss–Seidel (feature `parallel`): within a colour class no two constraints
 //! share a particle, so a class's projections run concurrently and the result is
 //! bit-identical to the serial sweep, for any number of threads. A family's sweep is one
-//! parallel region whose phases are the classes, run one after another
-//! ([`crate::schedule::run_phases`]); the overflow class (see [`crate::ordering`]) runs on
-//! one thread. The passes over the particles of a large body (prediction, the copies into
+//! parallel region whose phases are those of its [`ColourClasses`], run one after another
+//! ([`crate::schedule::run_phases`]): a class alone in its phase is split among the threads
+//! (the overflow class, see [`crate::ordering`], runs on one thread); the tasks of a
+//! partitioned body ([`crate::partition`]) run each whole on one thread, on disjoint slabs. The passes over the particles of a large body (prediction, the copies into
 //! and out of the working copy, the velocity update) run the same way as one phase of runs
 //! of particles: each particle's update is independent, so they are bit-identical too.
 //! Inside [`crate::Solver::step`] every region is posted to the step's team
 //! ([`crate::team`]) instead of waking the pool's threads.
+
+use std::ops::Range;
 
 use nalgebra::Vector3;
 use wide::f32x4;
 
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::mesh::Tetrahedra;
+use crate::ordering::{ColourClasses, Phase};
 use crate::projection::ParticleAccess;
 use crate::runs::{edge_run, vertex_face_run, volume_run};
-use crate::schedule::{run_phases, Nothing, Shared, PARTICLE_CHUNK};
+use crate::schedule::{run_phases, Nothing, Shared, Split, PARTICLE_CHUNK};
 use crate::systems::{Kernel, PredictRun, ProjectionCount, VelocityRun, VelocityUpdate};
 use crate::work::{self, Slot, WorkAccess};
 
@@ -56,7 +60,7 @@ fn particle_pass<C: Default + std::ops::AddAssign + Send>(
     len: usize,
     f: impl Fn(std::ops::Range<usize>) -> C + Sync,
 ) -> C {
-    run_phases(1, PARTICLE_CHUNK, |_| (len, true), |_, r| f(r))
+    run_phases(1, PARTICLE_CHUNK, |_| (len, Split::Lanes), |_, r| f(r))
 }
 
 /// [`crate::systems::predict`] of one body, in runs of particles.
@@ -156,7 +160,8 @@ struct SharedAccess {
 
 // SAFETY: a `SharedAccess` is only handed to the projections of one colour class, which
 // touch pairwise disjoint particles (greedy colouring; the overflow class, whose items may
-// overlap, never runs in parallel). The slices it points into outlive the parallel loop and
+// overlap, never runs in parallel), or to the tasks of one phase of a partitioned sweep,
+// which touch disjoint slabs of particles (crate::partition). The slices it points into outlive the parallel loop and
 // are borrowed mutably by it, so no other access exists meanwhile.
 unsafe impl Send for SharedAccess {}
 // SAFETY: as above.
@@ -210,29 +215,52 @@ impl ParticleAccess for SharedAccess {
     }
 }
 
-/// Runs `f` over every class, classes in order, in one parallel region
-/// ([`crate::schedule::run_phases`]: the classes are its phases). `f` gets the access, the
-/// run's first item index, the run's multipliers and whether the run is independent.
+/// Runs `f` over every class, in one parallel region ([`crate::schedule::run_phases`]: the
+/// phases of `classes` are its phases). A phase of one class is split among the threads in
+/// chunks; a phase of tasks hands each task whole to one thread, which runs its classes in
+/// order. `f` gets the access, the run's first item index, the run's multipliers and whether
+/// the run is independent.
 fn sweep<T: Send>(
-    classes: &crate::ordering::ColourClasses,
+    classes: &ColourClasses,
     items: &mut [T],
     acc: SharedAccess,
     f: impl Fn(&mut SharedAccess, usize, &mut [T], bool) -> ProjectionCount + Sync,
 ) -> ProjectionCount {
     let shared = Shared::new(items);
+    let class_run = |k: usize, within: Range<usize>| {
+        let (r, independent) = classes.class(k);
+        let first = r.start + within.start;
+        // SAFETY: `run_phases` hands each item of a class phase, and each task of a task
+        // phase (whose classes are its own), to one call only.
+        let run = unsafe { shared.run(first..r.start + within.end) };
+        f(&mut { acc }, first, run, independent)
+    };
     run_phases(
-        classes.len(),
+        classes.phase_count(),
         crate::schedule::CLASS_CHUNK,
-        |k| {
-            let (r, independent) = classes.class(k);
-            (r.len(), independent)
+        |j| match classes.phase(j) {
+            Phase::Class(k) => {
+                let (r, independent) = classes.class(k);
+                let split = if independent {
+                    Split::Lanes
+                } else {
+                    Split::Whole
+                };
+                (r.len(), split)
+            }
+            Phase::Tasks(tasks) => (tasks.len(), Split::Units),
         },
-        |k, within| {
-            let (r, independent) = classes.class(k);
-            let first = r.start + within.start;
-            // SAFETY: `run_phases` hands each item of a class to one call only.
-            let run = unsafe { shared.run(first..r.start + within.end) };
-            f(&mut { acc }, first, run, independent)
+        |j, within| match classes.phase(j) {
+            Phase::Class(k) => class_run(k, within),
+            Phase::Tasks(tasks) => {
+                let mut count = ProjectionCount::default();
+                for t in tasks.start + within.start..tasks.start + within.end {
+                    for k in classes.task(t) {
+                        count += class_run(k, 0..classes.class(k).0.len());
+                    }
+                }
+                count
+            }
         },
     )
 }

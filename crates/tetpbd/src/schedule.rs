@@ -2,8 +2,9 @@
 //! colour classes of a family, or the particles of a copy) that must run one after another,
 //! each phase's items split among the threads of rayon's pool.
 //!
-//! Why not one rayon parallel iterator per phase: a sweep of a 100k-tetrahedron body has
-//! 30 classes of tetrahedra (14 of edges), each a few hundred microseconds of work or less.
+//! Why not one rayon parallel iterator per phase: a sweep of a 100k-tetrahedron body in the
+//! plain layout has 30 classes of tetrahedra (14 of edges), each a few hundred microseconds
+//! of work or less (a partitioned body has 3 phases per family, see [`crate::partition`]).
 //! Between two parallel iterators rayon's idle thread goes to sleep and has to be woken, which
 //! on this virtual machine costs tens of microseconds each time (measured in
 //! docs/performance.md, "Scaling"). Here every thread of the pool enters once per sweep and
@@ -15,7 +16,8 @@
 //! owns region `i`: consecutive classes of a family cover the mesh in the same order, so the
 //! particles a thread touches stay in its cache from one phase to the next), then takes the
 //! chunks left in other regions. A phase that is not independent (the overflow class) is one
-//! chunk.
+//! chunk. A phase of *units* (the tasks of a partitioned sweep, [`crate::partition`]) is cut
+//! the same way with one unit per chunk and no lane alignment: a task is never split.
 //!
 //! **Claiming and waiting.** Each region has a claim counter and a done counter, both
 //! counting its chunks over all phases so far. A thread claims a chunk of phase `k` with a
@@ -28,8 +30,8 @@
 //! the sweep serially. No deadlock, whatever the pool does.
 //!
 //! **Determinism.** The chunks cut a phase at multiples of [`LANES`] from the phase's start,
-//! so the SIMD kernels group the same four items as the serial sweep does, and the items of a
-//! phase are independent: the result is bit-identical to the serial sweep for any number of
+//! so the SIMD kernels group the same four items as the serial sweep does; a unit runs whole
+//! on one thread, in the serial order; and the items (units) of a phase are independent: the result is bit-identical to the serial sweep for any number of
 //! threads and any assignment of chunks to threads.
 
 use std::ops::{AddAssign, Range};
@@ -60,28 +62,54 @@ struct Region {
     done: AtomicUsize,
 }
 
+/// How the items of a phase may be split among the threads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Split {
+    /// Pairwise independent items (a colour class, particles): chunks of the given size
+    /// cut at multiples of [`LANES`] from the phase's start.
+    Lanes,
+    /// Independent units of work (the tasks of a partitioned sweep): one unit per chunk.
+    Units,
+    /// Not independent (the overflow class): one chunk of every item.
+    Whole,
+}
+
 /// Where a phase of `len` items is cut for `regions` regions.
 #[derive(Clone, Copy)]
 struct Cut {
     len: usize,
-    independent: bool,
+    split: Split,
     regions: usize,
     chunk: usize,
 }
 
 impl Cut {
+    fn new(len: usize, split: Split, regions: usize, lanes_chunk: usize) -> Cut {
+        let chunk = match split {
+            Split::Lanes => lanes_chunk,
+            Split::Units | Split::Whole => 1,
+        };
+        Cut {
+            len,
+            split,
+            regions,
+            chunk,
+        }
+    }
+
     /// First item of region `r` (`r ≤ regions`).
     fn bound(&self, r: usize) -> usize {
+        let align = if self.split == Split::Lanes { LANES } else { 1 };
         if r >= self.regions {
             self.len
         } else {
-            self.len * r / self.regions / LANES * LANES
+            self.len * r / self.regions / align * align
         }
     }
 
     /// Chunks of region `r`.
     fn chunks(&self, r: usize) -> usize {
-        if !self.independent {
+        if self.split == Split::Whole {
             return usize::from(r == 0 && self.len > 0);
         }
         (self.bound(r + 1) - self.bound(r)).div_ceil(self.chunk)
@@ -89,7 +117,7 @@ impl Cut {
 
     /// Items of chunk `j` of region `r`.
     fn items(&self, r: usize, j: usize) -> Range<usize> {
-        if !self.independent {
+        if self.split == Split::Whole {
             return 0..self.len;
         }
         let (lo, hi) = (self.bound(r), self.bound(r + 1));
@@ -155,10 +183,17 @@ fn claim(region: &Region, end: usize) -> Option<usize> {
 
 /// Spins until `counter` reaches `target` (acquiring the writes of the chunks it counts).
 fn wait_for(counter: &AtomicUsize, target: usize) {
+    if counter.load(Ordering::Acquire) >= target {
+        return;
+    }
+    #[cfg(feature = "sync-stats")]
+    let since = Instant::now();
     let mut backoff = Backoff::default();
     while counter.load(Ordering::Acquire) < target {
         backoff.wait();
     }
+    #[cfg(feature = "sync-stats")]
+    crate::sync_stats::phase(since);
 }
 
 /// How long a wait spins (yielding the core every 256 rounds) before it sleeps between
@@ -191,18 +226,19 @@ impl Backoff {
 }
 
 /// Runs `phases` phases in order on every thread of the current rayon pool: phase `k` has
-/// `phase(k) = (len, independent)` items, and `work(k, items)` does the `items` of phase `k`
-/// (indices within the phase), cut in chunks of `chunk` items (rounded up to a multiple of
-/// [`LANES`]). Returns the sum of what `work` returned (summed per thread, then over the
-/// threads: use it for counts, whose sum does not depend on the order).
+/// `phase(k) = (len, split)` items, and `work(k, items)` does the `items` of phase `k`
+/// (indices within the phase): in chunks of `chunk` items (rounded up to a multiple of
+/// [`LANES`]) for [`Split::Lanes`], one item at a time for [`Split::Units`], all at once for
+/// [`Split::Whole`]. Returns the sum of what `work` returned (summed per thread, then over
+/// the threads: use it for counts, whose sum does not depend on the order).
 ///
-/// The items of an independent phase must be pairwise independent (touch disjoint data);
-/// `work` then runs concurrently on disjoint ranges of the phase. A phase that is not
-/// independent runs as one range on one thread.
+/// The items of a [`Split::Lanes`] or [`Split::Units`] phase must be pairwise independent
+/// (touch disjoint data); `work` then runs concurrently on disjoint ranges of the phase. A
+/// [`Split::Whole`] phase runs as one range on one thread.
 pub(crate) fn run_phases<C: Default + AddAssign + Send>(
     phases: usize,
     chunk: usize,
-    phase: impl Fn(usize) -> (usize, bool) + Sync,
+    phase: impl Fn(usize) -> (usize, Split) + Sync,
     work: impl Fn(usize, Range<usize>) -> C + Sync,
 ) -> C {
     let threads = rayon::current_num_threads();
@@ -216,13 +252,8 @@ pub(crate) fn run_phases<C: Default + AddAssign + Send>(
         // Chunks of each region in the phases before the current one.
         let mut before = [0usize; MAX_REGIONS];
         for k in 0..phases {
-            let (len, independent) = phase(k);
-            let cut = Cut {
-                len,
-                independent,
-                regions: regions_n,
-                chunk,
-            };
+            let (len, split) = phase(k);
+            let cut = Cut::new(len, split, regions_n, chunk);
             let mut ready = false;
             loop {
                 let got = (0..regions_n)
@@ -289,17 +320,21 @@ mod tests {
                 run_phases(
                     lens.len(),
                     CLASS_CHUNK,
-                    |k| (lens[k], k != 7),
+                    |k| match k {
+                        7 => (lens[k], Split::Whole),
+                        3 => (lens[k], Split::Units),
+                        _ => (lens[k], Split::Lanes),
+                    },
                     |k, items| {
                         let earlier_done = seen[..k]
                             .iter()
                             .flatten()
                             .all(|s| s.load(Ordering::SeqCst) == 1);
                         assert!(earlier_done, "phase {k} started before the ones before it");
-                        if k != 7 {
-                            assert_eq!(items.start % LANES, 0);
-                        } else {
-                            assert_eq!(items, 0..lens[k]);
+                        match k {
+                            7 => assert_eq!(items, 0..lens[k]),
+                            3 => assert_eq!(items.len(), 1),
+                            _ => assert_eq!(items.start % LANES, 0),
                         }
                         for i in items.clone() {
                             seen[k][i].fetch_add(1, Ordering::SeqCst);

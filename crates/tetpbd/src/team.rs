@@ -213,9 +213,15 @@ impl Drop for Close<'_> {
     fn drop(&mut self) {
         let team = self.0;
         team.epoch.fetch_add(1, Ordering::SeqCst);
+        #[cfg(feature = "sync-stats")]
+        let since = (team.active.load(Ordering::SeqCst) > 0).then(Instant::now);
         let mut backoff = Backoff::default();
         while team.active.load(Ordering::SeqCst) > 0 {
             backoff.wait();
+        }
+        #[cfg(feature = "sync-stats")]
+        if let Some(since) = since {
+            crate::sync_stats::close(since);
         }
         // SAFETY: the epoch is even again and `active` drained: no helper reads the job.
         unsafe { *team.job.get() = None };

@@ -55,8 +55,10 @@ fn parallel_steps_after_the_first_allocate_nothing() {
         .build()
         .unwrap();
     let mut world = hecs::World::new();
-    // 16³ cells: 4913 particles and 24 576 tetrahedra, above every parallel threshold.
+    // 16³ cells: 4913 particles and 24 576 tetrahedra, above every parallel threshold; a
+    // second copy cut into 4 slabs (the partitioned sweep's tasks).
     let body = common::hanging_cube(&mut world, 16);
+    let parted = common::hanging_cube_parts(&mut world, 16, 4);
     let mut solver = Solver::new(SolverSettings {
         substeps: 4,
         max_correction_speed: Some(10.0),
@@ -71,7 +73,9 @@ fn parallel_steps_after_the_first_allocate_nothing() {
         }
         ALLOCATIONS.load(Ordering::SeqCst) - before
     });
-    let p = world.get::<&Particles>(body).unwrap();
-    assert!(p.max_speed() > 0.01, "the body moves");
+    for e in [body, parted] {
+        let p = world.get::<&Particles>(e).unwrap();
+        assert!(p.max_speed() > 0.01, "the body moves");
+    }
     assert_eq!(counted, 0, "allocations in 10 parallel steps");
 }

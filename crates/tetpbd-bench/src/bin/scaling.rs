@@ -2,70 +2,143 @@
 //! 1/60 s frame), for edges + volume and for vertex–face, on 1 and 2 threads.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --max-cells N --frames F --shuffle --spatial-order on|off|both --breakdown]
+//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown]
 //! ```
+//!
+//! With `--features parallel` the 1-thread and the 2-thread runs are *interleaved*: two
+//! copies of the body, one stepped on a pool of one thread and one on a pool of two, frame
+//! after frame in turn, so that a change of the machine's load (other processes, clock)
+//! hits both columns alike. The speed-up is the median over the frames of the ratio of each
+//! 1-thread frame to the 2-thread frame after it, with the lower and upper quartiles of
+//! those ratios beside it. `--sequential` runs all the 1-thread frames first, then all the
+//! 2-thread ones (the older way; the speed-up is then the ratio of the medians).
+//!
+//! Each row ends with the CPU other processes used while it was measured, in cores (from
+//! `/proc/stat` less this process's own time): on a shared 2-core machine anything above a
+//! few hundredths of a core takes time from the 2-thread column.
+//!
+//! `--error` prints, after the measured frames, the constraint error of the 1-thread body
+//! (one more frame with [`tetpbd::SolverSettings::measure_error`]): how well the sweep
+//! order converges, e.g. to compare `--parts 1` with a partitioned order.
+//!
+//! `--set` measures one family set only (default both).
+//!
+//! `--parts P` builds the bodies cut into `P` slabs for the sweep order
+//! ([`tetpbd::SoftBodyBuilder::parts`]; default 0, the builder's choice).
 //!
 //! `--breakdown` also prints, per body and thread count, the median ms per frame spent in
 //! prediction, the copies into and out of the working copy, each family's system and the
-//! velocity update (from [`tetpbd::StepStats`]),
-//! and the number of colour classes of the edges and tetrahedra (the phases of a parallel
-//! sweep).
+//! velocity update (from [`tetpbd::StepStats`]), the phases of a sweep of the edges and of
+//! the tetrahedra (colour classes of the plain layout, tasks and classes of a partitioned
+//! one) and, built with `--features sync-stats`, the median ms per frame the threads spent
+//! waiting at phase boundaries (summed over both threads) and for a pass's last chunks.
 //!
 //! `--shuffle` numbers each grid's vertices and tetrahedra in a random order (as mesh files
 //! may); `--spatial-order` builds the bodies with the builder's particle renumbering on, off
 //! or both (default: the builder's default).
 //!
 //! Without `--features parallel` only the single-threaded column is measured. Prints medians
-//! over the measured frames (the first two frames are warm-up) and ns per tetrahedron per
-//! substep.
+//! over the measured frames (the first two frames of each body are warm-up) and ns per
+//! tetrahedron per substep (1 thread).
 
 use std::time::Instant;
 
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, shuffled, CellSplit};
-use tetpbd::{SoftBodyBuilder, Solver, SolverSettings, StepStats, TetMesh};
+use tetpbd::{EdgeConstraints, SoftBodyBuilder, Solver, SolverSettings, StepStats, TetMesh};
 use tetpbd_bench::{arg, flag, orders};
 
-/// Median ms per frame of a hanging cube (top face pinned), and the median ms per frame
-/// of each phase: prediction, copies into and out of the working copy, volume, vertex–face,
-/// edges, velocity update.
-fn frame_ms(
+/// Warm-up frames of each body, not measured.
+const WARM_UP: usize = 2;
+
+/// One body being stepped, with what its measured frames took.
+struct Body {
+    world: hecs::World,
+    solver: Solver,
+    /// ms per measured frame.
+    times: Vec<f64>,
+    /// ms per measured frame of prediction, copies, volume, vertex–face, edges, velocities.
+    phases: [Vec<f64>; 6],
+    /// ms per measured frame waiting at phase boundaries, and closing passes.
+    waits: [Vec<f64>; 2],
+    /// Phases of a sweep of the edges and of the tetrahedra.
+    sweep_phases: (usize, usize),
+}
+
+/// A hanging cube (top face pinned) of `mesh` with the family set `set`.
+fn body(
     mesh: &TetMesh,
     set: &str,
     spatial: bool,
-    frames: usize,
-) -> Result<(f64, [f64; 6]), Box<dyn std::error::Error>> {
+    parts: usize,
+) -> Result<Body, Box<dyn std::error::Error>> {
     let top: Vec<u32> = (0..mesh.vertices.len() as u32)
         .filter(|&i| mesh.vertices[i as usize].y > 0.4999)
         .collect();
     let b = SoftBodyBuilder::new(mesh.clone())
         .density(1000.0)
         .spatial_order(spatial)
+        .parts(parts)
         .pinned(top);
     let b = if set == "edges+volume" {
         b.edges(1e-7).volume(1e-10)
     } else {
         b.vertex_face(1e-7)
     };
+    let built = b.build()?;
+    let sweep_phases = (
+        built
+            .edges
+            .as_ref()
+            .map_or(0, |e: &EdgeConstraints| e.classes().phase_count()),
+        built.tetrahedra.classes().phase_count(),
+    );
     let mut world = hecs::World::new();
-    b.build()?.spawn(&mut world);
-    let mut solver = Solver::new(SolverSettings {
+    built.spawn(&mut world);
+    let solver = Solver::new(SolverSettings {
         substeps: 10,
         ..Default::default()
     })?;
-    let mut times = Vec::with_capacity(frames);
-    let mut phases: [Vec<f64>; 6] = Default::default();
-    for f in 0..frames + 2 {
+    Ok(Body {
+        world,
+        solver,
+        times: Vec::new(),
+        phases: Default::default(),
+        waits: Default::default(),
+        sweep_phases,
+    })
+}
+
+impl Body {
+    /// Steps one frame; records it unless `warm_up`.
+    fn frame(&mut self, warm_up: bool) -> Result<(), Box<dyn std::error::Error>> {
+        sync_take();
         let t = Instant::now();
-        let s = solver.step(&mut world)?;
-        if f >= 2 {
-            times.push(t.elapsed().as_secs_f64() * 1e3);
-            for (v, p) in phases.iter_mut().zip(phase_ms(&s)) {
+        let s = self.solver.step(&mut self.world)?;
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        let waits = sync_take();
+        if !warm_up {
+            self.times.push(ms);
+            for (v, p) in self.phases.iter_mut().zip(phase_ms(&s)) {
                 v.push(p);
             }
+            for (v, w) in self.waits.iter_mut().zip(waits) {
+                v.push(w);
+            }
         }
+        Ok(())
     }
-    Ok((median(&mut times), phases.map(|mut v| median(&mut v))))
+}
+
+/// ms of phase waits and close waits since the last call (zeros without `sync-stats`).
+fn sync_take() -> [f64; 2] {
+    #[cfg(feature = "sync-stats")]
+    {
+        let s = tetpbd::sync_stats::take();
+        [s.phase_wait, s.close_wait].map(|d| d.as_secs_f64() * 1e3)
+    }
+    #[cfg(not(feature = "sync-stats"))]
+    [0.0; 2]
 }
 
 fn phase_ms(s: &StepStats) -> [f64; 6] {
@@ -80,76 +153,209 @@ fn phase_ms(s: &StepStats) -> [f64; 6] {
     .map(|d| d.as_secs_f64() * 1e3)
 }
 
-fn median(v: &mut [f64]) -> f64 {
+/// The `q`-quantile (0 ≤ q ≤ 1, nearest rank) of `v`.
+fn quantile(v: &[f64], q: f64) -> f64 {
+    let mut v = v.to_vec();
     v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+    v[((v.len() - 1) as f64 * q).round() as usize]
 }
 
-/// Colour classes of the mesh's edges and tetrahedra.
-fn class_counts(mesh: &TetMesh) -> (usize, usize) {
-    let n = mesh.vertices.len();
-    let edges = tetpbd::unique_edges(&mesh.tets);
-    (
-        tetpbd::ordering::colour_order(&edges, n).1.len(),
-        tetpbd::ordering::colour_order(&mesh.tets, n).1.len(),
-    )
+fn median(v: &[f64]) -> f64 {
+    quantile(v, 0.5)
 }
 
+/// CPU time, s, used so far by every process of the machine (`/proc/stat`, user + nice +
+/// system + irq + softirq + steal; 0 where unreadable) and by this one (`getrusage`).
+fn cpu_seconds() -> (f64, f64) {
+    let all = std::fs::read_to_string("/proc/stat")
+        .ok()
+        .and_then(|s| {
+            let line = s.lines().next()?.to_string();
+            let v: Vec<f64> = line
+                .split_whitespace()
+                .skip(1)
+                .filter_map(|x| x.parse().ok())
+                .collect();
+            // user nice system idle iowait irq softirq steal
+            let busy = [0, 1, 2, 5, 6, 7]
+                .iter()
+                .filter_map(|&i| v.get(i))
+                .sum::<f64>();
+            Some(busy / 100.0)
+        })
+        .unwrap_or(0.0);
+    // SAFETY: `getrusage` fills the zeroed struct it is given; RUSAGE_SELF is valid.
+    let own = unsafe {
+        let mut u: libc::rusage = std::mem::zeroed();
+        libc::getrusage(libc::RUSAGE_SELF, &mut u);
+        let t = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+        t(u.ru_utime) + t(u.ru_stime)
+    };
+    (all, own)
+}
+
+/// Runs `f` on `pool` (on this thread without one).
 #[cfg(feature = "parallel")]
-fn with_threads<T: Send>(n: usize, f: impl FnOnce() -> T + Send) -> T {
-    match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
-        Ok(pool) => pool.install(f),
-        Err(_) => f(),
+fn on<T: Send>(pool: &Option<rayon::ThreadPool>, f: impl FnOnce() -> T + Send) -> T {
+    match pool {
+        Some(pool) => pool.install(f),
+        None => f(),
     }
 }
 
+/// Measures `one` (and `two`, on a pool of two threads): interleaved frame by frame, or
+/// one body after the other when `sequential`.
+fn measure(
+    one: &mut Body,
+    two: Option<&mut Body>,
+    frames: usize,
+    sequential: bool,
+) -> Result<(), String> {
+    #[cfg(feature = "parallel")]
+    {
+        let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().ok();
+        let (p1, p2) = (pool(1), pool(2));
+        let frame = |b: &mut Body, p: &Option<rayon::ThreadPool>, warm: bool| {
+            on(p, || b.frame(warm).map_err(|e| e.to_string()))
+        };
+        match two {
+            Some(two) if !sequential => {
+                for f in 0..frames + WARM_UP {
+                    frame(one, &p1, f < WARM_UP)?;
+                    frame(two, &p2, f < WARM_UP)?;
+                }
+            }
+            two => {
+                for f in 0..frames + WARM_UP {
+                    frame(one, &p1, f < WARM_UP)?;
+                }
+                if let Some(two) = two {
+                    for f in 0..frames + WARM_UP {
+                        frame(two, &p2, f < WARM_UP)?;
+                    }
+                }
+            }
+        }
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        let _ = (two, sequential);
+        for f in 0..frames + WARM_UP {
+            one.frame(f < WARM_UP).map_err(|e| e.to_string())?;
+        }
+    }
+    Ok(())
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let min_cells = arg("--min-cells", 0) as u32;
     let max_cells = arg("--max-cells", 55) as u32;
-    let frames = arg("--frames", 7);
+    let frames = arg("--frames", 15).max(1);
+    let parts = arg("--parts", 0);
+    let sequential = flag("--sequential");
+    let args: Vec<String> = std::env::args().collect();
+    let only = args
+        .iter()
+        .position(|a| a == "--set")
+        .and_then(|i| args.get(i + 1).cloned());
     let shuffle = flag("--shuffle");
     let breakdown = flag("--breakdown");
+    let parallel = cfg!(feature = "parallel");
     let numbering = if shuffle { "shuffled" } else { "grid" };
-    println!("hanging cube ({numbering} numbering), top face pinned, 10 substeps × 1 iteration per 1/60 s frame; median of {frames} frames after 2 warm-up");
-    println!("set           spatial order      tets  particles   1 thread ms/frame  ns/tet/substep   2 threads ms/frame  speed-up");
-    for cells in [6u32, 12, 26, 55].into_iter().filter(|c| *c <= max_cells) {
+    let mode = if !parallel {
+        "1 thread only"
+    } else if sequential {
+        "1-thread frames, then 2-thread frames"
+    } else {
+        "1- and 2-thread frames interleaved"
+    };
+    println!("hanging cube ({numbering} numbering), top face pinned, 10 substeps × 1 iteration per 1/60 s frame; median of {frames} frames after {WARM_UP} warm-up ({mode}); parts {parts} (0 = builder's choice)");
+    println!("set           spatial order      tets  particles   1 thread ms/frame  ns/tet/substep   2 threads ms/frame  speed-up (quartiles)");
+    for cells in [6u32, 12, 26, 55]
+        .into_iter()
+        .filter(|c| (min_cells..=max_cells).contains(c))
+    {
         let mut mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Six)?;
         if shuffle {
             mesh = shuffled(&mesh, 1).0;
         }
         for (set, spatial) in ["edges+volume", "vertex-face"]
             .into_iter()
+            .filter(|s| only.as_ref().is_none_or(|o| o == s))
             .flat_map(|s| orders().into_iter().map(move |o| (s, o)))
         {
-            #[cfg(feature = "parallel")]
-            let (one, two) = (
-                with_threads(1, || {
-                    frame_ms(&mesh, set, spatial, frames).map_err(|e| e.to_string())
-                })?,
-                Some(with_threads(2, || {
-                    frame_ms(&mesh, set, spatial, frames).map_err(|e| e.to_string())
-                })?),
-            );
-            #[cfg(not(feature = "parallel"))]
-            let (one, two): (_, Option<(f64, [f64; 6])>) =
-                (frame_ms(&mesh, set, spatial, frames)?, None);
-            let ((one, one_phases), two_phases) = (one, two.map(|t| t.1));
-            let two = two.map(|t| t.0);
-            let per_tet = one * 1e6 / (mesh.tets.len() as f64 * 10.0);
-            let two_s = two.map_or("-".to_string(), |t| format!("{t:.2}"));
-            let speed = two.map_or("-".to_string(), |t| format!("{:.2}×", one / t));
+            let mut one = body(&mesh, set, spatial, parts)?;
+            let mut two = if parallel {
+                Some(body(&mesh, set, spatial, parts)?)
+            } else {
+                None
+            };
+            let (all0, own0, wall0) = {
+                let (a, o) = cpu_seconds();
+                (a, o, Instant::now())
+            };
+            measure(&mut one, two.as_mut(), frames, sequential)?;
+            let (all1, own1) = cpu_seconds();
+            let wall = wall0.elapsed().as_secs_f64();
+            // Cores' worth of CPU other processes used meanwhile (/proc/stat counts in
+            // 10 ms ticks: about ±0.01 s over the run).
+            let others = ((all1 - all0) - (own1 - own0)).max(0.0) / wall;
+            let one_ms = median(&one.times);
+            let per_tet = one_ms * 1e6 / (mesh.tets.len() as f64 * 10.0);
+            let (two_s, speed) = match &two {
+                Some(t) => {
+                    let ratios: Vec<f64> = if sequential {
+                        vec![one_ms / median(&t.times)]
+                    } else {
+                        one.times.iter().zip(&t.times).map(|(a, b)| a / b).collect()
+                    };
+                    (
+                        format!("{:.2}", median(&t.times)),
+                        format!(
+                            "{:.2}× ({:.2}–{:.2})",
+                            median(&ratios),
+                            quantile(&ratios, 0.25),
+                            quantile(&ratios, 0.75)
+                        ),
+                    )
+                }
+                None => ("-".to_string(), "-".to_string()),
+            };
             println!(
-                "{set:13} {:13} {:9} {:10}   {one:17.2}  {per_tet:14.1}   {two_s:>18}  {speed:>8}",
+                "{set:13} {:13} {:9} {:10}   {one_ms:17.2}  {per_tet:14.1}   {two_s:>18}  {speed}  others {others:.2} cores over {wall:.1} s",
                 if spatial { "on" } else { "off" },
                 mesh.tets.len(),
                 mesh.vertices.len()
             );
+            if flag("--error") {
+                one.solver.settings.measure_error = true;
+                let s = one.solver.step(&mut one.world)?;
+                let f = |e: Option<tetpbd::ErrorStats>| {
+                    e.map_or("-".to_string(), |e| {
+                        format!("rms {:.3e} max {:.3e}", e.rms, e.max)
+                    })
+                };
+                println!(
+                    "    error after {} frames: edges {}  volume {}  vertex-face {}",
+                    frames + WARM_UP + 1,
+                    f(s.edge.after),
+                    f(s.volume.after),
+                    f(s.vertex_face.after)
+                );
+            }
             if breakdown {
-                let (e, t) = class_counts(&mesh);
-                println!("    colour classes: {e} of edges, {t} of tetrahedra");
-                for (threads, p) in [(1, Some(one_phases)), (2, two_phases)] {
-                    if let Some([pr, co, vo, vf, ed, ve]) = p {
-                        println!("    {threads} thread(s), ms/frame: predict {pr:.2}  copies {co:.2}  volume {vo:.2}  vertex-face {vf:.2}  edges {ed:.2}  velocities {ve:.2}");
-                    }
+                let (e, t) = one.sweep_phases;
+                println!("    phases per sweep: {e} of edges, {t} of tetrahedra");
+                for (threads, b) in [(1, Some(&one)), (2, two.as_ref())] {
+                    let Some(b) = b else { continue };
+                    let [pr, co, vo, vf, ed, ve] = b.phases.each_ref().map(|v| median(v));
+                    let [pw, cw] = b.waits.each_ref().map(|v| median(v));
+                    let waits = if cfg!(feature = "sync-stats") {
+                        format!("  waits: phases {pw:.2} close {cw:.2}")
+                    } else {
+                        String::new()
+                    };
+                    println!("    {threads} thread(s), ms/frame: predict {pr:.2}  copies {co:.2}  volume {vo:.2}  vertex-face {vf:.2}  edges {ed:.2}  velocities {ve:.2}{waits}");
                 }
             }
         }

@@ -36,6 +36,12 @@ impl Rng {
 /// A cube of `cells³` cells (six tetrahedra each) with its top face pinned and all three
 /// families, spawned into `world`: the body of the parallel tests.
 pub fn hanging_cube(world: &mut hecs::World, cells: u32) -> hecs::Entity {
+    hanging_cube_parts(world, cells, 0)
+}
+
+/// [`hanging_cube`] cut into `parts` slabs for the sweep order (0: the builder's choice).
+#[allow(dead_code)]
+pub fn hanging_cube_parts(world: &mut hecs::World, cells: u32, parts: usize) -> hecs::Entity {
     use tetpbd::generators::{box_grid, CellSplit};
     let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Six).unwrap();
     let top: Vec<u32> = (0..mesh.vertices.len() as u32)
@@ -46,6 +52,7 @@ pub fn hanging_cube(world: &mut hecs::World, cells: u32) -> hecs::Entity {
         .volume(0.0)
         .vertex_face(1e-5)
         .pinned(top)
+        .parts(parts)
         .build()
         .unwrap()
         .spawn(world)
