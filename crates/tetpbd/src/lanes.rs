@@ -18,7 +18,7 @@
 
 use wide::f32x4;
 
-use crate::constraint::{VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
+use crate::constraint::{VERTEX_FACE_KAPPA, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER};
 use crate::projection::{self, ParticleAccess};
 use crate::simd::Lane;
 use crate::systems::ProjectionCount;
@@ -220,6 +220,23 @@ fn delta_lambda<L: Lane>(c: L, lambda: L, alpha_tilde: L, w_grad_sq: L) -> (L, L
     (ok.vsel((-c - alpha_tilde * lambda) / safe, L::ZERO), ok)
 }
 
+/// [`crate::constraint::bounded_step`] on every lane: `dl` scaled down where a particle
+/// would move further than `max_step` (m), `reach² = maxₛ (wₛ |gₛ|)²` from the inverse
+/// masses `w` and squared gradient norms `gg`.
+#[inline(always)]
+fn bounded_step<L: Lane>(dl: L, w: [L; 4], gg: [L; 4], max_step: L) -> L {
+    let reach_sq = (0..4).fold(L::ZERO, |r, s| {
+        let x = w[s] * w[s] * gg[s];
+        x.vgt(r).vsel(x, r)
+    });
+    let over = (dl * dl * reach_sq).vgt(max_step * max_step);
+    if over.vbits() == 0 {
+        return dl;
+    }
+    let s = max_step / over.vsel(reach_sq, L::ONE).vsqrt();
+    over.vsel(L::ZERO.vgt(dl).vsel(-s, s), dl)
+}
+
 /// `LANES` items of `s` from `at` (the caller keeps `at + LANES ≤ s.len()`).
 #[inline(always)]
 pub(crate) fn chunk<T>(s: &[T], at: usize) -> &[T; LANES] {
@@ -374,6 +391,12 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
     // Per constraint k, the tetrahedra's heights and multipliers as lanes.
     let h: [L; 4] = transpose_rows(heights, at);
     let mut lam: [L; 4] = transpose_rows(lambdas, at);
+    // The move bound, as in `constraint::vertex_face_step_bound`: a fraction of max_k |d_k|.
+    let size = h.iter().fold(L::ZERO, |m, &d| {
+        let a = d.vgt(-d).vsel(d, -d);
+        a.vgt(m).vsel(a, m)
+    });
+    let max_step = L::splat(VERTEX_FACE_MAX_STEP) * size;
     let mut dp = [V3::<L>::ZERO; 4];
     let mut count = ProjectionCount::default();
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
@@ -397,9 +420,10 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
         let g0 = g1.add(g2).add(g3).neg();
         let g = [g0, g1, g2, g3];
         let wo = [w[order[0]], w[order[1]], w[order[2]], w[order[3]]];
-        let w_grad_sq = (0..4).fold(L::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
+        let gg = g.map(|g| g.dot(g));
+        let w_grad_sq = (0..4).fold(L::ZERO, |s, s_| s + wo[s_] * gg[s_]);
         let (dl, ok) = delta_lambda(na - h[k], lam[k], alpha, w_grad_sq);
-        let dl = valid.vsel(dl, L::ZERO);
+        let dl = bounded_step(valid.vsel(dl, L::ZERO), wo, gg, max_step);
         let ok = ok & valid;
         lam[k] += dl;
         for s in 0..4 {
