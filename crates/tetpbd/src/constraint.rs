@@ -64,8 +64,9 @@ pub fn vertex_face_step_bound(rest_values: &[f32; 4]) -> f32 {
 
 /// A multiplier step `Δλ` scaled down so that no particle moves further than `max_step`.
 ///
-/// `reach_sq = maxᵢ (wᵢ |∇ᵢC|)²` (the squared move per unit `Δλ`), `max_step` in metres.
-/// The projection moves particle `i` by `wᵢ ∇ᵢC Δλ`, so its largest move is
+/// `reach_sq ≥ maxᵢ (wᵢ |∇ᵢC|)²` (the squared move per unit `Δλ`, or an upper bound of it:
+/// the kernels pass `maxᵢ wᵢ · Σᵢ wᵢ |∇ᵢC|²`, which the XPBD denominator already holds),
+/// `max_step` in metres. The projection moves particle `i` by `wᵢ ∇ᵢC Δλ`, so no move exceeds
 /// `|Δλ| √reach_sq`; where that exceeds `max_step` the step becomes
 /// `sign(Δλ) · max_step / √reach_sq` (every move scaled by the same factor: the correction
 /// keeps its direction and, as the gradients sum to zero, conserves momentum). Smaller steps

@@ -221,14 +221,11 @@ fn delta_lambda<L: Lane>(c: L, lambda: L, alpha_tilde: L, w_grad_sq: L) -> (L, L
 }
 
 /// [`crate::constraint::bounded_step`] on every lane: `dl` scaled down where a particle
-/// would move further than `max_step` (m), `reach² = maxₛ (wₛ |gₛ|)²` from the inverse
-/// masses `w` and squared gradient norms `gg`.
+/// could move further than `max_step` (m), with `reach_sq = w_max · Σₛ wₛ |gₛ|²` (an upper
+/// bound of `maxₛ (wₛ |gₛ|)²`, as the scalar kernel takes it). Lanes within the bound keep
+/// `dl` bit for bit.
 #[inline(always)]
-fn bounded_step<L: Lane>(dl: L, w: [L; 4], gg: [L; 4], max_step: L) -> L {
-    let reach_sq = (0..4).fold(L::ZERO, |r, s| {
-        let x = w[s] * w[s] * gg[s];
-        x.vgt(r).vsel(x, r)
-    });
+fn bounded_step<L: Lane>(dl: L, reach_sq: L, max_step: L) -> L {
     let over = (dl * dl * reach_sq).vgt(max_step * max_step);
     if over.vbits() == 0 {
         return dl;
@@ -397,6 +394,7 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
         a.vgt(m).vsel(a, m)
     });
     let max_step = L::splat(VERTEX_FACE_MAX_STEP) * size;
+    let w_max = w.iter().fold(L::ZERO, |m, &x| x.vgt(m).vsel(x, m));
     let mut dp = [V3::<L>::ZERO; 4];
     let mut count = ProjectionCount::default();
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
@@ -420,10 +418,9 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
         let g0 = g1.add(g2).add(g3).neg();
         let g = [g0, g1, g2, g3];
         let wo = [w[order[0]], w[order[1]], w[order[2]], w[order[3]]];
-        let gg = g.map(|g| g.dot(g));
-        let w_grad_sq = (0..4).fold(L::ZERO, |s, s_| s + wo[s_] * gg[s_]);
+        let w_grad_sq = (0..4).fold(L::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
         let (dl, ok) = delta_lambda(na - h[k], lam[k], alpha, w_grad_sq);
-        let dl = bounded_step(valid.vsel(dl, L::ZERO), wo, gg, max_step);
+        let dl = bounded_step(valid.vsel(dl, L::ZERO), w_max * w_grad_sq, max_step);
         let ok = ok & valid;
         lam[k] += dl;
         for s in 0..4 {

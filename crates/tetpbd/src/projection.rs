@@ -75,16 +75,15 @@ fn apply<A: ParticleAccess, const N: usize>(
     max_step: f32,
 ) -> bool {
     let w = idx.map(|i| a.w(i));
-    let (w_grad_sq, reach_sq) = w
+    let w_grad_sq = w
         .iter()
         .zip(&e.grad)
-        .fold((0.0f32, 0.0f32), |(s, r), (w, g)| {
-            let g2 = g.norm_squared();
-            (s + w * g2, r.max(w * w * g2))
-        });
+        .fold(0.0f32, |s, (w, g)| s + w * g.norm_squared());
     match constraint::xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
         Some(dl) => {
-            let dl = constraint::bounded_step(dl, reach_sq, max_step);
+            // `w_max Σ wᵢ|∇ᵢC|² ≥ maxᵢ (wᵢ|∇ᵢC|)²`: the bound holds for every particle.
+            let w_max = w.iter().fold(0.0f32, |m, &x| m.max(x));
+            let dl = constraint::bounded_step(dl, w_max * w_grad_sq, max_step);
             *lambda += dl;
             for k in 0..N {
                 a.add(idx[k], e.grad[k] * (w[k] * dl));
