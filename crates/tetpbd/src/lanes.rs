@@ -345,7 +345,9 @@ pub(crate) fn volumes<L: Lane, A: ParticleAccess>(
 /// compute. A chunk of four with a face not healthy by a margin of 2 at its start
 /// (`|b × c| ≤ 2κQ`, κ = [`VERTEX_FACE_KAPPA`]) goes to the scalar kernel (a pair of chunks
 /// with one, to this kernel chunk by chunk); a lane whose face turns thin (`|b × c| < κQ`)
-/// within the chunk skips that projection and counts it as degenerate.
+/// within the chunk skips that projection and counts it as degenerate. Every projection's
+/// `Δλ` is bounded as in the scalar kernel ([`crate::constraint::bounded_step`] with
+/// [`crate::constraint::vertex_face_step_bound`]), lane by lane.
 #[inline(always)]
 pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
     bd: &mut Bounded<'_, A, 4>,
