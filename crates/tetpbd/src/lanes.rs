@@ -221,16 +221,17 @@ fn delta_lambda<L: Lane>(c: L, lambda: L, alpha_tilde: L, w_grad_sq: L) -> (L, L
 }
 
 /// [`crate::constraint::bounded_step`] on every lane: `dl` scaled down where a particle
-/// could move further than `max_step` (m), with `reach_sq = w_max · Σₛ wₛ |gₛ|²` (an upper
-/// bound of `maxₛ (wₛ |gₛ|)²`, as the scalar kernel takes it). Lanes within the bound keep
-/// `dl` bit for bit.
+/// could move further than `max_step` (m), the farthest move per unit `dl` taken as
+/// `√(w_max · w_grad_sq)` (an upper bound of `maxₛ wₛ |gₛ|`, as the scalar kernel takes it).
+/// `limit = max_step² / w_max` is computed once per chunk, so only `dl` and `w_grad_sq` are
+/// read per projection. Lanes within the bound keep `dl` bit for bit.
 #[inline(always)]
-fn bounded_step<L: Lane>(dl: L, reach_sq: L, max_step: L) -> L {
-    let over = (dl * dl * reach_sq).vgt(max_step * max_step);
+fn bounded_step<L: Lane>(dl: L, w_grad_sq: L, limit: L, max_step: L, w_max: L) -> L {
+    let over = (dl * dl * w_grad_sq).vgt(limit);
     if over.vbits() == 0 {
         return dl;
     }
-    let s = max_step / over.vsel(reach_sq, L::ONE).vsqrt();
+    let s = max_step / over.vsel(w_max * w_grad_sq, L::ONE).vsqrt();
     over.vsel(L::ZERO.vgt(dl).vsel(-s, s), dl)
 }
 
@@ -390,13 +391,13 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
     // Per constraint k, the tetrahedra's heights and multipliers as lanes.
     let h: [L; 4] = transpose_rows(heights, at);
     let mut lam: [L; 4] = transpose_rows(lambdas, at);
-    // The move bound, as in `constraint::vertex_face_step_bound`: a fraction of max_k |d_k|.
-    let size = h.iter().fold(L::ZERO, |m, &d| {
-        let a = d.vgt(-d).vsel(d, -d);
-        a.vgt(m).vsel(a, m)
-    });
+    // The move bound, as in `constraint::vertex_face_step_bound`: a fraction of max_k |d_k|
+    // (`√(d²) = |d|` exactly in IEEE arithmetic).
+    let size = h.iter().fold(L::ZERO, |m, &d| m.vmax(d * d)).vsqrt();
     let max_step = L::splat(VERTEX_FACE_MAX_STEP) * size;
-    let w_max = w.iter().fold(L::ZERO, |m, &x| x.vgt(m).vsel(x, m));
+    let w_max = w.iter().fold(L::ZERO, |m, &x| m.vmax(x));
+    // All four pinned (w_max = 0): the limit is infinite (or NaN), no lane is over.
+    let limit = max_step * max_step / w_max;
     let mut dp = [V3::<L>::ZERO; 4];
     let mut count = ProjectionCount::default();
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
@@ -422,7 +423,7 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
         let wo = [w[order[0]], w[order[1]], w[order[2]], w[order[3]]];
         let w_grad_sq = (0..4).fold(L::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
         let (dl, ok) = delta_lambda(na - h[k], lam[k], alpha, w_grad_sq);
-        let dl = bounded_step(valid.vsel(dl, L::ZERO), w_max * w_grad_sq, max_step);
+        let dl = bounded_step(valid.vsel(dl, L::ZERO), w_grad_sq, limit, max_step, w_max);
         let ok = ok & valid;
         lam[k] += dl;
         for s in 0..4 {
