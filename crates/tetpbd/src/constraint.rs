@@ -43,6 +43,49 @@ pub fn xpbd_delta_lambda<T: RealField + Copy>(
     }
 }
 
+/// Largest particle move of one vertex–face projection, as a fraction of the tetrahedron's
+/// rest size `max_k |d_k|` (the largest of its four rest values, m; see
+/// [`vertex_face_step_bound`]). Dimensionless.
+///
+/// 1: a projection moves no particle further than the tetrahedron's largest rest height (its
+/// largest rest value, smaller than that height on faces thin at rest). Corrections of a
+/// healthy scene are far below it and unchanged; it acts where a near-singular gradient
+/// would take a step of many body sizes (the hard sliver plate of the stability matrix).
+/// Measured in `docs/stability.md` against 0.5, 2 and 4.
+pub const VERTEX_FACE_MAX_STEP: f32 = 1.0;
+
+/// The move bound of one tetrahedron's vertex–face projections, m:
+/// [`VERTEX_FACE_MAX_STEP`] `· max_k |d_k|` over its four rest values `d_k` (m).
+#[inline(always)]
+pub fn vertex_face_step_bound(rest_values: &[f32; 4]) -> f32 {
+    let size = rest_values.iter().fold(0.0f32, |m, d| m.max(d.abs()));
+    VERTEX_FACE_MAX_STEP * size
+}
+
+/// A multiplier step `Δλ` scaled down so that no particle moves further than `max_step`.
+///
+/// `reach_sq ≥ maxᵢ (wᵢ |∇ᵢC|)²` (the squared move per unit `Δλ`, or an upper bound of it:
+/// the kernels pass `maxᵢ wᵢ · Σᵢ wᵢ |∇ᵢC|²`, which the XPBD denominator already holds),
+/// `max_step` in metres. The projection moves particle `i` by `wᵢ ∇ᵢC Δλ`, so no move exceeds
+/// `|Δλ| √reach_sq`; where that exceeds `max_step` the step becomes
+/// `sign(Δλ) · max_step / √reach_sq` (every move scaled by the same factor: the correction
+/// keeps its direction and, as the gradients sum to zero, conserves momentum). Smaller steps
+/// are returned unchanged, bit for bit. Units: `Δλ` in those of the multiplier (kg·m for a
+/// length constraint), `reach_sq` in `1/kg² · |∇C|²`.
+#[inline(always)]
+pub fn bounded_step<T: RealField + Copy>(dl: T, reach_sq: T, max_step: T) -> T {
+    if dl * dl * reach_sq > max_step * max_step {
+        let s = max_step / reach_sq.sqrt();
+        if dl < T::zero() {
+            -s
+        } else {
+            s
+        }
+    } else {
+        dl
+    }
+}
+
 /// A constraint value with its gradients with respect to each of its `N` particles.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Evaluated<T: RealField + Copy, const N: usize> {

@@ -18,7 +18,7 @@
 
 use wide::f32x4;
 
-use crate::constraint::{VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
+use crate::constraint::{VERTEX_FACE_KAPPA, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER};
 use crate::projection::{self, ParticleAccess};
 use crate::simd::Lane;
 use crate::systems::ProjectionCount;
@@ -220,6 +220,21 @@ fn delta_lambda<L: Lane>(c: L, lambda: L, alpha_tilde: L, w_grad_sq: L) -> (L, L
     (ok.vsel((-c - alpha_tilde * lambda) / safe, L::ZERO), ok)
 }
 
+/// [`crate::constraint::bounded_step`] on every lane: `dl` scaled down where a particle
+/// could move further than `max_step` (m), the farthest move per unit `dl` taken as
+/// `√(w_max · w_grad_sq)` (an upper bound of `maxₛ wₛ |gₛ|`, as the scalar kernel takes it).
+/// `limit = max_step² / w_max` is computed once per chunk, so only `dl` and `w_grad_sq` are
+/// read per projection. Lanes within the bound keep `dl` bit for bit.
+#[inline(always)]
+fn bounded_step<L: Lane>(dl: L, w_grad_sq: L, limit: L, max_step: L, w_max: L) -> L {
+    let over = (dl * dl * w_grad_sq).vgt(limit);
+    if over.vbits() == 0 {
+        return dl;
+    }
+    let s = max_step / over.vsel(w_max * w_grad_sq, L::ONE).vsqrt();
+    over.vsel(L::ZERO.vgt(dl).vsel(-s, s), dl)
+}
+
 /// `LANES` items of `s` from `at` (the caller keeps `at + LANES ≤ s.len()`).
 #[inline(always)]
 pub(crate) fn chunk<T>(s: &[T], at: usize) -> &[T; LANES] {
@@ -331,7 +346,9 @@ pub(crate) fn volumes<L: Lane, A: ParticleAccess>(
 /// compute. A chunk of four with a face not healthy by a margin of 2 at its start
 /// (`|b × c| ≤ 2κQ`, κ = [`VERTEX_FACE_KAPPA`]) goes to the scalar kernel (a pair of chunks
 /// with one, to this kernel chunk by chunk); a lane whose face turns thin (`|b × c| < κQ`)
-/// within the chunk skips that projection and counts it as degenerate.
+/// within the chunk skips that projection and counts it as degenerate. Every projection's
+/// `Δλ` is bounded as in the scalar kernel ([`crate::constraint::bounded_step`] with
+/// [`crate::constraint::vertex_face_step_bound`]), lane by lane.
 #[inline(always)]
 pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
     bd: &mut Bounded<'_, A, 4>,
@@ -374,6 +391,13 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
     // Per constraint k, the tetrahedra's heights and multipliers as lanes.
     let h: [L; 4] = transpose_rows(heights, at);
     let mut lam: [L; 4] = transpose_rows(lambdas, at);
+    // The move bound, as in `constraint::vertex_face_step_bound`: a fraction of max_k |d_k|
+    // (`√(d²) = |d|` exactly in IEEE arithmetic).
+    let size = h.iter().fold(L::ZERO, |m, &d| m.vmax(d * d)).vsqrt();
+    let max_step = L::splat(VERTEX_FACE_MAX_STEP) * size;
+    let w_max = w.iter().fold(L::ZERO, |m, &x| m.vmax(x));
+    // All four pinned (w_max = 0): the limit is infinite (or NaN), no lane is over.
+    let limit = max_step * max_step / w_max;
     let mut dp = [V3::<L>::ZERO; 4];
     let mut count = ProjectionCount::default();
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
@@ -399,7 +423,7 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
         let wo = [w[order[0]], w[order[1]], w[order[2]], w[order[3]]];
         let w_grad_sq = (0..4).fold(L::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
         let (dl, ok) = delta_lambda(na - h[k], lam[k], alpha, w_grad_sq);
-        let dl = valid.vsel(dl, L::ZERO);
+        let dl = bounded_step(valid.vsel(dl, L::ZERO), w_grad_sq, limit, max_step, w_max);
         let ok = ok & valid;
         lam[k] += dl;
         for s in 0..4 {

@@ -63,6 +63,8 @@ pub(crate) enum Outcome {
     Skipped,
 }
 
+/// One XPBD projection of `e`; no particle moves further than `max_step` (m; see
+/// [`constraint::bounded_step`], `f32::INFINITY` for no bound).
 #[inline(always)]
 fn apply<A: ParticleAccess, const N: usize>(
     a: &mut A,
@@ -70,15 +72,18 @@ fn apply<A: ParticleAccess, const N: usize>(
     e: &Evaluated<f32, N>,
     lambda: &mut f32,
     alpha_tilde: f32,
+    max_step: f32,
 ) -> bool {
     let w = idx.map(|i| a.w(i));
-    let w_grad_sq: f32 = w
+    let w_grad_sq = w
         .iter()
         .zip(&e.grad)
-        .map(|(w, g)| w * g.norm_squared())
-        .sum();
+        .fold(0.0f32, |s, (w, g)| s + w * g.norm_squared());
     match constraint::xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
         Some(dl) => {
+            // `w_max Σ wᵢ|∇ᵢC|² ≥ maxᵢ (wᵢ|∇ᵢC|)²`: the bound holds for every particle.
+            let w_max = w.iter().fold(0.0f32, |m, &x| m.max(x));
+            let dl = constraint::bounded_step(dl, w_max * w_grad_sq, max_step);
             *lambda += dl;
             for k in 0..N {
                 a.add(idx[k], e.grad[k] * (w[k] * dl));
@@ -125,7 +130,9 @@ pub(crate) fn edge<A: ParticleAccess>(
 /// degeneracy-aware form [`constraint::vertex_face_bounded`] with
 /// [`constraint::VERTEX_FACE_KAPPA`]. A face collapsed to a point falls back to holding
 /// `p1` at its rest value above `p0` along the face's rest normal (linear in `p0`, `p1`;
-/// re-expands a collapsed tetrahedron).
+/// re-expands a collapsed tetrahedron). No projection moves a particle further than
+/// [`constraint::vertex_face_step_bound`] of the tetrahedron's rest values (bounded
+/// corrections: [`constraint::bounded_step`]).
 #[inline(always)]
 pub(crate) fn vertex_face<A: ParticleAccess>(
     acc: &mut A,
@@ -149,6 +156,7 @@ pub(crate) fn vertex_face_held<A: ParticleAccess>(
     held: impl Fn(usize) -> bool,
 ) -> (u32, u32) {
     let (mut applied, mut degenerate) = (0, 0);
+    let max_step = constraint::vertex_face_step_bound(rest_heights);
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
         let idx = order.map(|o| tet[o] as usize);
         if !held(idx[1]) {
@@ -164,7 +172,7 @@ pub(crate) fn vertex_face_held<A: ParticleAccess>(
             constraint::VERTEX_FACE_KAPPA,
         ) {
             Some(e) => {
-                if apply(acc, idx, &e, &mut lambdas[k], alpha_tilde) {
+                if apply(acc, idx, &e, &mut lambdas[k], alpha_tilde, max_step) {
                     applied += 1;
                 }
             }
@@ -177,7 +185,7 @@ pub(crate) fn vertex_face_held<A: ParticleAccess>(
                     c: (p[1] - p[0]).dot(&n) - rest_heights[k],
                     grad: [-n, n, Vector3::zeros(), Vector3::zeros()],
                 };
-                apply(acc, idx, &e, &mut lambdas[k], alpha_tilde);
+                apply(acc, idx, &e, &mut lambdas[k], alpha_tilde, max_step);
             }
         }
     }
@@ -197,7 +205,7 @@ pub(crate) fn volume<A: ParticleAccess>(
     let idx = tet.map(|i| i as usize);
     let p = idx.map(|i| acc.x(i));
     let e = constraint::volume(&p[0], &p[1], &p[2], &p[3], rest_volume);
-    if apply(acc, idx, &e, lambda, alpha_tilde) {
+    if apply(acc, idx, &e, lambda, alpha_tilde, f32::INFINITY) {
         Outcome::Applied
     } else if idx.iter().any(|&i| acc.w(i) > 0.0) {
         Outcome::Degenerate

@@ -33,6 +33,8 @@ pub(crate) trait Lane:
     fn splat(x: f32) -> Self;
     /// Lane-wise square root.
     fn vsqrt(self) -> Self;
+    /// Lane-wise maximum (`maxps`: `o` where either lane is NaN).
+    fn vmax(self, o: Self) -> Self;
     /// Lane-wise `self > o` (mask).
     fn vgt(self, o: Self) -> Self;
     /// Lane-wise `self >= o` (mask).
@@ -86,6 +88,10 @@ impl Lane for f32x4 {
     #[inline(always)]
     fn vsqrt(self) -> Self {
         self.sqrt()
+    }
+    #[inline(always)]
+    fn vmax(self, o: Self) -> Self {
+        self.fast_max(o)
     }
     #[inline(always)]
     fn vgt(self, o: Self) -> Self {
@@ -171,6 +177,10 @@ impl Lane for X2 {
     #[inline(always)]
     fn vsqrt(self) -> Self {
         self.map(f32x4::sqrt)
+    }
+    #[inline(always)]
+    fn vmax(self, o: Self) -> Self {
+        self.zip(o, |a, b| a.fast_max(b))
     }
     #[inline(always)]
     fn vgt(self, o: Self) -> Self {
@@ -274,6 +284,11 @@ mod avx {
         fn vsqrt(self) -> Self {
             // SAFETY: AVX is available wherever a `Y8` is used (type docs).
             Y8(unsafe { _mm256_sqrt_ps(self.0) })
+        }
+        #[inline(always)]
+        fn vmax(self, o: Self) -> Self {
+            // SAFETY: AVX is available wherever a `Y8` is used (type docs).
+            Y8(unsafe { _mm256_max_ps(self.0, o.0) })
         }
         #[inline(always)]
         fn vgt(self, o: Self) -> Self {
