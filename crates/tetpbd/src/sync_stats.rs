@@ -1,6 +1,6 @@
 //! Diagnostic (feature `sync-stats`): time the threads of parallel sweeps spend waiting at
-//! phase boundaries ([`crate::schedule`]) and for a pass's last chunks when the pass closes
-//! ([`crate::team`]). Counted over all threads, process-wide; read and reset with [`take`].
+//! phase boundaries (the `schedule` module) and for a pass's last chunks when the pass closes
+//! (the `team` module). Counted over all threads, process-wide; read and reset with [`take`].
 //! The counting adds a clock read per wait that had to spin, so leave the feature off for
 //! timings.
 
