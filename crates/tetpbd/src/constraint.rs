@@ -47,12 +47,14 @@ pub fn xpbd_delta_lambda<T: RealField + Copy>(
 /// rest size `max_k |d_k|` (the largest of its four rest values, m; see
 /// [`vertex_face_step_bound`]). Dimensionless.
 ///
-/// 1: a projection moves no particle further than the tetrahedron's largest rest height (its
-/// largest rest value, smaller than that height on faces thin at rest). Corrections of a
-/// healthy scene are far below it and unchanged; it acts where a near-singular gradient
-/// would take a step of many body sizes (the hard sliver plate of the stability matrix).
-/// Measured in `docs/stability.md` against 0.5, 2 and 4.
-pub const VERTEX_FACE_MAX_STEP: f32 = 1.0;
+/// 2: a projection moves no particle further than twice the tetrahedron's largest rest
+/// height (its largest rest value, smaller than that height on faces thin at rest).
+/// Corrections of a healthy scene are far below it and unchanged; it acts where a
+/// near-singular gradient would take a step of many body sizes (the hard sliver plate of the
+/// stability matrix). 1 bounded the plate tighter but, together with the safety net's
+/// momentum restoration, left a scrambled vertex–face-only body tangled for good
+/// (`tests/recovery.rs`); measured in `docs/stability.md` against 0.5, 1 and 4.
+pub const VERTEX_FACE_MAX_STEP: f32 = 2.0;
 
 /// The move bound of one tetrahedron's vertex–face projections, m:
 /// [`VERTEX_FACE_MAX_STEP`] `· max_k |d_k|` over its four rest values `d_k` (m).
