@@ -54,11 +54,7 @@ fn run_parts(
         }
         let p = world.get::<&Particles>(e).unwrap();
         assert!(p.max_speed() > 0.01, "the body moves");
-        p.positions()
-            .iter()
-            .chain(p.velocities())
-            .map(|x| x.map(f32::to_bits).into())
-            .collect()
+        common::state_bits(&p)
     })
 }
 
@@ -121,11 +117,7 @@ fn run_free_mirrored(threads: usize) -> Vec<[u32; 3]> {
         }
         assert!(clamps > 0, "the net acts");
         let p = world.get::<&Particles>(e).unwrap();
-        p.positions()
-            .iter()
-            .chain(p.velocities())
-            .map(|x| x.map(f32::to_bits).into())
-            .collect()
+        common::state_bits(&p)
     })
 }
 

@@ -158,13 +158,7 @@ fn gentle(net: Option<f32>) -> (Vec<[u32; 3]>, u64) {
         clamps += solver.step(&mut world).unwrap().velocity_clamps;
     }
     let p = world.get::<&Particles>(e).unwrap();
-    let bits = p
-        .positions()
-        .iter()
-        .chain(p.velocities())
-        .map(|x| x.map(f32::to_bits).into())
-        .collect();
-    (bits, clamps)
+    (common::state_bits(&p), clamps)
 }
 
 #[test]

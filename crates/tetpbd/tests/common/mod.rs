@@ -57,3 +57,12 @@ pub fn hanging_cube_parts(world: &mut hecs::World, cells: u32, parts: usize) -> 
         .unwrap()
         .spawn(world)
 }
+
+/// Positions, then velocities, of a body as bits (for bit-identity comparisons).
+pub fn state_bits(p: &tetpbd::Particles) -> Vec<[u32; 3]> {
+    p.positions()
+        .iter()
+        .chain(p.velocities())
+        .map(|x| x.map(f32::to_bits).into())
+        .collect()
+}
