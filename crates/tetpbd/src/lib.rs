@@ -25,6 +25,8 @@
 //! ```
 #![warn(missing_docs)]
 
+#[cfg(feature = "parallel")]
+mod affinity;
 mod builder;
 pub mod constraint;
 mod error;

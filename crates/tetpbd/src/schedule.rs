@@ -246,8 +246,11 @@ pub(crate) fn run_phases<C: Default + AddAssign + Send>(
     let chunk = chunk.max(1).next_multiple_of(LANES);
     let regions: [Region; MAX_REGIONS] = Default::default();
     let total = Mutex::new(C::default());
+    #[cfg(feature = "sync-stats")]
+    let own = rayon::current_thread_index();
     let worker = || {
-        let home = rayon::current_thread_index().unwrap_or(0) % regions_n;
+        let index = rayon::current_thread_index();
+        let home = index.unwrap_or(0) % regions_n;
         let mut count = C::default();
         // Chunks of each region in the phases before the current one.
         let mut before = [0usize; MAX_REGIONS];
@@ -270,6 +273,8 @@ pub(crate) fn run_phases<C: Default + AddAssign + Send>(
                 }
                 count += work(k, cut.items(r, j));
                 regions[r].done.fetch_add(1, Ordering::Release);
+                #[cfg(feature = "sync-stats")]
+                crate::sync_stats::chunk(index != own);
             }
             for (r, b) in before.iter_mut().enumerate().take(regions_n) {
                 *b += cut.chunks(r);

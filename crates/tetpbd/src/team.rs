@@ -15,6 +15,10 @@
 //! job to come or its own job's chunks, and no cycle of waits can form (two steps run on the
 //! same pool each leave the other's helper loop within [`LINGER`]).
 //!
+//! A helper that finds itself on the core of the step's thread (the kernel often wakes it
+//! there) moves to another core for as long as it stays in the team ([`crate::affinity`]):
+//! two threads spinning on one core run no faster than one.
+//!
 //! Posting: the job (a closure on this thread's stack) is published with an odd epoch, and
 //! a helper registers in `active` before re-checking the epoch; closing makes the epoch even
 //! and waits for `active` to drain. With sequentially consistent orderings a helper either
@@ -25,6 +29,7 @@ use std::cell::{Cell, UnsafeCell};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
+use crate::affinity::{current_cpu, Moved};
 use crate::schedule::Backoff;
 
 /// How long a helper waits for the next job before it leaves the team.
@@ -45,6 +50,8 @@ struct Team {
     helpers: AtomicUsize,
     /// Set when the step is over.
     quit: AtomicBool,
+    /// The core the step's thread ran on at its last post (`usize::MAX`: not known).
+    step_cpu: AtomicUsize,
 }
 
 // SAFETY: `job` is written by the team's own thread only between jobs (epoch even, `active`
@@ -70,6 +77,7 @@ pub(crate) fn with_team<T>(f: impl FnOnce() -> T) -> T {
         active: AtomicUsize::new(0),
         helpers: AtomicUsize::new(0),
         quit: AtomicBool::new(false),
+        step_cpu: AtomicUsize::new(current_cpu().unwrap_or(usize::MAX)),
     };
     let mut step = OnThisThread(Some(f), None);
     let step_ref = &mut step;
@@ -140,6 +148,8 @@ fn help(team: &Team) {
     let mut seen = 0;
     let mut idle = Instant::now();
     let mut spins = 0u32;
+    let mut moved = Moved::default();
+    move_off_step(team, &mut moved);
     loop {
         let e = team.epoch.load(Ordering::SeqCst);
         if e % 2 == 1 && e != seen {
@@ -156,6 +166,7 @@ fn help(team: &Team) {
             team.active.fetch_sub(1, Ordering::SeqCst);
             seen = e;
             idle = Instant::now();
+            move_off_step(team, &mut moved);
             continue;
         }
         if team.quit.load(Ordering::SeqCst) {
@@ -166,12 +177,22 @@ fn help(team: &Team) {
             if idle.elapsed() > LINGER {
                 break;
             }
+            move_off_step(team, &mut moved);
             std::thread::yield_now();
         } else {
             std::hint::spin_loop();
         }
     }
     team.helpers.fetch_sub(1, Ordering::SeqCst);
+}
+
+/// Moves this helper off the step thread's core if it is on it (see [`crate::affinity`]).
+fn move_off_step(team: &Team, moved: &mut Moved) {
+    let Some(cpu) = current_cpu() else { return };
+    if team.step_cpu.load(Ordering::Relaxed) == cpu && moved.off(cpu) {
+        #[cfg(feature = "sync-stats")]
+        crate::sync_stats::moved();
+    }
 }
 
 /// Runs `worker` on this thread and on every helper of this thread's team; `false` (nothing
@@ -189,6 +210,9 @@ pub(crate) fn post(worker: &(dyn Fn() + Sync)) -> bool {
     let team = unsafe { &*team };
     if team.helpers.load(Ordering::SeqCst) == 0 {
         return false;
+    }
+    if let Some(cpu) = current_cpu() {
+        team.step_cpu.store(cpu, Ordering::Relaxed);
     }
     // SAFETY: only the lifetime is erased; the job is closed and every helper that may use
     // it has left it (`active` drained) before this function returns or unwinds (`Close`).

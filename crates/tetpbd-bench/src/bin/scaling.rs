@@ -2,7 +2,7 @@
 //! 1/60 s frame), for edges + volume and for vertex–face, on 1 and 2 threads.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown]
+//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown --per-frame]
 //! ```
 //!
 //! With `--features parallel` the 1-thread and the 2-thread runs are *interleaved*: two
@@ -33,6 +33,10 @@
 //! one) and, built with `--features sync-stats`, the median ms per frame the threads spent
 //! waiting at phase boundaries (summed over both threads) and for a pass's last chunks.
 //!
+//! `--per-frame` also prints every measured frame's ms on 1 and on 2 threads: the
+//! 2-thread column at 100k tetrahedra is bimodal on this machine (docs/performance.md), and
+//! its median alone hides how many frames ran at which speed.
+//!
 //! `--shuffle` numbers each grid's vertices and tetrahedra in a random order (as mesh files
 //! may); `--spatial-order` builds the bodies with the builder's particle renumbering on, off
 //! or both (default: the builder's default).
@@ -60,7 +64,7 @@ struct Body {
     /// ms per measured frame of prediction, copies, volume, vertex–face, edges, velocities.
     phases: [Vec<f64>; 6],
     /// ms per measured frame waiting at phase boundaries, and closing passes.
-    waits: [Vec<f64>; 2],
+    waits: [Vec<f64>; 4],
     /// Phases of a sweep of the edges and of the tetrahedra.
     sweep_phases: (usize, usize),
 }
@@ -130,15 +134,19 @@ impl Body {
     }
 }
 
-/// ms of phase waits and close waits since the last call (zeros without `sync-stats`).
-fn sync_take() -> [f64; 2] {
+/// ms of phase waits and close waits since the last call, the share of the sweeps' chunks
+/// that other threads than the stepping one ran, and how often a helper moved off the
+/// stepping thread's core (zeros without `sync-stats`).
+fn sync_take() -> [f64; 4] {
     #[cfg(feature = "sync-stats")]
     {
         let s = tetpbd::sync_stats::take();
-        [s.phase_wait, s.close_wait].map(|d| d.as_secs_f64() * 1e3)
+        let [p, c] = [s.phase_wait, s.close_wait].map(|d| d.as_secs_f64() * 1e3);
+        let share = s.chunks_elsewhere as f64 / s.chunks.max(1) as f64;
+        [p, c, share, s.moves as f64]
     }
     #[cfg(not(feature = "sync-stats"))]
-    [0.0; 2]
+    [0.0; 4]
 }
 
 fn phase_ms(s: &StepStats) -> [f64; 6] {
@@ -327,6 +335,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 mesh.tets.len(),
                 mesh.vertices.len()
             );
+            if flag("--per-frame") {
+                let two_times = two.as_ref().map_or(&[][..], |t| &t.times[..]);
+                let shares = two.as_ref().map_or(&[][..], |t| &t.waits[2][..]);
+                let moves = two.as_ref().map_or(&[][..], |t| &t.waits[3][..]);
+                for (i, a) in one.times.iter().enumerate() {
+                    let b = two_times
+                        .get(i)
+                        .map_or("-".to_string(), |b| format!("{b:.2}"));
+                    let share = match (shares.get(i), moves.get(i)) {
+                        (Some(s), Some(m)) if cfg!(feature = "sync-stats") => {
+                            format!(
+                                ", helpers ran {:.0} % of the chunks, moved {m} times",
+                                s * 100.0
+                            )
+                        }
+                        _ => String::new(),
+                    };
+                    println!("    frame {i:3}: 1 thread {a:.2} ms, 2 threads {b} ms{share}");
+                }
+            }
             if flag("--error") {
                 one.solver.settings.measure_error = true;
                 let s = one.solver.step(&mut one.world)?;
@@ -349,9 +377,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 for (threads, b) in [(1, Some(&one)), (2, two.as_ref())] {
                     let Some(b) = b else { continue };
                     let [pr, co, vo, vf, ed, ve] = b.phases.each_ref().map(|v| median(v));
-                    let [pw, cw] = b.waits.each_ref().map(|v| median(v));
+                    let [pw, cw, share, _] = b.waits.each_ref().map(|v| median(v));
                     let waits = if cfg!(feature = "sync-stats") {
-                        format!("  waits: phases {pw:.2} close {cw:.2}")
+                        format!(
+                            "  waits: phases {pw:.2} close {cw:.2}  helpers' chunks {:.0} %",
+                            share * 100.0
+                        )
                     } else {
                         String::new()
                     };
