@@ -52,7 +52,8 @@ pub struct ColourClasses {
     pub phases: Vec<u32>,
 }
 
-/// What one phase of a sweep is.
+/// What one phase of a sweep is (the parallel sweep's unit of work).
+#[cfg(feature = "parallel")]
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(crate) enum Phase {
     /// One class, alone in its task (its items may be split among threads when independent).
@@ -110,6 +111,7 @@ impl ColourClasses {
     }
 
     /// Phase `j` (`j < phase_count()`).
+    #[cfg(feature = "parallel")]
     pub(crate) fn phase(&self, j: usize) -> Phase {
         let tasks = self.phases[j] as usize..self.phases[j + 1] as usize;
         if tasks.len() == 1 && self.task(tasks.start).len() == 1 {
