@@ -36,6 +36,19 @@ impl Rng {
     }
 }
 
+/// One tetrahedron: the origin and the three unit points of the axes.
+pub fn unit_tet() -> TetMesh {
+    TetMesh {
+        vertices: vec![
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(0.0, 1.0, 0.0),
+            Vector3::new(0.0, 0.0, 1.0),
+        ],
+        tets: vec![[0, 1, 2, 3]],
+    }
+}
+
 /// A 1 m cube centred on the origin, of `cells³` cells split by `split`.
 pub fn cube(cells: u32, split: CellSplit) -> TetMesh {
     box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], split).unwrap()
