@@ -2,7 +2,7 @@
 
 mod coupling_common;
 
-use coupling_common::{particles, scene};
+use coupling_common::{particles, scene, spawn_with};
 use nalgebra::{Rotation3, Vector3};
 use rapier3d::math::{Pose, Rotation, Vector};
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
@@ -39,15 +39,8 @@ fn incline(mu: f32) -> (CoupledWorld, hecs::Entity, Vector3<f32>) {
     let body = SoftBodyBuilder::new(mesh)
         .density(1000.0)
         .edges(0.0)
-        .volume(0.0)
-        .build()
-        .expect("body");
-    let e = body.spawn(&mut s.soft);
-    let collider = SoftColliderBuilder::new()
-        .friction(mu)
-        .build()
-        .expect("collider");
-    s.soft.insert_one(e, collider).expect("entity");
+        .volume(0.0);
+    let e = spawn_with(&mut s, body, SoftColliderBuilder::new().friction(mu));
     (s, e, downhill)
 }
 

@@ -2,7 +2,7 @@
 
 mod coupling_common;
 
-use coupling_common::{ground, min_y, scene, soft_ball};
+use coupling_common::{ground, min_y, scene, soft_ball, spawn_with};
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
@@ -81,20 +81,13 @@ fn rigid_rebound(e: f32) -> f32 {
     let bottom: Vec<u32> = (0..mesh.vertices.len() as u32)
         .filter(|&i| mesh.vertices[i as usize].y < -0.1 + 1e-6)
         .collect();
-    let slab = tetpbd::SoftBodyBuilder::new(mesh)
+    let body = tetpbd::SoftBodyBuilder::new(mesh)
         .density(1000.0)
         .edges(0.0)
         .volume(0.0)
         .pinned(bottom)
-        .translation(Vector3::new(0.0, 0.1, 0.0))
-        .build()
-        .expect("slab")
-        .spawn(&mut s.soft);
-    let collider = SoftColliderBuilder::new()
-        .restitution(e)
-        .build()
-        .expect("collider");
-    s.soft.insert_one(slab, collider).expect("entity");
+        .translation(Vector3::new(0.0, 0.1, 0.0));
+    spawn_with(&mut s, body, SoftColliderBuilder::new().restitution(e));
     let r = 0.15;
     let rest = 0.2 + r + SoftCollider::DEFAULT_THICKNESS;
     let (ball, _) = s.physics.insert(

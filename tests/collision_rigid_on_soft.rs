@@ -4,7 +4,7 @@
 
 mod coupling_common;
 
-use coupling_common::{ground, min_y, particles, run, scene, volume_ratio};
+use coupling_common::{ground, min_y, particles, run, scene, spawn_with, volume_ratio};
 use nalgebra::Vector3;
 use rapier3d::math::{Pose, Rotation, Vector};
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyType, SharedShape};
@@ -30,16 +30,12 @@ fn slab(
         .density(1000.0)
         .edges(edges)
         .volume(volume)
-        .translation(Vector3::new(0.0, size.y / 2.0 + 0.0025, 0.0))
-        .build()
-        .expect("body");
-    let e = body.spawn(&mut s.soft);
-    let c = SoftColliderBuilder::new()
-        .triangle_collisions(triangles)
-        .build()
-        .expect("collider");
-    s.soft.insert_one(e, c).expect("entity");
-    e
+        .translation(Vector3::new(0.0, size.y / 2.0 + 0.0025, 0.0));
+    spawn_with(
+        s,
+        body,
+        SoftColliderBuilder::new().triangle_collisions(triangles),
+    )
 }
 
 /// A rigid ball dropped on a soft slab whose bottom is glued to the ground (so that ground
@@ -228,15 +224,12 @@ fn cone_drop(triangles: bool) -> f32 {
         .density(200.0)
         .edges(0.0)
         .volume(0.0)
-        .translation(Vector3::new(0.07, apex + 0.2 + 0.02, 0.13))
-        .build()
-        .expect("body");
-    let e = body.spawn(&mut s.soft);
-    let c = SoftColliderBuilder::new()
-        .triangle_collisions(triangles)
-        .build()
-        .expect("collider");
-    s.soft.insert_one(e, c).expect("entity");
+        .translation(Vector3::new(0.07, apex + 0.2 + 0.02, 0.13));
+    let e = spawn_with(
+        &mut s,
+        body,
+        SoftColliderBuilder::new().triangle_collisions(triangles),
+    );
     // How deep the apex gets inside the (still convex) cube during 0.5 s: its distance
     // behind the nearest boundary face plane, negative when outside.
     let tip = Vector3::new(0.0, apex, 0.0);

@@ -8,7 +8,7 @@ use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, ColliderHandle, RigidBodyBuilder, RigidBodyHandle};
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings, Tetrahedra};
-use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider};
+use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider, SoftColliderBuilder};
 
 /// Compliances of (edges, vertex–face, volume), `None` for a family the body does not have.
 pub type Families = (Option<f32>, Option<f32>, Option<f32>);
@@ -34,6 +34,18 @@ pub fn ground(scene: &mut CoupledWorld) -> (RigidBodyHandle, ColliderHandle) {
         RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
         ColliderBuilder::cuboid(5.0, 0.5, 5.0),
     )
+}
+
+/// Builds `body` into the scene's soft world with the soft collider `collider`.
+pub fn spawn_with(
+    scene: &mut CoupledWorld,
+    body: SoftBodyBuilder,
+    collider: SoftColliderBuilder,
+) -> Entity {
+    let e = body.build().expect("body").spawn(&mut scene.soft);
+    let collider = collider.build().expect("collider");
+    scene.soft.insert_one(e, collider).expect("entity");
+    e
 }
 
 /// A soft box of `size` (m) with `cells` cells per axis, centred at `at`, stiff edges and

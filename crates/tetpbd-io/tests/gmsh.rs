@@ -1,6 +1,9 @@
 //! Gmsh `.msh` 4.1 ASCII reader: round trips, a hand-written file in Gmsh's layout, and
 //! every error it reports.
 
+#[macro_use]
+mod common;
+
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::nalgebra::Vector3;
 use tetpbd_io::{read_msh_file, read_msh_str, write_msh, FileKind, ReadError};
@@ -22,16 +25,7 @@ fn file_round_trip_and_io_error() {
     assert_eq!(read_msh_file(&path).unwrap(), mesh);
     std::fs::remove_file(&path).unwrap();
     let err = read_msh_file(&path).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            ReadError::Io {
-                kind: FileKind::Msh,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::Io, kind: FileKind::Msh);
 }
 
 /// Two node blocks (one parametric, tags not contiguous), a triangle block that is skipped,
@@ -104,89 +98,23 @@ fn error(from: &str, to: &str, line: usize) -> ReadError {
 #[test]
 fn bad_numbers() {
     let err = error("1 0 0 1 0", "1 0 0 1e0x 0", 19);
-    assert!(
-        matches!(
-            err,
-            ReadError::BadNumber {
-                field: "parametric coordinate",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::BadNumber, field: "parametric coordinate");
     let err = error("0 0 1\n", "0 0 1y\n", 25);
-    assert!(
-        matches!(
-            err,
-            ReadError::BadNumber {
-                field: "z coordinate",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::BadNumber, field: "z coordinate");
     let err = error("2 20 30 40 50", "2 20 30 -40 50", 34);
-    assert!(
-        matches!(
-            err,
-            ReadError::BadNumber {
-                field: "node tag",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::BadNumber, field: "node tag");
     let err = error("4.1 0 8", "4.1 zero 8", 2);
-    assert!(
-        matches!(
-            err,
-            ReadError::BadNumber {
-                field: "file type",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::BadNumber, field: "file type");
 }
 
 #[test]
 fn wrong_field_counts() {
     let err = error("0 0 0 0.5 0.5", "0 0 0 0.5", 18);
-    assert!(
-        matches!(
-            err,
-            ReadError::FieldCount {
-                expected: 5,
-                found: 4,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::FieldCount, expected: 5, found: 4);
     let err = error("1 10 20 30 40", "1 10 20 30", 33);
-    assert!(
-        matches!(
-            err,
-            ReadError::FieldCount {
-                expected: 5,
-                found: 4,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::FieldCount, expected: 5, found: 4);
     let err = error("2 5 10 50", "2 5 10", 14);
-    assert!(
-        matches!(
-            err,
-            ReadError::FieldCount {
-                expected: 4,
-                found: 3,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::FieldCount, expected: 4, found: 3);
 }
 
 #[test]
@@ -199,7 +127,7 @@ fn unsupported_versions_binary_and_stray_text() {
     let err = error("4.1 0 8", "4.1 1 8", 2);
     assert!(err.to_string().contains("binary"), "{err}");
     let err = error("$PhysicalNames", "stray text\n$PhysicalNames", 4);
-    assert!(matches!(err, ReadError::Unsupported { .. }), "{err}");
+    assert_error!(err, ReadError::Unsupported);
     let err = error("$NodeData", "$Nodes\n$EndNodes\n$NodeData", 36);
     assert!(err.to_string().contains("second $Nodes"), "{err}");
     let err = error(
@@ -213,129 +141,49 @@ fn unsupported_versions_binary_and_stray_text() {
 #[test]
 fn unknown_and_duplicate_node_tags() {
     let err = error("2 20 30 40 50", "2 20 30 40 60", 34);
-    assert!(matches!(
-        err,
-        ReadError::IndexOutOfRange {
-            index: 60,
-            vertex_count: 5,
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::IndexOutOfRange, index: 60, vertex_count: 5);
     let err = error("40\n", "20\n", 22);
-    assert!(
-        matches!(err, ReadError::DuplicateTag { tag: 20, .. }),
-        "{err}"
-    );
+    assert_error!(err, ReadError::DuplicateTag, tag: 20);
 }
 
 #[test]
 fn fewer_rows_than_the_header_says() {
     let err = error("3 1 4 2", "3 1 4 3", 35);
-    assert!(
-        matches!(
-            err,
-            ReadError::MissingRows {
-                expected: 3,
-                found: 2,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::MissingRows, expected: 3, found: 2);
     assert!(
         err.to_string().contains("after 2 of 3 element rows"),
         "{err}"
     );
     let truncated = &GMSH_LIKE[..GMSH_LIKE.find("1 1 1\n$EndNodes").unwrap()];
     let err = read_msh_str(truncated).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            ReadError::MissingRows {
-                line: 25,
-                expected: 3,
-                found: 2,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::MissingRows, line: 25, expected: 3, found: 2);
 }
 
 #[test]
 fn more_rows_than_the_header_says() {
     let err = error("1 1 1\n", "1 1 1\n2 2 2\n", 27);
-    assert!(matches!(err, ReadError::ExtraRows { .. }), "{err}");
+    assert_error!(err, ReadError::ExtraRows);
 }
 
 #[test]
 fn header_total_disagrees_with_blocks() {
     let err = error("2 5 10 50", "2 6 10 50", 14);
-    assert!(matches!(
-        err,
-        ReadError::CountMismatch {
-            what: "nodes",
-            expected: 6,
-            found: 5,
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::CountMismatch, what: "nodes", expected: 6, found: 5);
     let err = error("2 3 1 3", "2 4 1 3", 29);
-    assert!(
-        matches!(
-            err,
-            ReadError::CountMismatch {
-                what: "elements",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::CountMismatch, what: "elements");
 }
 
 #[test]
 fn missing_sections() {
     let err = read_msh_str("").unwrap_err();
-    assert!(matches!(
-        err,
-        ReadError::MissingSection {
-            section: "$MeshFormat",
-            line: 0,
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::MissingSection, section: "$MeshFormat", line: 0);
     let no_elements = &GMSH_LIKE[..GMSH_LIKE.find("$Elements").unwrap()];
     let err = read_msh_str(no_elements).unwrap_err();
-    assert!(matches!(
-        err,
-        ReadError::MissingSection {
-            section: "$Elements",
-            line: 27,
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::MissingSection, section: "$Elements", line: 27);
     let err = error("$EndNodes", "$EndNode", 27);
-    assert!(
-        matches!(
-            err,
-            ReadError::MissingSection {
-                section: "$EndNodes",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::MissingSection, section: "$EndNodes");
     let err = error("$EndNodeData\n", "", 38);
-    assert!(matches!(err, ReadError::MissingSection { .. }), "{err}");
+    assert_error!(err, ReadError::MissingSection);
     let err = error("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n", "", 10);
-    assert!(
-        matches!(
-            err,
-            ReadError::MissingSection {
-                section: "$MeshFormat",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::MissingSection, section: "$MeshFormat");
 }

@@ -1,5 +1,8 @@
 //! Gmsh `.msh` 2.2 ASCII: round trip of a generated grid, Gmsh's element layout, errors.
 
+#[macro_use]
+mod common;
+
 use std::fmt::Write as _;
 
 use tetpbd::generators::{box_grid, CellSplit};
@@ -52,86 +55,19 @@ fn errors_name_the_line() {
     // Line 5 is the node count (36 nodes), 6..=41 the nodes, 42 $EndNodes, 43 $Elements,
     // 44 the element count, 45 the triangle, 46..=105 the 60 tetrahedra, 106 $EndElements.
     let err = error("\n36\n", "\n37\n", 42);
-    assert!(
-        matches!(
-            err,
-            ReadError::MissingRows {
-                expected: 37,
-                found: 36,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::MissingRows, expected: 37, found: 36);
     let err = error("\n20 ", "\n20 q", 7);
-    assert!(
-        matches!(
-            err,
-            ReadError::BadNumber {
-                field: "x coordinate",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::BadNumber, field: "x coordinate");
     let err = error("\n20 ", "\n10 ", 7);
-    assert!(
-        matches!(err, ReadError::DuplicateTag { tag: 10, .. }),
-        "{err}"
-    );
+    assert_error!(err, ReadError::DuplicateTag, tag: 10);
     let err = error("\n30 ", "\n30 1 ", 8);
-    assert!(
-        matches!(
-            err,
-            ReadError::FieldCount {
-                expected: 4,
-                found: 5,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::FieldCount, expected: 4, found: 5);
     let err = error("2 4 2 1 1 ", "2 4 3 1 1 ", 46);
-    assert!(
-        matches!(
-            err,
-            ReadError::FieldCount {
-                expected: 10,
-                found: 9,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::FieldCount, expected: 10, found: 9);
     let err = error("2 4 2 1 1 10 ", "2 4 2 1 1 15 ", 46);
-    assert!(matches!(
-        err,
-        ReadError::IndexOutOfRange {
-            index: 15,
-            vertex_count: 36,
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::IndexOutOfRange, index: 15, vertex_count: 36);
     let err = error("1 2 2 7 3", "1 2 x 7 3", 45);
-    assert!(
-        matches!(
-            err,
-            ReadError::BadNumber {
-                field: "number of tags",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::BadNumber, field: "number of tags");
     let err = error("$EndElements", "$EndElement", 106);
-    assert!(
-        matches!(
-            err,
-            ReadError::MissingSection {
-                section: "$EndElements",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::MissingSection, section: "$EndElements");
 }

@@ -1,5 +1,8 @@
 //! TetGen `.node`/`.ele` reader: round trips, accepted variants and every error it reports.
 
+#[macro_use]
+mod common;
+
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::nalgebra::Vector3;
 use tetpbd::TetMesh;
@@ -34,16 +37,7 @@ fn files_round_trip_and_missing_file_is_io_error() {
     let back = read_tetgen_files(dir.join("box.node"), dir.join("box.ele")).unwrap();
     assert_eq!(back, mesh);
     let err = read_tetgen_files(dir.join("box.node"), dir.join("absent.ele")).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            ReadError::Io {
-                kind: FileKind::Ele,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::Io, kind: FileKind::Ele);
     assert!(err.to_string().contains("absent.ele"), "{err}");
     assert_eq!(err.line(), None);
     std::fs::remove_dir_all(&dir).unwrap();
@@ -83,51 +77,19 @@ fn error(node: &str, ele: &str, line: usize) -> ReadError {
 #[test]
 fn bad_number_names_field_and_text() {
     let err = error("4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 x1 0\n3 0 0 1\n", ELE, 4);
-    assert!(matches!(
-        err,
-        ReadError::BadNumber {
-            kind: FileKind::Node,
-            field: "y coordinate",
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::BadNumber, kind: FileKind::Node, field: "y coordinate");
     assert_eq!(
         err.to_string(),
         ".node line 4: y coordinate is not a valid number: `x1`"
     );
     let err = error(NODE, "1 4 0\n0 0 1 2 nan\n", 2);
-    assert!(matches!(
-        err,
-        ReadError::BadNumber {
-            kind: FileKind::Ele,
-            field: "node number",
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::BadNumber, kind: FileKind::Ele, field: "node number");
     let err = error("4 3 0 0\n0 0 0 0\n1 1e999 0 0\n2 0 1 0\n3 0 0 1\n", ELE, 3);
-    assert!(
-        matches!(
-            err,
-            ReadError::BadNumber {
-                field: "x coordinate",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::BadNumber, field: "x coordinate");
     let err = error("4 3 0 0\n0 0 0 0\n1 inf 0 0\n2 0 1 0\n3 0 0 1\n", ELE, 3);
-    assert!(matches!(err, ReadError::BadNumber { .. }), "{err}");
+    assert_error!(err, ReadError::BadNumber);
     let err = error("-4 3 0 0\n", ELE, 1);
-    assert!(
-        matches!(
-            err,
-            ReadError::BadNumber {
-                field: "number of points",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::BadNumber, field: "number of points");
 }
 
 #[test]
@@ -137,36 +99,17 @@ fn wrong_field_count() {
         ELE,
         3,
     );
-    assert!(matches!(
-        err,
-        ReadError::FieldCount {
-            kind: FileKind::Node,
-            expected: 5,
-            found: 4,
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::FieldCount, kind: FileKind::Node, expected: 5, found: 4);
     let err = error(NODE, "1 4 1\n0 0 1 2 3\n", 2);
-    assert!(matches!(
-        err,
-        ReadError::FieldCount {
-            kind: FileKind::Ele,
-            expected: 6,
-            found: 5,
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::FieldCount, kind: FileKind::Ele, expected: 6, found: 5);
     let err = error("4 3 0 0 9\n", ELE, 1);
-    assert!(
-        matches!(err, ReadError::FieldCount { what: "header", .. }),
-        "{err}"
-    );
+    assert_error!(err, ReadError::FieldCount, what: "header");
 }
 
 #[test]
 fn unsupported_header_values() {
     let err = error("4 2 0 0\n", ELE, 1);
-    assert!(matches!(err, ReadError::Unsupported { .. }), "{err}");
+    assert_error!(err, ReadError::Unsupported);
     assert!(err.to_string().contains("dimension 2"), "{err}");
     let err = error("4 3 0 2\n", ELE, 1);
     assert!(err.to_string().contains("boundary marker flag 2"), "{err}");
@@ -179,36 +122,16 @@ fn unsupported_header_values() {
 #[test]
 fn rows_out_of_sequence() {
     let err = error("4 3 0 0\n1 0 0 0\n2 1 0 0\n4 0 1 0\n3 0 0 1\n", ELE, 4);
-    assert!(
-        matches!(
-            err,
-            ReadError::BadRowNumber {
-                expected: 3,
-                found: 4,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::BadRowNumber, expected: 3, found: 4);
 }
 
 #[test]
 fn index_out_of_range_respects_numbering() {
     let err = error(NODE, "1 4 0\n0 0 1 2 4\n", 2);
-    assert!(matches!(
-        err,
-        ReadError::IndexOutOfRange {
-            index: 4,
-            vertex_count: 4,
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::IndexOutOfRange, index: 4, vertex_count: 4);
     let one_based = "4 3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n";
     let err = error(one_based, "1 4 0\n1 0 1 2 3\n", 2);
-    assert!(
-        matches!(err, ReadError::IndexOutOfRange { index: 0, .. }),
-        "{err}"
-    );
+    assert_error!(err, ReadError::IndexOutOfRange, index: 0);
     assert_eq!(
         read_tetgen_str(one_based, "1\n1 1 2 3 4\n").unwrap().tets,
         vec![[0, 1, 2, 3]]
@@ -222,69 +145,25 @@ fn fewer_rows_than_the_header_says() {
         ELE,
         6,
     );
-    assert!(matches!(
-        err,
-        ReadError::MissingRows {
-            kind: FileKind::Node,
-            expected: 5,
-            found: 4,
-            ..
-        }
-    ));
+    assert_error!(err, ReadError::MissingRows, kind: FileKind::Node, expected: 5, found: 4);
     assert_eq!(
         err.to_string(),
         ".node line 6: input ends after 4 of 5 point rows"
     );
     let err = error(NODE, "2 4 0\n0 0 1 2 3\n", 2);
-    assert!(
-        matches!(
-            err,
-            ReadError::MissingRows {
-                kind: FileKind::Ele,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::MissingRows, kind: FileKind::Ele);
 }
 
 #[test]
 fn more_rows_than_the_header_says() {
     let err = error(NODE, "1 4 0\n0 0 1 2 3\n1 0 1 2 3\n", 3);
-    assert!(
-        matches!(
-            err,
-            ReadError::ExtraRows {
-                kind: FileKind::Ele,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::ExtraRows, kind: FileKind::Ele);
 }
 
 #[test]
 fn empty_file_misses_its_header() {
     let err = error("# only a comment\n", ELE, 1);
-    assert!(
-        matches!(
-            err,
-            ReadError::MissingSection {
-                kind: FileKind::Node,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::MissingSection, kind: FileKind::Node);
     let err = error(NODE, "", 0);
-    assert!(
-        matches!(
-            err,
-            ReadError::MissingSection {
-                kind: FileKind::Ele,
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert_error!(err, ReadError::MissingSection, kind: FileKind::Ele);
 }

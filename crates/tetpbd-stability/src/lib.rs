@@ -17,4 +17,4 @@ pub use cases::{all_cases, Case, CaseKind};
 pub use config::{Config, ConstraintSet};
 pub use coupled::{coupled_cases, CoupledCase, CoupledOutcome};
 pub use report::markdown;
-pub use run::{run_scene, Outcome, Scene, Start};
+pub use run::{run_scene, run_scene_observed, FrameView, Outcome, Scene, Start};

@@ -1,7 +1,7 @@
 //! Running one scene under one configuration and measuring it.
 
 use nalgebra::Vector3;
-use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, TetMesh, Tetrahedra};
+use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats, TetMesh, Tetrahedra};
 
 use crate::config::Config;
 
@@ -126,8 +126,30 @@ fn hash_unit(mut s: u64) -> f32 {
     (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
 }
 
+/// What [`run_scene_observed`] shows its observer after each frame.
+pub struct FrameView<'a> {
+    /// The frame just stepped, from 1.
+    pub frame: usize,
+    /// The solver's statistics of that frame (errors measured).
+    pub stats: &'a StepStats,
+    /// The body's particles after it.
+    pub particles: &'a Particles,
+    /// The reference energy the outcome's kinetic energy ratios are taken against, J.
+    pub reference: f32,
+}
+
 /// Runs `scene` under `config`.
 pub fn run_scene(scene: &Scene, config: &Config) -> Outcome {
+    run_scene_observed(scene, config, |_| {})
+}
+
+/// [`run_scene`], calling `observe` after every frame it steps: how a diagnostic traces a
+/// run frame by frame. The outcome is the same as [`run_scene`]'s.
+pub fn run_scene_observed(
+    scene: &Scene,
+    config: &Config,
+    mut observe: impl FnMut(&FrameView<'_>),
+) -> Outcome {
     let mut out = Outcome {
         finite: true,
         require_recovery: scene.require_recovery,
@@ -224,6 +246,12 @@ pub fn run_scene(scene: &Scene, config: &Config) -> Outcome {
             max(&stats.volume),
         ];
         out.final_max_speed = p.max_speed();
+        observe(&FrameView {
+            frame,
+            stats: &stats,
+            particles: &p,
+            reference,
+        });
     }
     out.peak_ke_ratio = peak / reference;
     out.final_ke_ratio = world

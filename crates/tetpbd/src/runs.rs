@@ -200,15 +200,36 @@ dispatched!(
     (tets: &[[u32; 4]], heights: &[[f32; 4]], lambdas: &mut [[f32; 4]])
 );
 
-#[cfg(all(test, target_arch = "x86_64"))]
+#[cfg(test)]
 mod tests {
+    use std::ops::Range;
+
     use nalgebra::Vector3;
 
     use super::*;
     use crate::generators::{box_grid, CellSplit};
     use crate::work::{self, Slot, WorkAccess};
-    use crate::SoftBodyBuilder;
+    use crate::{SoftBody, SoftBodyBuilder};
 
+    /// A 1 m cube of `cells³` cells with all three families (edges 1e-6, volume 1e-9,
+    /// vertex–face 1e-6), each particle moved from `x` to `f(i, x)`, loaded into its work
+    /// slots.
+    fn deformed(cells: u32, f: impl Fn(usize, Vector3<f32>) -> Vector3<f32>) -> SoftBody {
+        let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Six).unwrap();
+        let mut body = SoftBodyBuilder::new(mesh)
+            .edges(1e-6)
+            .volume(1e-9)
+            .vertex_face(1e-6)
+            .build()
+            .unwrap();
+        for (i, x) in body.particles.positions.iter_mut().enumerate() {
+            *x = f(i, *x);
+        }
+        work::load(&mut body.particles);
+        body
+    }
+
+    /// Every slot's position, inverse mass and rounding residual, as bits.
     fn bits(slots: &[Slot]) -> Vec<[u32; 8]> {
         slots
             .iter()
@@ -220,99 +241,128 @@ mod tests {
             .collect()
     }
 
+    /// How [`sweep`] runs the colour classes (all with the SIMD kernel).
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    enum Runs {
+        /// Each class as one run of the SSE2 build.
+        #[cfg(target_arch = "x86_64")]
+        Sse2,
+        /// Each independent class as one run of the AVX2 + FMA build, the others as `Sse2`.
+        #[cfg(target_arch = "x86_64")]
+        Avx2,
+        /// Each class as one run through the dispatching `*_run`.
+        Dispatched,
+        /// Each class as runs of [`lanes::LANES`] items from its start (one chunk each),
+        /// through the dispatching `*_run`.
+        ChunksOfFour,
+    }
+
+    /// One run of the `edge`, `volume` or `vertex_face` family as `runs` says, on `$arg`s,
+    /// α̃ = 1e-3, the SIMD kernel.
+    macro_rules! run {
+        (edge, $($t:tt)*) => { run!(@ edge_run, edge_run_avx2, edge_run_base, $($t)*) };
+        (volume, $($t:tt)*) => { run!(@ volume_run, volume_run_avx2, volume_run_base, $($t)*) };
+        (vertex_face, $($t:tt)*) => {
+            run!(@ vertex_face_run, vertex_face_run_avx2, vertex_face_run_base, $($t)*)
+        };
+        (@ $name:ident, $fast:ident, $base:ident, $runs:expr, $ind:expr, $($arg:expr),*) => {
+            match $runs {
+                // SAFETY: `sweep` checked `avx2()`.
+                #[cfg(target_arch = "x86_64")]
+                Runs::Avx2 if $ind => unsafe { $fast($($arg,)* 1e-3) },
+                Runs::Dispatched | Runs::ChunksOfFour => $name($($arg,)* 1e-3, Kernel::Simd, $ind),
+                #[cfg(target_arch = "x86_64")]
+                Runs::Sse2 | Runs::Avx2 => $base::<X2, _>($($arg,)* 1e-3, Kernel::Simd, $ind),
+            }
+        };
+    }
+
+    /// One sweep of each family of `body` (edges, then each tetrahedron class's volume and
+    /// vertex–face constraints) from its work slots and zero multipliers, α̃ = 1e-3: the
+    /// slots and the multipliers after it as bits, and what it counted.
+    fn sweep(body: &SoftBody, runs: Runs) -> (Vec<[u32; 8]>, Vec<u32>, ProjectionCount) {
+        #[cfg(target_arch = "x86_64")]
+        assert!(runs != Runs::Avx2 || avx2(), "no AVX2 + FMA on this CPU");
+        let (tets, p) = (&body.tetrahedra, &body.particles);
+        let (e, vf) = (
+            body.edges.as_ref().unwrap(),
+            body.vertex_face.as_ref().unwrap(),
+        );
+        let mut slots = p.work.0.clone();
+        let mut acc = WorkAccess {
+            slots: &mut slots,
+            rest: &p.rest_positions,
+        };
+        let mut lam_e = vec![0.0; e.edges.len()];
+        let mut lam_v = vec![0.0; tets.len()];
+        let mut lam_f = vec![[0.0; 4]; tets.len()];
+        let mut count = ProjectionCount::default();
+        let parts = |r: Range<usize>| {
+            let step = if runs == Runs::ChunksOfFour {
+                lanes::LANES
+            } else {
+                r.len().max(1)
+            };
+            (r.start..r.end)
+                .step_by(step)
+                .map(move |s| s..(s + step).min(r.end))
+        };
+        for (r, ind) in e.classes.ranges() {
+            for q in parts(r) {
+                let (x, d, l) = (
+                    &e.edges[q.clone()],
+                    &e.rest_lengths[q.clone()],
+                    &mut lam_e[q],
+                );
+                count += run!(edge, runs, ind, &mut acc, x, d, l);
+            }
+        }
+        for (r, ind) in tets.classes.ranges() {
+            let t = |q: &Range<usize>| &tets.indices[q.clone()];
+            for q in parts(r.clone()) {
+                let (v, l) = (&tets.rest_volumes[q.clone()], &mut lam_v[q.clone()]);
+                count += run!(volume, runs, ind, &mut acc, t(&q), v, l);
+            }
+            for q in parts(r) {
+                let (h, l) = (&vf.rest_heights[q.clone()], &mut lam_f[q.clone()]);
+                count += run!(vertex_face, runs, ind, &mut acc, t(&q), h, l);
+            }
+        }
+        let lam: Vec<u32> = lam_e
+            .iter()
+            .chain(&lam_v)
+            .chain(lam_f.iter().flatten())
+            .map(|x| x.to_bits())
+            .collect();
+        (bits(&slots), lam, count)
+    }
+
     /// The AVX2 + FMA build of the kernels moves every particle and multiplier exactly as
     /// the SSE2 build does (one sweep of each family on a deformed body).
+    #[cfg(target_arch = "x86_64")]
     #[test]
     fn avx2_build_is_bit_identical_to_sse2() {
         if !avx2() {
             eprintln!("no AVX2 + FMA on this CPU: only the SSE2 build runs here");
             return;
         }
-        let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [4; 3], CellSplit::Six).unwrap();
-        let mut body = SoftBodyBuilder::new(mesh)
-            .edges(1e-6)
-            .volume(1e-9)
-            .vertex_face(1e-6)
-            .build()
-            .unwrap();
-        for x in &mut body.particles.positions {
-            *x = Vector3::new(
+        let body = deformed(4, |_, x| {
+            Vector3::new(
                 x.x + 0.1 * x.y,
                 0.7 * x.y + 0.02 * x.z * x.x,
                 x.z - 0.05 * x.x,
-            );
-        }
-        work::load(&mut body.particles);
-        let (tets, p) = (&body.tetrahedra, &body.particles);
-        let (e, vf) = (
-            body.edges.as_ref().unwrap(),
-            body.vertex_face.as_ref().unwrap(),
+            )
+        });
+        let (sse2, avx2) = (sweep(&body, Runs::Sse2), sweep(&body, Runs::Avx2));
+        assert!(
+            sse2.0 != bits(&body.particles.work.0),
+            "the sweep moves particles"
         );
-        let sweep = |fast: bool| {
-            let mut slots = p.work.0.clone();
-            let mut acc = WorkAccess {
-                slots: &mut slots,
-                rest: &p.rest_positions,
-            };
-            let mut lam_e = vec![0.0; e.edges.len()];
-            let mut lam_v = vec![0.0; tets.len()];
-            let mut lam_f = vec![[0.0; 4]; tets.len()];
-            let at = 1e-3;
-            for (r, ind) in e.classes.ranges() {
-                let (x, d, l) = (
-                    &e.edges[r.clone()],
-                    &e.rest_lengths[r.clone()],
-                    &mut lam_e[r],
-                );
-                if fast && ind {
-                    // SAFETY: `avx2()` checked above.
-                    unsafe { edge_run_avx2(&mut acc, x, d, l, at) };
-                } else {
-                    edge_run_base::<X2, _>(&mut acc, x, d, l, at, Kernel::Simd, ind);
-                }
-            }
-            for (r, ind) in tets.classes.ranges() {
-                let (t, v, l) = (
-                    &tets.indices[r.clone()],
-                    &tets.rest_volumes[r.clone()],
-                    &mut lam_v[r.clone()],
-                );
-                if fast && ind {
-                    // SAFETY: `avx2()` checked above.
-                    unsafe { volume_run_avx2(&mut acc, t, v, l, at) };
-                } else {
-                    volume_run_base::<X2, _>(&mut acc, t, v, l, at, Kernel::Simd, ind);
-                }
-                let (h, l) = (&vf.rest_heights[r.clone()], &mut lam_f[r]);
-                if fast && ind {
-                    // SAFETY: `avx2()` checked above.
-                    unsafe { vertex_face_run_avx2(&mut acc, t, h, l, at) };
-                } else {
-                    vertex_face_run_base::<X2, _>(&mut acc, t, h, l, at, Kernel::Simd, ind);
-                }
-            }
-            let lam: Vec<u32> = lam_e
-                .iter()
-                .chain(&lam_v)
-                .chain(lam_f.iter().flatten())
-                .map(|x| x.to_bits())
-                .collect();
-            (bits(&slots), lam)
-        };
-        let (sse2, avx2) = (sweep(false), sweep(true));
-        assert!(sse2.0 != bits(&p.work.0), "the sweep moves particles");
-        assert!(sse2 == avx2, "the AVX2 build differs from the SSE2 build");
+        assert!(
+            (&sse2.0, &sse2.1) == (&avx2.0, &avx2.1),
+            "the AVX2 build differs from the SSE2 build"
+        );
     }
-}
-
-#[cfg(test)]
-mod pair_tests {
-    use nalgebra::Vector3;
-
-    use super::*;
-    use crate::generators::{box_grid, CellSplit};
-    use crate::work::{self, WorkAccess};
-    use crate::SoftBodyBuilder;
 
     /// Pairs of chunks move every particle and multiplier exactly as chunks of four alone
     /// do: each colour class swept as one run (pairs of chunks, then a chunk, then the scalar
@@ -323,74 +373,14 @@ mod pair_tests {
     #[test]
     fn pairs_are_bit_identical_to_chunks_of_four() {
         for squash in [0.7, 0.002] {
-            let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [5; 3], CellSplit::Six).unwrap();
-            let mut body = SoftBodyBuilder::new(mesh)
-                .edges(1e-6)
-                .volume(1e-9)
-                .vertex_face(1e-6)
-                .build()
-                .unwrap();
-            for (i, x) in body.particles.positions.iter_mut().enumerate() {
+            let body = deformed(5, |i, x| {
                 let jitter = ((i * 7919) % 13) as f32 * 3e-5;
-                *x = Vector3::new(x.x + 0.1 * x.y, squash * x.y + jitter, x.z - 0.05 * x.x);
-            }
-            work::load(&mut body.particles);
-            let (tets, p) = (&body.tetrahedra, &body.particles);
-            let (e, vf) = (
-                body.edges.as_ref().unwrap(),
-                body.vertex_face.as_ref().unwrap(),
+                Vector3::new(x.x + 0.1 * x.y, squash * x.y + jitter, x.z - 0.05 * x.x)
+            });
+            let (pairs, chunks) = (
+                sweep(&body, Runs::Dispatched),
+                sweep(&body, Runs::ChunksOfFour),
             );
-            let sweep = |split: bool| {
-                let mut slots = p.work.0.clone();
-                let mut acc = WorkAccess {
-                    slots: &mut slots,
-                    rest: &p.rest_positions,
-                };
-                let mut lam_e = vec![0.0; e.edges.len()];
-                let mut lam_v = vec![0.0; tets.len()];
-                let mut lam_f = vec![[0.0; 4]; tets.len()];
-                let mut count = ProjectionCount::default();
-                let at = 1e-3;
-                let parts = |r: std::ops::Range<usize>| {
-                    let step = if split { lanes::LANES } else { r.len().max(1) };
-                    (r.start..r.end)
-                        .step_by(step)
-                        .map(move |s| s..(s + step).min(r.end))
-                };
-                let k = Kernel::Simd;
-                for (r, ind) in e.classes.ranges() {
-                    for q in parts(r) {
-                        let (x, d) = (&e.edges[q.clone()], &e.rest_lengths[q.clone()]);
-                        count += edge_run(&mut acc, x, d, &mut lam_e[q], at, k, ind);
-                    }
-                }
-                for (r, ind) in tets.classes.ranges() {
-                    for q in parts(r.clone()) {
-                        let (t, v) = (&tets.indices[q.clone()], &tets.rest_volumes[q.clone()]);
-                        count += volume_run(&mut acc, t, v, &mut lam_v[q], at, k, ind);
-                    }
-                    for q in parts(r) {
-                        let (t, h) = (&tets.indices[q.clone()], &vf.rest_heights[q.clone()]);
-                        count += vertex_face_run(&mut acc, t, h, &mut lam_f[q], at, k, ind);
-                    }
-                }
-                let lam: Vec<u32> = lam_e
-                    .iter()
-                    .chain(&lam_v)
-                    .chain(lam_f.iter().flatten())
-                    .map(|x| x.to_bits())
-                    .collect();
-                let bits: Vec<[u32; 8]> = slots
-                    .iter()
-                    .map(|s| {
-                        let [a, b, c, d] = s.xw.to_array();
-                        let [e, f, g, h] = s.r.to_array();
-                        [a, b, c, d, e, f, g, h].map(f32::to_bits)
-                    })
-                    .collect();
-                (bits, lam, count)
-            };
-            let (pairs, chunks) = (sweep(false), sweep(true));
             assert!(
                 pairs == chunks,
                 "pairs differ from chunks (squash {squash})"

@@ -1,23 +1,14 @@
 //! Every bad input returns its typed error, naming what is wrong.
 
+mod common;
+
+use common::unit_tet;
 use nalgebra::Vector3;
 use tetpbd::generators::{ball, box_grid, CellSplit};
 use tetpbd::{
     BuildError, ExternalAcceleration, Particles, SettingsError, SoftBodyBuilder, Solver,
     SolverSettings, StateError, TetMesh,
 };
-
-fn tet() -> TetMesh {
-    TetMesh {
-        vertices: vec![
-            Vector3::new(0.0, 0.0, 0.0),
-            Vector3::new(1.0, 0.0, 0.0),
-            Vector3::new(0.0, 1.0, 0.0),
-            Vector3::new(0.0, 0.0, 1.0),
-        ],
-        tets: vec![[0, 1, 2, 3]],
-    }
-}
 
 fn err(b: SoftBodyBuilder) -> BuildError {
     b.build().expect_err("must be rejected")
@@ -29,19 +20,19 @@ fn builder_rejects_bad_meshes() {
         err(SoftBodyBuilder::new(TetMesh::default())),
         BuildError::NoVertices
     );
-    let mut m = tet();
+    let mut m = unit_tet();
     m.vertices[2].y = f32::NAN;
     assert_eq!(
         err(SoftBodyBuilder::new(m)),
         BuildError::NonFiniteVertex { vertex: 2 }
     );
-    let mut m = tet();
+    let mut m = unit_tet();
     m.vertices[3].z = f32::INFINITY;
     assert_eq!(
         err(SoftBodyBuilder::new(m)),
         BuildError::NonFiniteVertex { vertex: 3 }
     );
-    let mut m = tet();
+    let mut m = unit_tet();
     m.tets.push([0, 1, 2, 7]);
     assert_eq!(
         err(SoftBodyBuilder::new(m)),
@@ -51,19 +42,19 @@ fn builder_rejects_bad_meshes() {
             vertex_count: 4
         }
     );
-    let mut m = tet();
+    let mut m = unit_tet();
     m.tets[0] = [0, 1, 1, 3];
     assert_eq!(
         err(SoftBodyBuilder::new(m)),
         BuildError::RepeatedVertex { tet: 0, index: 1 }
     );
-    let mut m = tet();
+    let mut m = unit_tet();
     m.vertices[3] = Vector3::new(0.5, 0.5, 0.0); // coplanar
     assert!(matches!(
         err(SoftBodyBuilder::new(m)),
         BuildError::DegenerateTetrahedron { tet: 0, .. }
     ));
-    let mut m = tet();
+    let mut m = unit_tet();
     m.vertices.push(Vector3::new(5.0, 5.0, 5.0));
     assert_eq!(
         err(SoftBodyBuilder::new(m)),
@@ -71,7 +62,7 @@ fn builder_rejects_bad_meshes() {
     );
     // A non-finite translation is caught on the translated vertices.
     assert_eq!(
-        err(SoftBodyBuilder::new(tet()).translation(Vector3::new(0.0, f32::NAN, 0.0))),
+        err(SoftBodyBuilder::new(unit_tet()).translation(Vector3::new(0.0, f32::NAN, 0.0))),
         BuildError::NonFiniteVertex { vertex: 0 }
     );
 }
@@ -79,23 +70,23 @@ fn builder_rejects_bad_meshes() {
 #[test]
 fn builder_rejects_bad_parameters() {
     for d in [0.0, -1.0, f32::NAN, f32::INFINITY] {
-        let e = err(SoftBodyBuilder::new(tet()).density(d));
+        let e = err(SoftBodyBuilder::new(unit_tet()).density(d));
         assert!(matches!(e, BuildError::BadDensity { .. }), "{d}: {e:?}");
     }
     for a in [-1e-9, f32::NAN, f32::INFINITY] {
         assert!(matches!(
-            err(SoftBodyBuilder::new(tet()).edges(a)),
+            err(SoftBodyBuilder::new(unit_tet()).edges(a)),
             BuildError::BadCompliance { family: "edge", .. }
         ));
         assert!(matches!(
-            err(SoftBodyBuilder::new(tet()).vertex_face(a)),
+            err(SoftBodyBuilder::new(unit_tet()).vertex_face(a)),
             BuildError::BadCompliance {
                 family: "vertex-face",
                 ..
             }
         ));
         assert!(matches!(
-            err(SoftBodyBuilder::new(tet()).volume(a)),
+            err(SoftBodyBuilder::new(unit_tet()).volume(a)),
             BuildError::BadCompliance {
                 family: "volume",
                 ..
@@ -103,31 +94,31 @@ fn builder_rejects_bad_parameters() {
         ));
     }
     assert_eq!(
-        err(SoftBodyBuilder::new(tet()).pinned([9])),
+        err(SoftBodyBuilder::new(unit_tet()).pinned([9])),
         BuildError::PinnedOutOfRange {
             index: 9,
             vertex_count: 4
         }
     );
     assert_eq!(
-        err(SoftBodyBuilder::new(tet()).velocity(Vector3::new(f32::NAN, 0.0, 0.0))),
+        err(SoftBodyBuilder::new(unit_tet()).velocity(Vector3::new(f32::NAN, 0.0, 0.0))),
         BuildError::NonFiniteVelocity
     );
     assert!(matches!(
-        err(SoftBodyBuilder::new(tet()).volume_epsilon(-1.0)),
+        err(SoftBodyBuilder::new(unit_tet()).volume_epsilon(-1.0)),
         BuildError::BadEpsilon { .. }
     ));
     assert!(box_grid(Vector3::new(1.0, 0.0, 1.0), [1, 1, 1], CellSplit::Six).is_err());
     assert!(box_grid(Vector3::new(1.0, 1.0, 1.0), [1, 0, 1], CellSplit::Six).is_err());
     assert!(ball(f32::NAN, 2, CellSplit::Six).is_err());
     // Messages name the value.
-    let msg = err(SoftBodyBuilder::new(tet()).density(-3.0)).to_string();
+    let msg = err(SoftBodyBuilder::new(unit_tet()).density(-3.0)).to_string();
     assert!(msg.contains("-3"), "{msg}");
 }
 
 #[test]
 fn either_orientation_is_accepted() {
-    let mut m = tet();
+    let mut m = unit_tet();
     m.tets[0] = [0, 2, 1, 3]; // negative orientation
     let b = SoftBodyBuilder::new(m)
         .vertex_face(0.0)
@@ -180,7 +171,7 @@ fn solver_rejects_bad_settings() {
     );
     // Settings changed after construction are checked by every step, before any state moves.
     let mut world = hecs::World::new();
-    let e = SoftBodyBuilder::new(tet())
+    let e = SoftBodyBuilder::new(unit_tet())
         .edges(0.0)
         .build()
         .unwrap()
@@ -197,7 +188,7 @@ fn solver_rejects_bad_settings() {
 
 #[test]
 fn state_writes_reject_bad_values() {
-    let mut p = SoftBodyBuilder::new(tet()).build().unwrap().particles;
+    let mut p = SoftBodyBuilder::new(unit_tet()).build().unwrap().particles;
     assert_eq!(
         p.set_position(4, Vector3::zeros()),
         Err(StateError::ParticleOutOfRange { index: 4, len: 4 })
@@ -218,7 +209,7 @@ fn state_writes_reject_bad_values() {
     );
     assert!(p.set_pinned(10, true).is_err());
     assert!(ExternalAcceleration::new(Vector3::new(0.0, f32::NAN, 0.0)).is_err());
-    let mut e = SoftBodyBuilder::new(tet())
+    let mut e = SoftBodyBuilder::new(unit_tet())
         .edges(0.0)
         .build()
         .unwrap()

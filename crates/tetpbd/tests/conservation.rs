@@ -106,12 +106,7 @@ fn collapsed_body_stays_finite_and_reexpands() {
         .build()
         .unwrap()
         .spawn(&mut world);
-    {
-        let mut p = world.get::<&mut Particles>(e).unwrap();
-        for i in 0..p.len() {
-            p.set_position(i, Vector3::new(0.1, 0.2, 0.3)).unwrap();
-        }
-    }
+    common::deform_with(&mut world, e, |_, _| Vector3::new(0.1, 0.2, 0.3));
     let mut solver = Solver::new(SolverSettings {
         gravity: Vector3::zeros(),
         measure_error: true,

@@ -1,16 +1,16 @@
 //! The SIMD kernels agree with the scalar reference kernels.
 
+mod common;
+
 use nalgebra::Vector3;
-use tetpbd::generators::{box_grid, CellSplit};
+use tetpbd::generators::CellSplit;
 use tetpbd::systems::Kernel;
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats};
 
 fn run(kernel: Kernel, set: &str, deformed: bool, frames: usize) -> (Vec<Vector3<f32>>, StepStats) {
     let mut world = hecs::World::new();
-    let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [5, 5, 5], CellSplit::Six).unwrap();
-    let top: Vec<u32> = (0..mesh.vertices.len() as u32)
-        .filter(|&i| mesh.vertices[i as usize].y > 0.49)
-        .collect();
+    let mesh = common::cube(5, CellSplit::Six);
+    let top = common::top(&mesh);
     let b = SoftBodyBuilder::new(mesh).pinned(top);
     let b = match set {
         "edges+volume" => b.edges(1e-6).volume(0.0),
@@ -18,16 +18,7 @@ fn run(kernel: Kernel, set: &str, deformed: bool, frames: usize) -> (Vec<Vector3
     };
     let e = b.build().unwrap().spawn(&mut world);
     if deformed {
-        let mut p = world.get::<&mut Particles>(e).unwrap();
-        for i in 0..p.len() {
-            let x = p.positions()[i];
-            // Sheared and squashed to 60 %: large corrections, no inversion.
-            p.set_position(
-                i,
-                Vector3::new(x.x + 0.1 * x.y, 0.6 * x.y, x.z - 0.05 * x.x),
-            )
-            .unwrap();
-        }
+        common::deform(&mut world, e, common::Deformation::Sheared);
     }
     let mut solver = Solver::new(SolverSettings {
         kernel,

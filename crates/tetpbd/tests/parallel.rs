@@ -17,6 +17,15 @@ impl SubstepHook for Slow {
     }
 }
 
+/// Runs `f` on a pool of `threads` threads.
+fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
 /// Positions and velocities, as bits, after `frames` frames of a hanging cube of `cells³`
 /// cells on a pool of `threads` threads, with or without the slow hook.
 fn run(threads: usize, cells: u32, substeps: u32, frames: usize, slow: bool) -> Vec<[u32; 3]> {
@@ -32,11 +41,7 @@ fn run_parts(
     frames: usize,
     slow: bool,
 ) -> Vec<[u32; 3]> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| {
+    on_threads(threads, || {
         let mut world = hecs::World::new();
         let e = common::hanging_cube_parts(&mut world, cells, parts);
         let mut solver = Solver::new(SolverSettings {
@@ -83,28 +88,16 @@ fn large_body_agrees_bit_for_bit_with_and_without_a_slow_hook() {
 /// safety net at 5 m/s on a pool of `threads` threads: the net clamps, and gives the
 /// linear momentum back, every substep.
 fn run_free_mirrored(threads: usize) -> Vec<[u32; 3]> {
-    use nalgebra::Vector3;
-    use tetpbd::generators::{box_grid, CellSplit};
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| {
+    use tetpbd::generators::CellSplit;
+    on_threads(threads, || {
         let mut world = hecs::World::new();
-        let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [16; 3], CellSplit::Six).unwrap();
-        let e = tetpbd::SoftBodyBuilder::new(mesh)
+        let e = tetpbd::SoftBodyBuilder::new(common::cube(16, CellSplit::Six))
             .edges(0.0)
             .volume(0.0)
             .build()
             .unwrap()
             .spawn(&mut world);
-        {
-            let mut p = world.get::<&mut Particles>(e).unwrap();
-            for i in 0..p.len() {
-                let x = p.positions()[i];
-                p.set_position(i, Vector3::new(-x.x, x.y, x.z)).unwrap();
-            }
-        }
+        common::deform(&mut world, e, common::Deformation::Mirrored);
         let mut solver = Solver::new(SolverSettings {
             substeps: 3,
             max_correction_speed: Some(5.0),

@@ -2,23 +2,11 @@
 
 mod common;
 
-use common::Rng;
+use common::{unit_tet, Rng};
 use hecs::World;
 use nalgebra::Vector3;
 use tetpbd::constraint::{apply, edge, vertex_face, volume};
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, TetMesh};
-
-fn single_tet() -> TetMesh {
-    TetMesh {
-        vertices: vec![
-            Vector3::new(0.0, 0.0, 0.0),
-            Vector3::new(1.0, 0.0, 0.0),
-            Vector3::new(0.0, 1.0, 0.0),
-            Vector3::new(0.0, 0.0, 1.0),
-        ],
-        tets: vec![[0, 1, 2, 3]],
-    }
-}
 
 fn perturbed(rng: &mut Rng, p: [Vector3<f32>; 4], amount: f64) -> [Vector3<f32>; 4] {
     p.map(|v| v + rng.vec(amount).cast::<f32>())
@@ -27,7 +15,7 @@ fn perturbed(rng: &mut Rng, p: [Vector3<f32>; 4], amount: f64) -> [Vector3<f32>;
 #[test]
 fn hard_projection_removes_c_to_first_order() {
     let mut rng = Rng::new(10);
-    let rest = single_tet().vertices;
+    let rest = unit_tet().vertices;
     let rest: [Vector3<f32>; 4] = [rest[0], rest[1], rest[2], rest[3]];
     // Above f32 rounding (~1e-7 m here), |C| after one hard projection is O(|C|²).
     for amount in [3e-2, 1e-2] {

@@ -10,10 +10,10 @@
 
 mod common;
 
-use common::Rng;
+use common::Deformation as Start;
 use hecs::{Entity, World};
 use nalgebra::Vector3;
-use tetpbd::generators::{box_grid, CellSplit};
+use tetpbd::generators::CellSplit;
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, Tetrahedra};
 
 #[derive(Clone, Copy, Debug)]
@@ -23,13 +23,6 @@ enum Families {
     VertexFaceEdges,
     EdgesVolume,
     EdgesOnly,
-}
-
-#[derive(Clone, Copy, Debug)]
-enum Start {
-    Mirrored,
-    Flattened,
-    Scrambled,
 }
 
 #[derive(Debug)]
@@ -48,8 +41,7 @@ fn run(families: Families, start: Start, max_frames: usize) -> Outcome {
 
 fn run_on(families: Families, start: Start, max_frames: usize, split: CellSplit) -> Outcome {
     let mut world = World::new();
-    let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [3, 3, 3], split).unwrap();
-    let b = SoftBodyBuilder::new(mesh).density(1000.0);
+    let b = SoftBodyBuilder::new(common::cube(3, split)).density(1000.0);
     let b = match families {
         Families::VertexFace => b.vertex_face(0.0),
         Families::VertexFaceEdges => b.vertex_face(0.0).edges(0.0),
@@ -57,19 +49,7 @@ fn run_on(families: Families, start: Start, max_frames: usize, split: CellSplit)
         Families::EdgesOnly => b.edges(0.0),
     };
     let e: Entity = b.build().unwrap().spawn(&mut world);
-    {
-        let mut p = world.get::<&mut Particles>(e).unwrap();
-        let mut rng = Rng::new(42);
-        for i in 0..p.len() {
-            let x = p.positions()[i];
-            let y = match start {
-                Start::Mirrored => Vector3::new(-x.x, x.y, x.z),
-                Start::Flattened => Vector3::new(x.x, 0.0, x.z),
-                Start::Scrambled => rng.vec(0.5).cast(),
-            };
-            p.set_position(i, y).unwrap();
-        }
-    }
+    common::deform(&mut world, e, start);
     let mut solver = Solver::new(SolverSettings {
         gravity: Vector3::zeros(),
         substeps: 10,

@@ -5,10 +5,10 @@
 
 mod common;
 
-use common::Rng;
+use common::{Deformation as Start, Rng};
 use hecs::{Entity, World};
 use nalgebra::Vector3;
-use tetpbd::generators::{ball, box_grid, CellSplit};
+use tetpbd::generators::{ball, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings};
 
 /// Linear momentum, angular momentum about the centre of mass, and the scales they are
@@ -34,42 +34,17 @@ fn momenta(p: &Particles) -> (Vector3<f64>, Vector3<f64>, f64, f64) {
     (lin, ang, sp, sl)
 }
 
-#[derive(Clone, Copy, Debug)]
-enum Start {
-    Mirrored,
-    Scrambled,
-    /// The top half twisted about the vertical axis by 0.03 rad/m and stretched by 0.9 %:
-    /// a small, one-sided strain whose snap-back exceeds 1 m/s only at the top.
-    Strained,
-}
-
 /// A 1 m box of 3³ cells (density 1000 kg/m³, edges + volume) at rest, its positions
 /// mirrored, scrambled or strained.
 fn deformed(world: &mut World, start: Start) -> Entity {
-    let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [3, 3, 3], CellSplit::Six).unwrap();
-    let e = SoftBodyBuilder::new(mesh)
+    let e = SoftBodyBuilder::new(common::cube(3, CellSplit::Six))
         .density(1000.0)
         .edges(0.0)
         .volume(0.0)
         .build()
         .unwrap()
         .spawn(world);
-    let mut p = world.get::<&mut Particles>(e).unwrap();
-    let mut rng = Rng::new(42);
-    for i in 0..p.len() {
-        let x = p.positions()[i];
-        let y = match start {
-            Start::Mirrored => Vector3::new(-x.x, x.y, x.z),
-            Start::Scrambled => rng.vec(0.5).cast(),
-            Start::Strained if x.y > 0.0 => {
-                let (s, c) = (0.03 * x.y).sin_cos();
-                Vector3::new(x.x * c - x.z * s, 1.009 * x.y, x.x * s + x.z * c)
-            }
-            Start::Strained => x,
-        };
-        p.set_position(i, y).unwrap();
-    }
-    drop(p);
+    common::deform(world, e, start);
     e
 }
 
@@ -175,13 +150,10 @@ fn net_that_never_acts_changes_nothing() {
 fn collinear_body_stays_finite() {
     let mut world = World::new();
     let e = deformed(&mut world, Start::Mirrored);
-    {
-        let mut p = world.get::<&mut Particles>(e).unwrap();
-        for i in 0..p.len() {
-            let t = (i as f32 * 0.37).sin() * 0.5;
-            p.set_position(i, Vector3::new(t, 2.0 * t, -t)).unwrap();
-        }
-    }
+    common::deform_with(&mut world, e, |i, _| {
+        let t = (i as f32 * 0.37).sin() * 0.5;
+        Vector3::new(t, 2.0 * t, -t)
+    });
     let mut solver = Solver::new(SolverSettings {
         gravity: Vector3::zeros(),
         max_correction_speed: Some(1.0),

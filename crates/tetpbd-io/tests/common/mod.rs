@@ -1,4 +1,16 @@
-//! Helpers shared by the fuzz tests.
+//! Helpers shared by the tests: a pseudo-random generator for the fuzz tests, and an
+//! assertion on typed errors.
+#![allow(dead_code)]
+
+/// Asserts that the error `err` is the `variant` (a struct-like variant's path) with these
+/// field patterns, other fields free (`matches!(err, variant { field: value, .. })`),
+/// printing the error when it is not.
+#[allow(unused_macros)]
+macro_rules! assert_error {
+    ($err:ident, $variant:path $(, $field:ident: $value:pat)*) => {
+        assert!(matches!($err, $variant { $($field: $value,)* .. }), "{}", $err)
+    };
+}
 
 /// xorshift64* pseudo-random numbers.
 pub struct Rng(pub u64);
