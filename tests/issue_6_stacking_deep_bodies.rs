@@ -1,11 +1,11 @@
 //! Issue 6: the stacking pass blew deep soft bodies up under a heavy rigid body.
 //!
-//! The pass fixes each level of a soft body against the frozen level below it, a march from
-//! the ground up. Marching an elastic body's shape in one direction amplifies lateral errors
-//! level by level: a 100 kg box dropped on a 1 m cube of 8³ or 12³ cells drove its particles
-//! to 22–176 m/s and fell through the cube and 90–100 m through the ground; a 1000 kg box on
-//! a slab 8 cells thick went 24 m through the ground. Bodies deeper than
-//! `CouplingSettings::stacking_max_levels` are now left to the ordinary projections.
+//! The pass fixed each level of a soft body against the frozen levels below it, a march
+//! from the ground up, which amplifies lateral errors level by level: a 100 kg box dropped
+//! on a 1 m cube of 8³ or 12³ cells drove its particles to 22–176 m/s and fell through the
+//! cube and 90–100 m through the ground; a 1000 kg box on a slab 8 cells deep went 24 m
+//! through the ground. Now only the roots are held and every other particle keeps its mass
+//! (`tetpbd::project_stacked`): one more Gauss–Seidel sweep, in ground-up order.
 
 mod coupling_common;
 
@@ -31,7 +31,6 @@ struct Run {
     lowest: f32,
     bottom: f32,
     passes: u64,
-    too_deep: u64,
 }
 
 /// A soft box of `cells` (cell size `cell` m) and `mass` kg resting on the ground, with a
@@ -59,13 +58,11 @@ fn drop_box(cells: [u32; 3], cell: f32, mass: f32, box_mass: f32, frames: usize)
         lowest: f32::INFINITY,
         bottom: 0.0,
         passes: 0,
-        too_deep: 0,
     };
     for f in 0..frames {
         let stats = s.step().expect("step");
         assert_eq!(stats.soft.non_finite_resets, 0);
         r.passes += stats.stacking_passes;
-        r.too_deep += stats.stacking_too_deep;
         let v = speed(&s, slab);
         assert!(v.is_finite(), "frame {f}: non-finite particle speed");
         r.peak = r.peak.max(v);
@@ -87,65 +84,61 @@ fn bottom(s: &CoupledWorld, b: RigidBodyHandle) -> f32 {
     s.physics.bodies[b].translation().y - HALF
 }
 
-/// The case that blew up: a 100 kg box on a 1 m cube of 1000 kg (8³ cells, 8 levels). Now
-/// the cube is not stacked and carries the box on its top.
+/// Prints a run.
+fn show(what: &str, r: &Run) {
+    println!(
+        "{what}: peak {:.3} m/s, last second {:.4}, box bottom {:.4} (lowest {:.4}), \
+         stacking passes {}",
+        r.peak, r.late, r.bottom, r.lowest, r.passes
+    );
+}
+
+/// The case that blew up: a 100 kg box on a 1 m cube of 1000 kg (8³ cells, 8 levels). The
+/// cube is stacked and carries the box on its top, at rest.
 #[test]
 fn heavy_box_on_a_deep_cube_rests_on_its_top() {
     let r = drop_box([8; 3], 0.125, 1000.0, 100.0, 180);
-    println!(
-        "8³ cube, 100 kg box: peak {:.3} m/s, last second {:.4}, box bottom {:.4} (lowest {:.4}), \
-         passes {}, too deep {}",
-        r.peak, r.late, r.bottom, r.lowest, r.passes, r.too_deep
-    );
-    assert!(r.peak < 2.0, "particles reached {} m/s", r.peak);
-    assert!(r.late < 0.05, "still moving at {} m/s", r.late);
+    show("8³ cube, 100 kg box", &r);
+    assert!(r.peak < 1.0, "particles reached {} m/s", r.peak);
+    assert!(r.late < 0.01, "still moving at {} m/s", r.late);
     assert!(
-        r.lowest > 0.97,
+        r.lowest > 0.995,
         "the box sank to {} (top at 1.003)",
         r.lowest
     );
-    assert!(r.too_deep > 0 && r.passes == 0, "the deep cube was stacked");
+    assert!(r.passes > 0, "the cube was not stacked");
 }
 
-/// Up to the limit (6 levels) the pass still carries a 1000 kg box on a 1 kg slab.
+/// A 1000 kg box on 1 kg slabs 2 to 8 cells deep (it went 24 m through the ground at 8):
+/// held on the top, at rest.
 #[test]
-fn slab_at_the_limit_is_stacked_and_holds_the_box() {
-    let r = drop_box([6, 6, 6], 0.1, 1.0, 1000.0, 120);
-    println!(
-        "6-level slab, 1000 kg box: peak {:.3} m/s, last second {:.4}, box bottom {:.4} \
-         (lowest {:.4}), passes {}, too deep {}",
-        r.peak, r.late, r.bottom, r.lowest, r.passes, r.too_deep
-    );
-    assert!(r.passes > 0 && r.too_deep == 0, "the slab was not stacked");
+fn heavy_box_on_light_slabs_up_to_8_cells_deep_is_held() {
+    for depth in [2u32, 4, 6, 8] {
+        let r = drop_box([6, depth, 6], 0.1, 1.0, 1000.0, 180);
+        let top = depth as f32 * 0.1 + 0.003;
+        show(&format!("{depth}-cell slab, 1000 kg box"), &r);
+        assert!(r.peak < 1.0, "{depth}: particles reached {} m/s", r.peak);
+        assert!(r.late < 0.01, "{depth}: still moving at {} m/s", r.late);
+        assert!(
+            r.lowest > top - 0.003,
+            "{depth}: the box sank to {} (top at {top})",
+            r.lowest
+        );
+        assert!(r.passes > 0, "{depth}: the slab was not stacked");
+    }
+}
+
+/// A 1000 kg box on a 1 kg column 16 cells tall (0.6 m wide): held and finite, but not at
+/// rest after 3 s (the box rocks on the slender column at up to 0.5 m/s; a known limit).
+#[test]
+fn heavy_box_on_a_tall_light_column_is_held() {
+    let r = drop_box([6, 16, 6], 0.1, 1.0, 1000.0, 180);
+    show("16-cell column, 1000 kg box", &r);
     assert!(r.peak < 2.0, "particles reached {} m/s", r.peak);
     assert!(
-        r.lowest > 0.595,
-        "the box sank to {} (top at 0.603)",
+        r.lowest > 1.603 - 0.01,
+        "the box sank to {} (top at 1.603)",
         r.lowest
     );
-}
-
-/// Past the limit a 1 kg slab 8 cells deep is crushed by the 1000 kg box, as without the
-/// pass, but stays finite, keeps the box out of the ground and comes to rest (it went 24 m
-/// through the ground when stacked).
-#[test]
-fn slab_past_the_limit_is_crushed_but_stays_finite() {
-    let r = drop_box([6, 8, 6], 0.1, 1.0, 1000.0, 180);
-    println!(
-        "8-level slab, 1000 kg box: peak {:.3} m/s, last second {:.4}, box bottom {:.4} \
-         (lowest {:.4}), passes {}, too deep {}",
-        r.peak, r.late, r.bottom, r.lowest, r.passes, r.too_deep
-    );
-    assert!(
-        r.lowest > -0.05,
-        "the box went {} m into the ground",
-        -r.lowest
-    );
-    assert!(
-        r.bottom > -0.01,
-        "the box ended {} m in the ground",
-        -r.bottom
-    );
-    assert!(r.late < 0.5, "still moving at {} m/s", r.late);
-    assert!(r.too_deep > 0 && r.passes == 0, "the deep slab was stacked");
+    assert!(r.bottom > 1.603 - 0.005, "the box ended at {}", r.bottom);
 }

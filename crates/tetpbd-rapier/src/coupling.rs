@@ -42,23 +42,10 @@ pub struct CouplingSettings {
     /// dynamic body whose generalized mass at a contact is at least this many times the
     /// mass of the particle (or the mean of the triangle's particles) it touches gets the
     /// *stacking pass* after the ordinary projections of every iteration: its constraints
-    /// once more from the ground up with the lower particles frozen, then the heavy body's
+    /// once more from the ground up with the supported particles held, then the heavy body's
     /// contacts with the soft surface frozen (shock propagation, `stacking` module docs).
     /// Without it, one iteration per substep lets a 1000 kg box crush a 1 kg slab.
     pub stacking_mass_ratio: f32,
-    /// Deepest soft body the stacking pass runs on, in levels (tetrahedra between the
-    /// support and the farthest particle; a grid body standing on a face has one level per
-    /// cell of its height). A deeper body is left to the ordinary projections and counted in
-    /// [`crate::CouplingStats::stacking_too_deep`]; 0 turns the pass off.
-    ///
-    /// Why a limit: the pass fixes each level against the frozen one below it, a march
-    /// from the ground up, and marching an elastic body's shape in one direction amplifies
-    /// a lateral error at every level. Measured with a 1000 kg box dropped on 0.6 m slabs of
-    /// 0.1 m cells (`tests/issue_6_stacking_deep_bodies.rs`): 4 levels peak at 0.17 m/s,
-    /// 6 at 0.71 m/s, 8 explode (26–30 m/s, the box driven 24 m through the ground). Past
-    /// the limit a heavy load on a light body is crushed as without the pass (finite, it
-    /// comes to rest), not held.
-    pub stacking_max_levels: u32,
 }
 
 impl Default for CouplingSettings {
@@ -68,7 +55,6 @@ impl Default for CouplingSettings {
             default_collider: SoftCollider::default(),
             max_depenetration_speed: 2.0,
             stacking_mass_ratio: 10.0,
-            stacking_max_levels: 6,
         }
     }
 }
@@ -218,8 +204,8 @@ impl<'a> RapierContext<'a> {
 /// dynamic coefficients), the other rigid points against soft surface triangles (`corner`
 /// module docs), then attachments ([`crate::Attachments`]), then, for a soft body on an
 /// immovable support that carries a much heavier dynamic body, the *stacking pass*: its own
-/// constraints once more from the ground up with the lower particles frozen, and the heavy
-/// body's contacts with the surface frozen (shock propagation; `stacking` module docs,
+/// constraints once more from the ground up with the supported particles held, and the
+/// heavy body's contacts with the surface frozen (`stacking` module docs,
 /// [`CouplingSettings::stacking_mass_ratio`]). After each substep's velocity update: the
 /// separating velocity a stacking pass gave a heavy body is removed, the per-particle
 /// separating velocity is removed, then restitution acts per (soft body,
@@ -247,17 +233,13 @@ impl<'a> RapierContext<'a> {
 ///   rigid body on a soft body resting on an immovable support is carried by the stacking
 ///   pass (a 1000 kg box on a 1 kg slab at 10 substeps × 1 iteration,
 ///   `tests/collision_mass_ratio.rs`); one on a soft body that rests on nothing immovable
-///   (on another dynamic body, or in free flight) is not, and the pass makes the stacked
-///   soft body as stiff as its constraints allow in one ground-up sweep, however soft the
-///   heavy load would squash it in a converged solve. Its cost is about one more scalar
-///   sweep over the whole soft body per iteration (`tetpbd-bench --bin stacking`).
-///   A soft body deeper than [`CouplingSettings::stacking_max_levels`] (6 levels, i.e. 6
-///   cells of a grid body's height, by default) is not stacked: the ground-up march
-///   amplifies lateral errors level by level and blew deeper bodies up
-///   (`tests/issue_6_stacking_deep_bodies.rs`). A heavy load on such a body is carried only
-///   as far as the ordinary projections carry it: a 1000 kg box on a 1000 kg cube of 8³
-///   cells rests on its top, one on a 1 kg slab 8 cells deep crushes it (finite, the box
-///   stays out of the ground).
+///   (on another dynamic body, or in free flight) is not. The heavy body rests on the soft
+///   surface as on a frozen one (step 3 of the pass), so a very compliant soft body is
+///   squashed less under it than a converged solve would squash it. On a slender soft
+///   column (a 1000 kg box on a 1 kg column 0.6 m wide and 16 cells tall) the box is held
+///   but rocks at up to 0.5 m/s after 3 s (`tests/issue_6_stacking_deep_bodies.rs`). The
+///   pass costs about one more scalar sweep over the whole soft body per iteration
+///   (`tetpbd-bench --bin stacking`).
 /// * A heavy soft body on a stack of supported rigid bodies keeps a small rocking motion
 ///   (a few cm/s), the one-frame lag between the soft load and rapier's answer.
 /// * The soft load pressing an anchored body onto its supports does not reach rapier: it
@@ -386,7 +368,6 @@ impl Coupling {
                 margin: self.settings.margin,
                 max_depenetration_speed: self.settings.max_depenetration_speed,
                 stacking_mass_ratio: self.settings.stacking_mass_ratio,
-                stacking_max_levels: self.settings.stacking_max_levels,
                 order: self.solver.settings.order,
                 reports: &mut self.reports,
             };

@@ -15,7 +15,7 @@ use crate::report::{ContactReport, SoftFeature};
 use crate::restitution::{com_velocity, end_episodes, restitution_pass};
 use crate::rolling::rolling_pass;
 use crate::shape_query::surface_point;
-use crate::stacking::{stacked_velocity_pass, stacking_pass, Stacked, Stacking};
+use crate::stacking::{stacked_velocity_pass, stacking_pass, Stacking};
 use crate::support::{end_substep_supports, hold_supported, measure_clearance, project_supports};
 
 /// Borrows the frame state and rapier's query pipeline for one soft step.
@@ -28,8 +28,6 @@ pub(crate) struct CouplingHook<'q, 'a> {
     pub max_depenetration_speed: f32,
     /// `CouplingSettings::stacking_mass_ratio`.
     pub stacking_mass_ratio: f32,
-    /// `CouplingSettings::stacking_max_levels`.
-    pub stacking_max_levels: u32,
     /// The solver's family order (the stacking pass projects in it).
     pub order: [tetpbd::Family; 3],
     pub reports: &'q mut Vec<ContactReport>,
@@ -131,24 +129,19 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 pinned,
                 order: self.order,
                 ratio: self.stacking_mass_ratio,
-                max_levels: self.stacking_max_levels,
                 h,
                 max_push: self.max_depenetration_speed * h,
             };
             let t = std::time::Instant::now();
-            match stacking_pass(
+            if stacking_pass(
                 world,
                 s.entity,
                 &mut contacts[s.contacts.clone()],
                 &mut corners[s.corners.clone()],
                 &mut stacking,
             ) {
-                Stacked::Ran => {
-                    stats.stacking_passes += 1;
-                    s.stacked = true;
-                }
-                Stacked::TooDeep => stats.stacking_too_deep += 1,
-                Stacked::No => {}
+                stats.stacking_passes += 1;
+                s.stacked = true;
             }
             stats.stacking_time += t.elapsed();
         }

@@ -71,9 +71,6 @@ pub struct CouplingStats {
     /// Stacking passes run (one per stacked soft body and iteration; `stacking` module
     /// docs, [`crate::CouplingSettings::stacking_mass_ratio`]).
     pub stacking_passes: u64,
-    /// Stacking passes not run because the soft body is deeper than
-    /// [`crate::CouplingSettings::stacking_max_levels`] (one per body and iteration).
-    pub stacking_too_deep: u64,
     /// Wall time of the stacking passes and their velocity passes (part of the soft step's
     /// hook time).
     pub stacking_time: Duration,

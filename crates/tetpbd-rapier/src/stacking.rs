@@ -14,18 +14,19 @@
 //!   particles, and
 //! * carries a dynamic rigid body at least [`crate::CouplingSettings::stacking_mass_ratio`]
 //!   times heavier than the particles it touches (the body's generalized mass at the
-//!   contact against the particle's mass, or the triangle's mean particle mass), and
-//! * is at most [`crate::CouplingSettings::stacking_max_levels`] levels deep (below),
+//!   contact against the particle's mass, or the triangle's mean particle mass),
 //!
 //! is swept once more from the ground up, as Guendelman et al. (2003) propagate shocks
 //! through a stack of rigid bodies:
 //!
 //! 1. the particles in an active contact with an immovable support, and pinned particles,
 //!    are the roots (the levels are kept while the roots stay the same);
-//! 2. the body's own constraints are projected level by level away from the roots with the
-//!    lower particles frozen ([`tetpbd::project_stacked`]): the body takes its shape back
-//!    by moving the particles further from the ground, as a stack resting on the ground
-//!    would;
+//! 2. the body's own constraints are projected once more, level by level away from the
+//!    roots, with the roots held ([`tetpbd::project_stacked`]): each level is corrected
+//!    against the levels below it, which were corrected just before, so the support's
+//!    reaction reaches the top of the body within the sweep. (Holding every lower level,
+//!    as shock propagation holds the lower bodies of a rigid stack, blew bodies deeper than
+//!    6 levels up under a heavy box: `tetpbd::project_stacked`'s docs.)
 //! 3. with every particle frozen, the contacts and rigid-point contacts of the dynamic
 //!    bodies are projected once more: a heavy body is pushed out of the soft surface
 //!    entirely instead of pushing the particles into the body.
@@ -36,24 +37,13 @@
 //! projection gives a particle: the body is pushed out of the surface, not thrown off it
 //! (without this, the thickness skin a box is created in turned into 2.3 m/s upwards).
 //!
-//! The pass is one-way by design (lower particles and the soft surface act as infinitely
-//! heavy), so it does not conserve momentum: the impulses it leaves out are those the
+//! The pass is one-way by design (the roots and, in step 3, the soft surface act as
+//! infinitely heavy), so it does not conserve momentum: the impulses it leaves out are those the
 //! immovable support would take, which is right for a load resting on the ground through
 //! the soft body and wrong for a free one; hence the two conditions. The ordinary
 //! projections still run first, so soft bodies that are not stacked (and every scene
 //! without such a heavy load) behave exactly as without it. Counted in
 //! [`crate::CouplingStats::stacking_passes`].
-//!
-//! Depth limit: fixing each level against the frozen one below is a march from the ground
-//! up, and marching an elastic body's shape in one direction (as one would march an
-//! elliptic equation from one boundary) amplifies a lateral error at every level. With a
-//! 1000 kg box dropped on 0.6 m slabs of 0.1 m cells, the slab's peak particle speed was
-//! 0.09, 0.14, 0.16, 0.17, 0.28 and 0.71 m/s at 1 to 6 levels and 26–30 m/s at 8 (box
-//! driven 24 m through the ground); a 100 kg box on a 1 m cube of 8³ or 12³ cells exploded
-//! likewise. A deeper body is left to the ordinary projections (counted in
-//! [`crate::CouplingStats::stacking_too_deep`]). Keeping the lower particles frozen along
-//! the support's normal only, or lowering their inverse mass instead of zeroing it, might
-//! lift the limit; not tried.
 //!
 //! Cost: per iteration of a stacked soft body, one breadth-first pass over its tetrahedra,
 //! about one more sweep over its constraints (scalar kernels; each constraint at most once)
@@ -85,8 +75,6 @@ pub(crate) struct Stacking<'a> {
     pub order: [Family; 3],
     /// Mass ratio from which a dynamic body counts as heavy.
     pub ratio: f32,
-    /// Deepest body stacked, in levels (`CouplingSettings::stacking_max_levels`).
-    pub max_levels: u32,
     pub h: f32,
     pub max_push: f32,
 }
@@ -146,26 +134,15 @@ fn run_end<T>(items: &[T], start: usize, collider: impl Fn(&T) -> usize) -> usiz
             .count()
 }
 
-/// What [`stacking_pass`] did with a soft body.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Stacked {
-    /// The pass ran.
-    Ran,
-    /// The body is stacked but deeper than the limit: left to the ordinary projections.
-    TooDeep,
-    /// The body is not stacked.
-    No,
-}
-
-/// Runs the stacking pass (module docs) on one soft body if it is stacked and no deeper
-/// than [`Stacking::max_levels`].
+/// Runs the stacking pass (module docs) on one soft body if it is stacked; returns whether
+/// it ran.
 pub(crate) fn stacking_pass(
     world: &mut World,
     entity: Entity,
     contacts: &mut [ParticleContact],
     corners: &mut [CornerContact],
     s: &mut Stacking<'_>,
-) -> Stacked {
+) -> bool {
     let Ok((p, tets, surface, edges, vertex_face, volume)) = world.query_one_mut::<(
         &mut Particles,
         &Tetrahedra,
@@ -174,10 +151,10 @@ pub(crate) fn stacking_pass(
         Option<&mut VertexFaceConstraints>,
         Option<&mut VolumeConstraints>,
     )>(entity) else {
-        return Stacked::No;
+        return false;
     };
     if !carries_heavy(contacts, corners, p, surface, s) {
-        return Stacked::No;
+        return false;
     }
     // Roots: particles in contact with an immovable support in this substep. (Those in
     // contact at any time in the frame would change less often, but keep particles frozen
@@ -195,10 +172,7 @@ pub(crate) fn stacking_pass(
     }
     let top = layers.set_roots(tets, edges.as_deref(), supported.chain(pinned));
     if top == 0 {
-        return Stacked::No;
-    }
-    if top > s.max_levels {
-        return Stacked::TooDeep;
+        return false;
     }
     let families = BodyConstraints {
         edges,
@@ -252,7 +226,7 @@ pub(crate) fn stacking_pass(
             let _ = p.set_pinned(i, false);
         }
     }
-    Stacked::Ran
+    true
 }
 
 /// After a substep in which the soft body was stacked: at every active contact with a

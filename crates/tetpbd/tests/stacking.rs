@@ -1,4 +1,4 @@
-//! The ground-up (stacking) sweep: levels from the roots, lower particles frozen.
+//! The ground-up (stacking) sweep: levels from the roots, roots held, one ordered sweep.
 
 use hecs::World;
 use nalgebra::Vector3;
@@ -10,10 +10,17 @@ use tetpbd::{
 
 /// A column of three cells standing on y = 0; returns the entity and its bottom particles.
 fn column(world: &mut World, families: &str) -> (hecs::Entity, Vec<u32>) {
-    let mesh = box_grid(Vector3::new(0.2, 0.6, 0.2), [1, 3, 1], CellSplit::Six).unwrap();
+    column_of(world, families, [1, 3, 1])
+}
+
+/// A column of `cells` cells of 0.2 m standing on y = 0; returns the entity and its bottom
+/// particles.
+fn column_of(world: &mut World, families: &str, cells: [u32; 3]) -> (hecs::Entity, Vec<u32>) {
+    let size = Vector3::new(cells[0] as f32, cells[1] as f32, cells[2] as f32) * 0.2;
+    let mesh = box_grid(size, cells, CellSplit::Six).unwrap();
     let b = SoftBodyBuilder::new(mesh)
         .density(1000.0)
-        .translation(Vector3::new(0.0, 0.3, 0.0));
+        .translation(Vector3::new(0.0, size.y / 2.0, 0.0));
     let b = match families {
         "edges+volume" => b.edges(0.0).volume(0.0),
         "vertex-face" => b.vertex_face(0.0),
@@ -58,55 +65,129 @@ fn levels_count_cells_from_the_roots() {
     assert!(!StackingLayers::default().fits(p.len(), tets));
 }
 
-/// The top of the column pushed down by 5 cm: one ground-up sweep with hard constraints
-/// restores the column by moving the upper particles only (the roots do not move), and
-/// brings it much closer to its rest shape than the squashed start.
+/// Largest edge error `| |x_i − x_j| − d |` of a body, m.
+fn max_edge_error(p: &Particles, edges: &EdgeConstraints) -> f32 {
+    let x = p.positions();
+    edges
+        .edges()
+        .iter()
+        .zip(edges.rest_lengths())
+        .map(|(&[a, b], &d)| ((x[a as usize] - x[b as usize]).norm() - d).abs())
+        .fold(0.0, f32::max)
+}
+
+/// One ground-up sweep of a body's own families with `bottom` as the roots.
+fn sweep(world: &mut World, e: hecs::Entity, bottom: &[u32]) {
+    let (p, tets, edges, vf, vol) = world
+        .query_one_mut::<(
+            &mut Particles,
+            &Tetrahedra,
+            Option<&mut EdgeConstraints>,
+            Option<&mut VertexFaceConstraints>,
+            Option<&mut VolumeConstraints>,
+        )>(e)
+        .unwrap();
+    let mut layers = StackingLayers::new(p.len(), tets);
+    layers.set_roots(tets, edges.as_deref(), bottom.iter().copied());
+    project_stacked(
+        p,
+        tets,
+        BodyConstraints {
+            edges,
+            vertex_face: vf,
+            volume: vol,
+        },
+        Family::ALL,
+        1.0 / 600.0,
+        &layers,
+    );
+}
+
+/// The top of the column pushed down by 5 cm: ground-up sweeps with hard constraints
+/// restore the column (the roots do not move): the first one takes a good part of the
+/// squash out, repeated ones converge to the rest shape.
 #[test]
 fn a_squashed_column_is_restored_from_the_ground_up() {
     for families in ["edges+volume", "vertex-face", "vertex-face+edges"] {
         let mut world = World::new();
         let (e, bottom) = column(&mut world, families);
-        let (p, tets, edges, vf, vol) = world
-            .query_one_mut::<(
-                &mut Particles,
-                &Tetrahedra,
-                Option<&mut EdgeConstraints>,
-                Option<&mut VertexFaceConstraints>,
-                Option<&mut VolumeConstraints>,
-            )>(e)
-            .unwrap();
-        for i in 0..p.len() {
-            let x = p.positions()[i];
-            if x.y > 0.5 {
-                p.positions_mut()[i].y -= 0.05;
+        let before: Vec<Vector3<f32>> = {
+            let mut p = world.get::<&mut Particles>(e).unwrap();
+            for x in p.positions_mut() {
+                if x.y > 0.5 {
+                    x.y -= 0.05;
+                }
             }
+            p.positions().to_vec()
+        };
+        let height = |w: &World| {
+            let p = w.get::<&Particles>(e).unwrap();
+            p.positions().iter().map(|x| x.y).fold(f32::MIN, f32::max)
+        };
+        sweep(&mut world, e, &bottom);
+        let first = height(&world);
+        for _ in 0..49 {
+            sweep(&mut world, e, &bottom);
         }
-        let before: Vec<Vector3<f32>> = p.positions().to_vec();
-        let height = |p: &Particles| p.positions().iter().map(|x| x.y).fold(f32::MIN, f32::max);
-        let mut layers = StackingLayers::new(p.len(), tets);
-        layers.set_roots(tets, edges.as_deref(), bottom.iter().copied());
-        let count = project_stacked(
-            p,
-            tets,
-            BodyConstraints {
-                edges,
-                vertex_face: vf,
-                volume: vol,
-            },
-            Family::ALL,
-            1.0 / 600.0,
-            &layers,
-        );
-        assert!(count.applied > 0, "{families}");
+        let last = height(&world);
+        println!("{families}: top at {first:.4} m after one sweep, {last:.4} after 50 (rest 0.6, squashed 0.55)");
+        let p = world.get::<&Particles>(e).unwrap();
         for &i in &bottom {
             assert_eq!(p.positions()[i as usize], before[i as usize], "{families}");
         }
-        let top = height(p);
-        println!("{families}: top at {top:.4} m after one sweep (rest 0.6, squashed 0.55)");
         assert!(
-            (top - 0.6).abs() < 0.01,
-            "{families}: top at {top} after one stacked sweep"
+            first > 0.56,
+            "{families}: top at {first} after one stacked sweep"
         );
+        assert!(
+            (last - 0.6).abs() < 0.005,
+            "{families}: top at {last} after 50 sweeps"
+        );
+        let tets = world.get::<&Tetrahedra>(e).unwrap();
         assert_eq!(tets.count_inverted(p.positions()), 0, "{families}");
     }
+}
+
+/// A column 16 cells tall with every particle above the roots moved sideways by up to
+/// 1 mm: ground-up sweeps only shrink the error. (The explosion of deep bodies under the
+/// earlier sweep, which froze every level below the current one, needs the substeps'
+/// velocities and shows only through the coupling: `tests/issue_6_stacking_deep_bodies.rs`
+/// at the workspace root.)
+#[test]
+fn a_tall_column_shaken_sideways_settles() {
+    let mut world = World::new();
+    let (e, bottom) = column_of(&mut world, "edges+volume", [2, 16, 2]);
+    let mut seed = 12345u32;
+    let mut rand = || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
+    };
+    {
+        let mut p = world.get::<&mut Particles>(e).unwrap();
+        for x in p.positions_mut() {
+            if x.y > 1e-4 {
+                x.x += 1e-3 * rand();
+                x.z += 1e-3 * rand();
+            }
+        }
+    }
+    let error = |w: &World| {
+        let p = w.get::<&Particles>(e).unwrap();
+        max_edge_error(&p, &w.get::<&EdgeConstraints>(e).unwrap())
+    };
+    let start = error(&world);
+    let mut worst = start;
+    for _ in 0..20 {
+        sweep(&mut world, e, &bottom);
+        worst = worst.max(error(&world));
+    }
+    let end = error(&world);
+    println!(
+        "edge error: {start:.3e} m at the start, at most {worst:.3e}, {end:.3e} after 20 sweeps"
+    );
+    assert!(worst <= start, "the error grew to {worst} (start {start})");
+    assert!(
+        end < 0.5 * start,
+        "the error only went from {start} to {end}"
+    );
 }
