@@ -25,8 +25,8 @@
 //!    roots, with the roots held ([`tetpbd::project_stacked`]): each level is corrected
 //!    against the levels below it, which were corrected just before, so the support's
 //!    reaction reaches the top of the body within the sweep. (Holding every lower level,
-//!    as shock propagation holds the lower bodies of a rigid stack, blew bodies deeper than
-//!    6 levels up under a heavy box: `tetpbd::project_stacked`'s docs.)
+//!    as shock propagation holds the lower bodies of a rigid stack, blew bodies of 8 levels
+//!    and more up under a heavy box: `tetpbd::project_stacked`'s docs.)
 //! 3. with every particle frozen, the contacts and rigid-point contacts of the dynamic
 //!    bodies are projected once more: a heavy body is pushed out of the soft surface
 //!    entirely instead of pushing the particles into the body.

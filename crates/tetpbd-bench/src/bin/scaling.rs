@@ -63,7 +63,9 @@ struct Body {
     times: Vec<f64>,
     /// ms per measured frame of prediction, copies, volume, vertex–face, edges, velocities.
     phases: [Vec<f64>; 6],
-    /// ms per measured frame waiting at phase boundaries, and closing passes.
+    /// Per measured frame (`sync-stats` builds; zeros otherwise): ms waiting at phase
+    /// boundaries, ms closing passes, the share of chunks the helpers ran, and the helpers'
+    /// moves off the stepping thread's core.
     waits: [Vec<f64>; 4],
     /// Phases of a sweep of the edges and of the tetrahedra.
     sweep_phases: (usize, usize),
