@@ -28,6 +28,8 @@ pub enum ContactEngine {
     Tetpbd {
         /// `DeformationDamping` rate, 1/s (0 = none).
         damping: f32,
+        /// `CouplingSettings::self_weight_stacking`.
+        self_weight: bool,
     },
     /// rapier's soft body with a cell model and solver (material: [`crate::rapier_material`]).
     Rapier {
@@ -52,10 +54,21 @@ impl ContactEngine {
     /// A short label, unique among the engine set-ups.
     pub fn label(&self) -> String {
         match *self {
-            ContactEngine::Tetpbd { damping } if damping > 0.0 => {
-                format!("tetpbd edges+volume α=0, damping {damping}/s")
+            ContactEngine::Tetpbd {
+                damping,
+                self_weight,
+            } => {
+                let sweep = if self_weight {
+                    ", self-weight sweep"
+                } else {
+                    ""
+                };
+                if damping > 0.0 {
+                    format!("tetpbd edges+volume α=0, damping {damping}/s{sweep}")
+                } else {
+                    format!("tetpbd edges+volume α=0, undamped{sweep}")
+                }
             }
-            ContactEngine::Tetpbd { .. } => "tetpbd edges+volume α=0, undamped".to_string(),
             ContactEngine::Rapier { cell, solver, hard } => rapier_label(cell, solver, hard),
         }
     }
@@ -79,9 +92,16 @@ pub fn build_contact(
     iterations: u32,
 ) -> Result<Box<dyn ContactSim>, Box<dyn Error>> {
     Ok(match engine {
-        ContactEngine::Tetpbd { damping } => {
-            Box::new(Ours::new(scene, damping, substeps, iterations)?)
-        }
+        ContactEngine::Tetpbd {
+            damping,
+            self_weight,
+        } => Box::new(Ours::new(
+            scene,
+            damping,
+            self_weight,
+            substeps,
+            iterations,
+        )?),
         ContactEngine::Rapier { cell, solver, hard } => {
             if iterations != 1 {
                 return Err(format!("rapier has no iteration count (got {iterations})").into());
@@ -117,6 +137,7 @@ impl Ours {
     fn new(
         sc: &ContactScene,
         damping: f32,
+        self_weight: bool,
         substeps: u32,
         iterations: u32,
     ) -> Result<Ours, Box<dyn Error>> {
@@ -126,7 +147,11 @@ impl Ours {
             iterations,
             ..SolverSettings::default()
         };
-        let mut scene = CoupledWorld::new(solver, CouplingSettings::default())?;
+        let coupling = CouplingSettings {
+            self_weight_stacking: self_weight,
+            ..CouplingSettings::default()
+        };
+        let mut scene = CoupledWorld::new(solver, coupling)?;
         let (body, collider) = ground();
         scene.physics.insert(body, collider);
         let mut bodies = Vec::new();

@@ -28,6 +28,8 @@ pub(crate) struct CouplingHook<'q, 'a> {
     pub max_depenetration_speed: f32,
     /// `CouplingSettings::stacking_mass_ratio`.
     pub stacking_mass_ratio: f32,
+    /// `CouplingSettings::self_weight_stacking`.
+    pub self_weight_stacking: bool,
     /// The solver's family order (the stacking pass projects in it).
     pub order: [tetpbd::Family; 3],
     pub reports: &'q mut Vec<ContactReport>,
@@ -129,11 +131,12 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 pinned,
                 order: self.order,
                 ratio: self.stacking_mass_ratio,
+                self_weight: self.self_weight_stacking,
                 h,
                 max_push: self.max_depenetration_speed * h,
             };
             let t = std::time::Instant::now();
-            if stacking_pass(
+            if let Some(heavy) = stacking_pass(
                 world,
                 s.entity,
                 &mut contacts[s.contacts.clone()],
@@ -141,7 +144,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 &mut stacking,
             ) {
                 stats.stacking_passes += 1;
-                s.stacked = true;
+                s.stacked |= heavy;
             }
             stats.stacking_time += t.elapsed();
         }

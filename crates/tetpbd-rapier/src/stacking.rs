@@ -45,6 +45,11 @@
 //! without such a heavy load) behave exactly as without it. Counted in
 //! [`crate::CouplingStats::stacking_passes`].
 //!
+//! With [`crate::CouplingSettings::self_weight_stacking`] step 2 runs on every soft body
+//! with roots, loaded or not: a body resting under its own weight then sags by far less
+//! than one iteration per substep leaves (the setting's docs give the figures). Steps 3 and
+//! the velocity pass still run only under a heavy load, and only those count as stacked.
+//!
 //! Cost: per iteration of a stacked soft body, one breadth-first pass over its tetrahedra,
 //! about one more sweep over its constraints (scalar kernels; each constraint at most once)
 //! and one more sweep over its contacts with dynamic bodies.
@@ -75,6 +80,9 @@ pub(crate) struct Stacking<'a> {
     pub order: [Family; 3],
     /// Mass ratio from which a dynamic body counts as heavy.
     pub ratio: f32,
+    /// `CouplingSettings::self_weight_stacking`: the sweep (step 2) runs without a heavy
+    /// load too.
+    pub self_weight: bool,
     pub h: f32,
     pub max_push: f32,
 }
@@ -134,15 +142,16 @@ fn run_end<T>(items: &[T], start: usize, collider: impl Fn(&T) -> usize) -> usiz
             .count()
 }
 
-/// Runs the stacking pass (module docs) on one soft body if it is stacked; returns whether
-/// it ran.
+/// Runs the stacking pass (module docs) on one soft body if it is stacked; returns `None`
+/// if it did not run, otherwise whether it carried a heavy load (steps 1–3 ran; without
+/// one, under [`Stacking::self_weight`], only steps 1–2).
 pub(crate) fn stacking_pass(
     world: &mut World,
     entity: Entity,
     contacts: &mut [ParticleContact],
     corners: &mut [CornerContact],
     s: &mut Stacking<'_>,
-) -> bool {
+) -> Option<bool> {
     let Ok((p, tets, surface, edges, vertex_face, volume)) = world.query_one_mut::<(
         &mut Particles,
         &Tetrahedra,
@@ -151,10 +160,11 @@ pub(crate) fn stacking_pass(
         Option<&mut VertexFaceConstraints>,
         Option<&mut VolumeConstraints>,
     )>(entity) else {
-        return false;
+        return None;
     };
-    if !carries_heavy(contacts, corners, p, surface, s) {
-        return false;
+    let heavy = carries_heavy(contacts, corners, p, surface, s);
+    if !heavy && !s.self_weight {
+        return None;
     }
     // Roots: particles in contact with an immovable support in this substep. (Those in
     // contact at any time in the frame would change less often, but keep particles frozen
@@ -172,7 +182,7 @@ pub(crate) fn stacking_pass(
     }
     let top = layers.set_roots(tets, edges.as_deref(), supported.chain(pinned));
     if top == 0 {
-        return false;
+        return None;
     }
     let families = BodyConstraints {
         edges,
@@ -180,6 +190,9 @@ pub(crate) fn stacking_pass(
         volume,
     };
     project_stacked(p, tets, families, s.order, s.h, layers);
+    if !heavy {
+        return Some(false);
+    }
     // The dynamic bodies against the frozen soft surface.
     s.pinned.clear();
     s.pinned.extend((0..p.len()).map(|i| p.is_pinned(i)));
@@ -226,7 +239,7 @@ pub(crate) fn stacking_pass(
             let _ = p.set_pinned(i, false);
         }
     }
-    true
+    Some(true)
 }
 
 /// After a substep in which the soft body was stacked: at every active contact with a

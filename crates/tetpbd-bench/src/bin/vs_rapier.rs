@@ -4,11 +4,12 @@
 //! frame dt and substeps, in one process.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --bin vs_rapier [-- --frames F] [--pile] [--tetpbd-only]
+//! cargo run --release -p tetpbd-bench --bin vs_rapier [-- --frames F] [--pile] [--tetpbd-only] [--self-weight]
 //! ```
 //!
 //! `--pile` runs only scene d); `--tetpbd-only` prints tetpbd's rows at every substep count
-//! and runs no rapier (no comparisons).
+//! and runs no rapier (no comparisons); `--self-weight` runs tetpbd with
+//! `CouplingSettings::self_weight_stacking` on.
 //!
 //! Prints, per engine and scene: median wall ms per frame over the resting phase (cube: from
 //! 2 s on, pile: from 3 s on), the settled max |v| (largest particle speed over the last 30
@@ -66,8 +67,15 @@ fn print_row(name: &str, tets: usize, x: &ContactResult) {
 type Found = Option<(ContactEngine, u32, ContactResult)>;
 
 fn compare(scene: &ContactScene) -> Res<()> {
-    let undamped = ContactEngine::Tetpbd { damping: 0.0 };
-    let damped = ContactEngine::Tetpbd { damping: 5.0 };
+    let self_weight = flag("--self-weight");
+    let undamped = ContactEngine::Tetpbd {
+        damping: 0.0,
+        self_weight,
+    };
+    let damped = ContactEngine::Tetpbd {
+        damping: 5.0,
+        self_weight,
+    };
     let mut ours = Vec::new();
     for substeps in TETPBD_SUBSTEPS {
         for e in [undamped, damped] {

@@ -68,8 +68,14 @@ pub fn scenes(quick: bool) -> Result<Vec<ContactScene>, tetpbd::BuildError> {
 /// Engine set-ups swept on `scene`.
 fn engines(scene: &ContactScene, quick: bool) -> Vec<ContactEngine> {
     let mut e = vec![
-        ContactEngine::Tetpbd { damping: 5.0 },
-        ContactEngine::Tetpbd { damping: 0.0 },
+        ContactEngine::Tetpbd {
+            damping: 5.0,
+            self_weight: false,
+        },
+        ContactEngine::Tetpbd {
+            damping: 0.0,
+            self_weight: false,
+        },
         ContactEngine::Rapier {
             cell: SoftBodyCellModel::Volume,
             solver: SoftBodySolver::Constraints,
