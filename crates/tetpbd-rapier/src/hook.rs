@@ -32,6 +32,8 @@ pub(crate) struct CouplingHook<'q, 'a> {
     pub self_weight_stacking: bool,
     /// The solver's family order (the stacking pass projects in it).
     pub order: [tetpbd::Family; 3],
+    /// The solver's projection kernel (the stacking pass's sweep runs with it).
+    pub kernel: tetpbd::systems::Kernel,
     pub reports: &'q mut Vec<ContactReport>,
 }
 
@@ -130,6 +132,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 layers: cache,
                 pinned,
                 order: self.order,
+                kernel: self.kernel,
                 ratio: self.stacking_mass_ratio,
                 self_weight: self.self_weight_stacking,
                 h,

@@ -51,8 +51,9 @@
 //! the velocity pass still run only under a heavy load, and only those count as stacked.
 //!
 //! Cost: per iteration of a stacked soft body, one breadth-first pass over its tetrahedra,
-//! about one more sweep over its constraints (scalar kernels; each constraint at most once)
-//! and one more sweep over its contacts with dynamic bodies.
+//! about one more sweep over its constraints (each constraint at most once; edges and
+//! volumes in SIMD lanes, colour class by colour class within a level, vertex–face on the
+//! scalar kernel) and one more sweep over its contacts with dynamic bodies.
 
 use hecs::{Entity, World};
 use rapier3d::geometry::ColliderSet;
@@ -66,6 +67,7 @@ use crate::contact::project_contacts;
 use crate::corner::{project_corners, CornerContact, CornerPass};
 use crate::frame::{ColliderProxy, ParticleContact};
 use nalgebra::Vector3;
+use tetpbd::systems::Kernel;
 
 /// What the pass borrows besides one soft body's contacts.
 pub(crate) struct Stacking<'a> {
@@ -78,6 +80,8 @@ pub(crate) struct Stacking<'a> {
     /// Scratch: which particles were pinned before freezing.
     pub pinned: &'a mut Vec<bool>,
     pub order: [Family; 3],
+    /// The solver's projection kernel.
+    pub kernel: Kernel,
     /// Mass ratio from which a dynamic body counts as heavy.
     pub ratio: f32,
     /// `CouplingSettings::self_weight_stacking`: the sweep (step 2) runs without a heavy
@@ -189,7 +193,7 @@ pub(crate) fn stacking_pass(
         vertex_face,
         volume,
     };
-    project_stacked(p, tets, families, s.order, s.h, layers);
+    project_stacked(p, tets, families, s.order, s.h, layers, s.kernel);
     if !heavy {
         return Some(false);
     }

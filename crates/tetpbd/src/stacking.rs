@@ -23,7 +23,18 @@
 //! ill-conditioned). Constraints among roots only (level 0) and constraints with a particle
 //! no root reaches are left alone. Each constraint is projected at most once per sweep, so
 //! a sweep costs about one more sweep over the body's constraints, plus a breadth-first
-//! pass over its tetrahedra.
+//! pass over its tetrahedra when the roots change.
+//!
+//! Within a level the order is free, so each level's edges and tetrahedra are sorted into
+//! greedy colour classes when the levels are built (items of one class share no particle),
+//! and the edge and volume constraints run through the same SIMD kernels as the ordinary
+//! sweep, four or eight at a time (on a 1 m cube of 8³ cells 97 % of the edges and 93 % of
+//! the tetrahedra fall in full lanes). The kernels walk contiguous runs, so the sweep copies
+//! the families' indices, rest values and multipliers into level order before it and the
+//! multipliers back after it. The vertex–face constraints of a level stay on the scalar
+//! kernel, one vertex at a time (only the level's own vertices are held above their faces).
+//! The roots are held by an inverse mass of 0 in the working copy for the length of the
+//! sweep. The scalar kernel in the same order is the reference (`tests/stacking.rs`).
 //!
 //! Why the levels above the roots are not frozen too, as shock propagation freezes the
 //! lower bodies of a rigid stack: fixing each level against a frozen one below is a march
@@ -48,13 +59,148 @@
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::mesh::Tetrahedra;
 use crate::particles::Particles;
-use crate::projection::{self, ParticleAccess};
+use crate::projection;
+use crate::runs;
 use crate::stats::Family;
-use crate::systems::ProjectionCount;
-use crate::work::{self, WorkAccess};
+use crate::systems::{Kernel, ProjectionCount};
+use crate::work;
 
 /// Level of a particle that no root reaches.
 const UNREACHED: u32 = u32::MAX;
+
+/// Colour of the overflow class of a greedy colouring (its items may share particles).
+const OVERFLOW: usize = 63;
+
+/// One family's items (edges or tetrahedra) in sweep order: by level, and within a level
+/// in greedy colour classes (items of one class touch disjoint particles, so the SIMD
+/// kernels run them in lanes), plus the per-sweep copies of the items' data in that order.
+#[derive(Clone, Debug, Default)]
+struct LevelOrder {
+    /// Item indices, level by level, each level's items sorted by colour (stable).
+    order: Vec<u32>,
+    /// Start of each level's items in `order` (`starts[L - 1]..starts[L]` is level `L`).
+    starts: Vec<u32>,
+    /// Start of each colour class in `order`, then `order.len()`.
+    classes: Vec<u32>,
+    /// Per class: whether its items may share particles (the overflow colour).
+    dependent: Vec<bool>,
+    /// First class of each level `L ≥ 1` (index `L - 1`), then the class count.
+    level_classes: Vec<u32>,
+    /// Scratch: the items' colours.
+    colours: Vec<u8>,
+    /// Scratch: one level's items while they are sorted.
+    sorted: Vec<u32>,
+}
+
+impl LevelOrder {
+    /// Sorts the items of `levels` (the level of each item) into levels `1..=top` and each
+    /// level into greedy colour classes; `used` is a per-particle scratch of zeros (left
+    /// zero). Allocates only while its buffers grow past their capacity.
+    fn build<const N: usize>(
+        &mut self,
+        items: &[[u32; N]],
+        levels: impl Iterator<Item = u32> + Clone,
+        top: u32,
+        used: &mut [u64],
+    ) {
+        bucket(levels, top, &mut self.order, &mut self.starts);
+        self.colours.clear();
+        self.colours.resize(self.order.len(), 0);
+        self.classes.clear();
+        self.dependent.clear();
+        self.level_classes.clear();
+        for l in 0..top as usize {
+            let (a, b) = (self.starts[l] as usize, self.starts[l + 1] as usize);
+            self.level_classes.push(self.classes.len() as u32);
+            let mut count = [0u32; OVERFLOW + 1];
+            for k in a..b {
+                let item = &items[self.order[k] as usize];
+                let mask = item.iter().fold(0u64, |m, &i| m | used[i as usize]);
+                let c = ((!mask).trailing_zeros() as usize).min(OVERFLOW);
+                for &i in item {
+                    used[i as usize] |= 1u64 << c;
+                }
+                self.colours[k] = c as u8;
+                count[c] += 1;
+            }
+            // Starts of the colours within the level, then a stable placement.
+            let mut next = [0u32; OVERFLOW + 1];
+            let mut at = a as u32;
+            for (c, &n) in count.iter().enumerate() {
+                next[c] = at;
+                if n > 0 {
+                    self.classes.push(at);
+                    self.dependent.push(c == OVERFLOW);
+                }
+                at += n;
+            }
+            self.sorted.clear();
+            self.sorted.resize(b - a, 0);
+            for k in a..b {
+                let c = self.colours[k] as usize;
+                self.sorted[next[c] as usize - a] = self.order[k];
+                next[c] += 1;
+            }
+            self.order[a..b].copy_from_slice(&self.sorted);
+            for &k in &self.order[a..b] {
+                for &i in &items[k as usize] {
+                    used[i as usize] = 0;
+                }
+            }
+        }
+        self.level_classes.push(self.classes.len() as u32);
+        self.classes.push(self.order.len() as u32);
+    }
+
+    /// The classes of level `l ≥ 1`: each as its range in `order` and whether it is
+    /// independent.
+    fn level(&self, l: u32) -> impl Iterator<Item = (std::ops::Range<usize>, bool)> + '_ {
+        let l = l as usize;
+        let (a, b) = match (self.level_classes.get(l - 1), self.level_classes.get(l)) {
+            (Some(&a), Some(&b)) => (a as usize, b as usize),
+            _ => (0, 0),
+        };
+        (a..b).map(|k| {
+            (
+                self.classes[k] as usize..self.classes[k + 1] as usize,
+                !self.dependent[k],
+            )
+        })
+    }
+}
+
+/// Per-sweep copies of one family's data in sweep order (the SIMD kernels walk contiguous
+/// runs). Gathered before a sweep, multipliers scattered back after it.
+#[derive(Clone, Debug, Default)]
+struct Gathered<T: Clone + Default, R: Clone + Default> {
+    items: Vec<T>,
+    rest: Vec<R>,
+    lambdas: Vec<R>,
+}
+
+impl<T: Copy + Default, R: Copy + Default> Gathered<T, R> {
+    fn gather(&mut self, order: &[u32], items: &[T], rest: &[R], lambdas: &[R]) {
+        let pick = |v: &[R], k: u32| v.get(k as usize).copied().unwrap_or_default();
+        self.items.clear();
+        self.items.extend(
+            order
+                .iter()
+                .map(|&k| items.get(k as usize).copied().unwrap_or_default()),
+        );
+        self.rest.clear();
+        self.rest.extend(order.iter().map(|&k| pick(rest, k)));
+        self.lambdas.clear();
+        self.lambdas.extend(order.iter().map(|&k| pick(lambdas, k)));
+    }
+
+    fn scatter(&self, order: &[u32], lambdas: &mut [R]) {
+        for (&k, &l) in order.iter().zip(&self.lambdas) {
+            if let Some(x) = lambdas.get_mut(k as usize) {
+                *x = l;
+            }
+        }
+    }
+}
 
 /// Levels of one body's particles and the constraint order of a ground-up sweep
 /// ([`project_stacked`]). Built for one body ([`StackingLayers::new`]); keeps its
@@ -69,14 +215,19 @@ pub struct StackingLayers {
     /// Number of tetrahedra of the body the rows were built for.
     tet_count: usize,
     queue: Vec<u32>,
+    /// Per particle: colours used so far in the level being coloured (scratch, zeros).
+    used: Vec<u64>,
     /// The roots of the current levels (sorted, unique) and the next call's candidates.
     roots: Vec<u32>,
     candidates: Vec<u32>,
-    /// Edges and tetrahedra sorted by level, with the start of each level.
-    edge_order: Vec<u32>,
-    edge_starts: Vec<u32>,
-    tet_order: Vec<u32>,
-    tet_starts: Vec<u32>,
+    /// Edges and tetrahedra in sweep order.
+    edges: LevelOrder,
+    tets: LevelOrder,
+    /// Per-sweep data of the edge and volume families in sweep order.
+    edge_data: Gathered<[u32; 2], f32>,
+    volume_data: Gathered<[u32; 4], f32>,
+    /// The roots' inverse masses while a sweep holds them.
+    held: Vec<f32>,
     /// Highest level reached.
     top: u32,
 }
@@ -86,6 +237,7 @@ impl StackingLayers {
     pub fn new(n: usize, tets: &Tetrahedra) -> Self {
         let mut s = StackingLayers {
             level: vec![UNREACHED; n],
+            used: vec![0; n],
             ..StackingLayers::default()
         };
         s.incidence(n, tets.indices());
@@ -95,14 +247,18 @@ impl StackingLayers {
     /// Whether these layers were built for a body with `n` particles and tetrahedra `tets`
     /// (by their counts).
     pub fn fits(&self, n: usize, tets: &Tetrahedra) -> bool {
-        self.level.len() == n && self.first.len() == n + 1 && self.tet_count == tets.len()
+        self.level.len() == n
+            && self.used.len() == n
+            && self.first.len() == n + 1
+            && self.tet_count == tets.len()
     }
 
     /// Gives every particle its level below the `roots` (particle indices; out-of-range ones
-    /// are ignored) and orders the body's tetrahedra and `edges` by level. `tets` and
-    /// `edges` are those of the body the layers were built for. The levels are only
-    /// recomputed when the set of roots differs from the previous call's. Returns the
-    /// highest level reached (0 when there are no roots, or the layers do not fit `tets`).
+    /// are ignored) and orders the body's tetrahedra and `edges` by level, and each level in
+    /// colour classes. `tets` and `edges` are those of the body the layers were built for.
+    /// The levels are only recomputed when the set of roots differs from the previous
+    /// call's. Returns the highest level reached (0 when there are no roots, or the layers
+    /// do not fit `tets`).
     pub fn set_roots(
         &mut self,
         tets: &Tetrahedra,
@@ -129,10 +285,10 @@ impl StackingLayers {
             self.queue.push(r);
         }
         self.top = 0;
-        self.edge_order.clear();
-        self.edge_starts.clear();
-        self.tet_order.clear();
-        self.tet_starts.clear();
+        self.edges
+            .build::<2>(&[], std::iter::empty(), 0, &mut self.used);
+        self.tets
+            .build::<4>(&[], std::iter::empty(), 0, &mut self.used);
         if self.queue.is_empty() {
             return 0;
         }
@@ -156,22 +312,22 @@ impl StackingLayers {
         }
         let level = &self.level;
         let top = self.top;
-        bucket(
+        self.tets.build(
+            tets.indices(),
             tets.indices()
                 .iter()
                 .map(|t| t.iter().map(|&i| level[i as usize]).max().unwrap_or(0)),
             top,
-            &mut self.tet_order,
-            &mut self.tet_starts,
+            &mut self.used,
         );
         if let Some(e) = edges {
-            bucket(
+            self.edges.build(
+                &e.edges,
                 e.edges
                     .iter()
                     .map(|[a, b]| level[*a as usize].max(level[*b as usize])),
                 top,
-                &mut self.edge_order,
-                &mut self.edge_starts,
+                &mut self.used,
             );
         }
         top
@@ -254,37 +410,6 @@ fn shift_starts(starts: &mut [u32]) {
     }
 }
 
-/// The roots (level 0) held (inverse mass 0); every other particle at its own mass.
-struct RootsHeld<'a, 'b> {
-    inner: &'a mut WorkAccess<'b>,
-    level: &'a [u32],
-}
-
-impl ParticleAccess for RootsHeld<'_, '_> {
-    #[inline(always)]
-    fn row(&self, i: usize) -> wide::f32x4 {
-        let row = self.inner.row(i);
-        if self.level[i] == 0 {
-            let [x, y, z, _] = row.to_array();
-            wide::f32x4::new([x, y, z, 0.0])
-        } else {
-            row
-        }
-    }
-    #[inline(always)]
-    fn rest(&self, i: usize) -> nalgebra::Vector3<f32> {
-        self.inner.rest(i)
-    }
-    #[inline(always)]
-    fn add_row(&mut self, i: usize, d: wide::f32x4) {
-        self.inner.add_row(i, d);
-    }
-    #[inline(always)]
-    fn len(&self) -> usize {
-        self.inner.len()
-    }
-}
-
 /// The constraint families of one body, as [`project_stacked`] borrows them.
 pub struct BodyConstraints<'a> {
     /// Edge distance constraints, if the body has them.
@@ -299,52 +424,81 @@ pub struct BodyConstraints<'a> {
 /// last [`StackingLayers::set_roots`] for this body: for each level `L ≥ 1`, the constraints
 /// of level `L` in the family `order`, the roots held. XPBD with the families'
 /// compliances and the substep length `h` (s); multipliers accumulate with the substep's
-/// other projections. Scalar kernels.
+/// other projections.
+///
+/// Within a level, edges and volume constraints run colour class by colour class with
+/// `kernel` ([`Kernel::Simd`]: four or eight independent projections at once, the overflow
+/// class and each class's remainder on the scalar kernel; [`Kernel::Scalar`]: the same order
+/// one by one, the reference). The level's vertex–face constraints run on the scalar kernel
+/// (only the heights of the level's own vertices are projected). The roots are held by
+/// setting their inverse mass to 0 in the working copy for the sweep.
 pub fn project_stacked(
     p: &mut Particles,
     tets: &Tetrahedra,
     families: BodyConstraints<'_>,
     order: [Family; 3],
     h: f32,
-    layers: &StackingLayers,
+    layers: &mut StackingLayers,
+    kernel: Kernel,
 ) -> ProjectionCount {
     let mut count = ProjectionCount::default();
     if layers.top == 0 || layers.level.len() != p.len() {
         return count;
     }
     let BodyConstraints {
-        mut edges,
+        edges,
         mut vertex_face,
-        mut volume,
+        volume,
     } = families;
-    work::with_access(p, work::CopyMode::PerSweep, |inner| {
-        let mut acc = RootsHeld {
-            inner,
-            level: &layers.level,
-        };
-        let range = |starts: &[u32], l: u32| {
-            starts
-                .get(l as usize - 1)
-                .zip(starts.get(l as usize))
-                .map_or(0..0, |(&a, &b)| a as usize..b as usize)
-        };
-        for l in 1..=layers.top {
+    let StackingLayers {
+        level,
+        roots,
+        edges: edge_order,
+        tets: tet_order,
+        edge_data,
+        volume_data,
+        held,
+        top,
+        ..
+    } = layers;
+    if let Some(e) = edges.as_deref() {
+        edge_data.gather(&edge_order.order, &e.edges, &e.rest_lengths, &e.lambdas);
+    }
+    if let Some(v) = volume.as_deref() {
+        volume_data.gather(
+            &tet_order.order,
+            &tets.indices,
+            &tets.rest_volumes,
+            &v.lambdas,
+        );
+    }
+    work::with_access(p, work::CopyMode::PerSweep, |acc| {
+        // Hold the roots: inverse mass 0 for the sweep, restored after it.
+        held.clear();
+        for &r in roots.iter() {
+            let slot = &mut acc.slots[r as usize];
+            let [x, y, z, w] = slot.xw.to_array();
+            held.push(w);
+            slot.xw = wide::f32x4::new([x, y, z, 0.0]);
+        }
+        for l in 1..=*top {
             for family in order {
                 match family {
                     Family::Edge => {
-                        let Some(e) = edges.as_deref_mut() else {
+                        let Some(e) = edges.as_deref() else {
                             continue;
                         };
                         let alpha_tilde = e.compliance / (h * h);
-                        for &k in &layers.edge_order[range(&layers.edge_starts, l)] {
-                            let k = k as usize;
-                            count.add(projection::edge(
-                                &mut acc,
-                                e.edges[k],
-                                e.rest_lengths[k],
-                                &mut e.lambdas[k],
+                        for (r, independent) in edge_order.level(l) {
+                            count += runs::edge_run(
+                                acc,
+                                &edge_data.items[r.clone()],
+                                &edge_data.rest[r.clone()],
+                                &mut edge_data.lambdas[r],
                                 alpha_tilde,
-                            ));
+                                kernel,
+                                independent,
+                            );
                         }
                     }
                     Family::VertexFace => {
@@ -352,44 +506,121 @@ pub fn project_stacked(
                             continue;
                         };
                         let alpha_tilde = vf.compliance / (h * h);
-                        for &t in &layers.tet_order[range(&layers.tet_starts, l)] {
+                        let (a, b) = (
+                            tet_order.starts[l as usize - 1],
+                            tet_order.starts[l as usize],
+                        );
+                        for &t in &tet_order.order[a as usize..b as usize] {
                             let t = t as usize;
                             // Only a vertex of this level is held above its face: moving a
                             // face alone to hold a root is ill-conditioned (the
                             // height barely depends on a face point whose opposite edge
                             // passes under the vertex) and blew the slab up.
-                            let level = &layers.level;
-                            let (a, d) = projection::vertex_face_held(
-                                &mut acc,
+                            let (ap, d) = projection::vertex_face_held(
+                                acc,
                                 tets.indices[t],
                                 &vf.rest_heights[t],
                                 &mut vf.lambdas[t],
                                 alpha_tilde,
                                 |i| level[i] == l,
                             );
-                            count.applied += u64::from(a);
+                            count.applied += u64::from(ap);
                             count.degenerate += u64::from(d);
                         }
                     }
                     Family::Volume => {
-                        let Some(vol) = volume.as_deref_mut() else {
+                        let Some(vol) = volume.as_deref() else {
                             continue;
                         };
                         let alpha_tilde = vol.compliance / (h * h);
-                        for &t in &layers.tet_order[range(&layers.tet_starts, l)] {
-                            let t = t as usize;
-                            count.add(projection::volume(
-                                &mut acc,
-                                tets.indices[t],
-                                tets.rest_volumes[t],
-                                &mut vol.lambdas[t],
+                        for (r, independent) in tet_order.level(l) {
+                            count += runs::volume_run(
+                                acc,
+                                &volume_data.items[r.clone()],
+                                &volume_data.rest[r.clone()],
+                                &mut volume_data.lambdas[r],
                                 alpha_tilde,
-                            ));
+                                kernel,
+                                independent,
+                            );
                         }
                     }
                 }
             }
         }
+        for (&r, &w) in roots.iter().zip(held.iter()) {
+            let slot = &mut acc.slots[r as usize];
+            let [x, y, z, _] = slot.xw.to_array();
+            slot.xw = wide::f32x4::new([x, y, z, w]);
+        }
     });
+    if let Some(e) = edges {
+        edge_data.scatter(&edge_order.order, &mut e.lambdas);
+    }
+    if let Some(v) = volume {
+        volume_data.scatter(&tet_order.order, &mut v.lambdas);
+    }
     count
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::generators::{box_grid, CellSplit};
+    use crate::SoftBodyBuilder;
+
+    /// Checks one family's sweep order: every reached item once, levels ascending, and the
+    /// items of an independent class on pairwise distinct particles.
+    fn check<const N: usize>(o: &LevelOrder, items: &[[u32; N]], level: &[u32], top: u32) {
+        let item_level = |k: u32| {
+            items[k as usize]
+                .iter()
+                .map(|&i| level[i as usize])
+                .max()
+                .unwrap()
+        };
+        let reached = (0..items.len() as u32)
+            .filter(|&k| (1..=top).contains(&item_level(k)))
+            .count();
+        let mut seen = vec![false; items.len()];
+        let mut count = 0;
+        for l in 1..=top {
+            for (r, independent) in o.level(l) {
+                let mut touched = std::collections::BTreeSet::new();
+                for &k in &o.order[r] {
+                    assert_eq!(item_level(k), l);
+                    assert!(!std::mem::replace(&mut seen[k as usize], true));
+                    count += 1;
+                    for &i in &items[k as usize] {
+                        assert!(!independent || touched.insert(i), "shared particle {i}");
+                    }
+                }
+            }
+        }
+        assert_eq!(count, reached);
+    }
+
+    #[test]
+    fn levels_are_split_into_independent_colour_classes() {
+        let mesh = box_grid(Vector3::new(1.0, 2.0, 1.0), [3, 6, 3], CellSplit::Six).unwrap();
+        let body = SoftBodyBuilder::new(mesh)
+            .edges(0.0)
+            .volume(0.0)
+            .build()
+            .unwrap();
+        let x = body.particles.positions();
+        let bottom = (0..x.len() as u32).filter(|&i| x[i as usize].y < -0.99);
+        let edges = body.edges.as_ref().unwrap();
+        let mut layers = StackingLayers::new(x.len(), &body.tetrahedra);
+        let top = layers.set_roots(&body.tetrahedra, Some(edges), bottom);
+        assert_eq!(top, 6);
+        check(&layers.edges, edges.edges(), &layers.level, top);
+        check(&layers.tets, body.tetrahedra.indices(), &layers.level, top);
+        assert!(layers.used.iter().all(|&u| u == 0));
+        // A level of a 3 × 3 cell layer has more than one class and runs mostly in lanes.
+        let (r, independent) = layers.tets.level(3).next().unwrap();
+        assert!(independent && r.len() >= 4, "{r:?}");
+    }
 }
