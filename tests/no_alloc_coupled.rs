@@ -268,6 +268,44 @@ fn soft_pile_steps_without_allocating() {
     check("pile", &tally, frames as u64);
 }
 
+/// Three soft cubes stacked on rigid ground with the self-weight sweep on
+/// (`CouplingSettings::self_weight_stacking`): the ground-up sweep runs on the bottom cube
+/// in every substep, its levels rebuilt as its ground contacts change.
+#[test]
+fn self_weight_sweep_steps_without_allocating() {
+    let solver = SolverSettings {
+        substeps: 10,
+        ..SolverSettings::default()
+    };
+    let coupling = CouplingSettings {
+        self_weight_stacking: true,
+        ..CouplingSettings::default()
+    };
+    let mut scene = CoupledWorld::new(solver, coupling).expect("settings");
+    scene.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
+        ColliderBuilder::cuboid(5.0, 0.5, 5.0),
+    );
+    for i in 0..3 {
+        soft_cube(
+            &mut scene,
+            3,
+            Vector3::new(0.1 * i as f32, 0.55 + 1.01 * i as f32, 0.0),
+        );
+    }
+    let mut soft = SoftContacts::new(SoftContactSettings::default()).expect("settings");
+    for _ in 0..20 {
+        scene.step_with(&mut soft).expect("step");
+    }
+    let frames = 30;
+    let mut passes = 0;
+    let tally = counted(frames, || {
+        passes += scene.step_with(&mut soft).expect("step").stacking_passes;
+    });
+    assert!(passes > 0, "the self-weight sweep ran");
+    check("self-weight", &tally, frames as u64);
+}
+
 /// A soft cube rolling over rigid ground with rolling resistance on (off by default, so the
 /// scenes above never run its pass).
 #[test]

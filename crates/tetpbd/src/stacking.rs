@@ -103,6 +103,16 @@ impl LevelOrder {
         top: u32,
         used: &mut [u64],
     ) {
+        // Every buffer at its largest size on the first build, so that a later change of
+        // the roots (inside a step) does not allocate.
+        let n = items.len();
+        self.order.reserve(n);
+        self.colours.reserve(n);
+        self.sorted.reserve(n);
+        self.classes.reserve(n + 1);
+        self.dependent.reserve(n);
+        self.level_classes.reserve(n + 1);
+        self.starts.reserve(used.len() + 1);
         bucket(levels, top, &mut self.order, &mut self.starts);
         self.colours.clear();
         self.colours.resize(self.order.len(), 0);
@@ -180,6 +190,10 @@ struct Gathered<T: Clone + Default, R: Clone + Default> {
 
 impl<T: Copy + Default, R: Copy + Default> Gathered<T, R> {
     fn gather(&mut self, order: &[u32], items: &[T], rest: &[R], lambdas: &[R]) {
+        // Sized for every item of the family at once (no allocation when more are reached).
+        self.items.reserve(items.len());
+        self.rest.reserve(items.len());
+        self.lambdas.reserve(items.len());
         let pick = |v: &[R], k: u32| v.get(k as usize).copied().unwrap_or_default();
         self.items.clear();
         self.items.extend(
@@ -238,6 +252,10 @@ impl StackingLayers {
         let mut s = StackingLayers {
             level: vec![UNREACHED; n],
             used: vec![0; n],
+            queue: Vec::with_capacity(n),
+            roots: Vec::with_capacity(n),
+            candidates: Vec::with_capacity(n),
+            held: Vec::with_capacity(n),
             ..StackingLayers::default()
         };
         s.incidence(n, tets.indices());
