@@ -134,11 +134,16 @@ fn check(name: &str, tally: &Tally, frames: u64) {
 }
 
 fn scene() -> CoupledWorld {
+    scene_with(CouplingSettings::default())
+}
+
+/// Rigid ground, 10 substeps, the given coupling settings.
+fn scene_with(coupling: CouplingSettings) -> CoupledWorld {
     let solver = SolverSettings {
         substeps: 10,
         ..SolverSettings::default()
     };
-    let mut scene = CoupledWorld::new(solver, CouplingSettings::default()).expect("settings");
+    let mut scene = CoupledWorld::new(solver, coupling).expect("settings");
     scene.physics.insert(
         RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
         ColliderBuilder::cuboid(5.0, 0.5, 5.0),
@@ -273,19 +278,10 @@ fn soft_pile_steps_without_allocating() {
 /// in every substep, its levels rebuilt as its ground contacts change.
 #[test]
 fn self_weight_sweep_steps_without_allocating() {
-    let solver = SolverSettings {
-        substeps: 10,
-        ..SolverSettings::default()
-    };
-    let coupling = CouplingSettings {
+    let mut scene = scene_with(CouplingSettings {
         self_weight_stacking: true,
         ..CouplingSettings::default()
-    };
-    let mut scene = CoupledWorld::new(solver, coupling).expect("settings");
-    scene.physics.insert(
-        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
-        ColliderBuilder::cuboid(5.0, 0.5, 5.0),
-    );
+    });
     for i in 0..3 {
         soft_cube(
             &mut scene,

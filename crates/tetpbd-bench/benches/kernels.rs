@@ -25,7 +25,7 @@ use rapier3d::prelude::{SoftBodyCellModel, SoftBodySolver};
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::systems::{self, Kernel};
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings};
-use tetpbd_bench::{build_contact, ContactEngine, ContactScene};
+use tetpbd_bench::{build_contact, perturb, ContactEngine, ContactScene};
 
 /// Substep length of the projection sweeps, s.
 const H: f32 = 1.0 / 600.0;
@@ -42,18 +42,7 @@ fn perturbed(family: &str, cells: u32) -> (hecs::World, hecs::Entity, Vec<Vector
     let mut world = hecs::World::new();
     let e = b.build().expect("body").spawn(&mut world);
     let mut p = world.get::<&mut Particles>(e).expect("particles");
-    let mut s = 0x9E37_79B9_7F4A_7C15u64;
-    let cell = 1.0 / cells as f32;
-    for i in 0..p.len() {
-        let mut r = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            ((s >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 0.02 * cell
-        };
-        let x = p.positions()[i] + Vector3::new(r(), r(), r());
-        p.set_position(i, x).expect("finite");
-    }
+    perturb(&mut p, 1.0 / cells as f32).expect("finite");
     let original = p.positions().to_vec();
     drop(p);
     (world, e, original)

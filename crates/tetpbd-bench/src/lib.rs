@@ -10,6 +10,7 @@ mod clock;
 mod contact_metrics;
 mod contact_scene;
 mod contact_sim;
+mod perturb;
 mod rapier_setup;
 mod xpbd64;
 
@@ -21,6 +22,7 @@ pub use contact_metrics::{
 };
 pub use contact_scene::{ContactKind, ContactScene, GROUND_HALF_EXTENTS};
 pub use contact_sim::{build_contact, ContactEngine, ContactSim};
+pub use perturb::perturb;
 pub use rapier_setup::{
     lumped_masses, rapier_label, rapier_material, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON,
     RAPIER_YOUNG,

@@ -33,6 +33,7 @@ mod error;
 mod families;
 pub mod generators;
 mod lanes;
+mod level_order;
 pub mod locality;
 mod mesh;
 mod momentum;

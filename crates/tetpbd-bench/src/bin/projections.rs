@@ -18,7 +18,7 @@ use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, shuffled, CellSplit};
 use tetpbd::systems::{self, Kernel};
 use tetpbd::{Particles, SoftBodyBuilder};
-use tetpbd_bench::{arg, flag, orders};
+use tetpbd_bench::{arg, flag, orders, perturb};
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -61,18 +61,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // A deterministic perturbation of 1 % of the cell size.
         let original: Vec<Vector3<f32>> = {
             let mut p = world.get::<&mut Particles>(e)?;
-            let mut s = 0x9E37_79B9_7F4A_7C15u64;
-            let cell = 1.0 / cells as f32;
-            for i in 0..p.len() {
-                let mut r = || {
-                    s ^= s << 13;
-                    s ^= s >> 7;
-                    s ^= s << 17;
-                    ((s >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 0.02 * cell
-                };
-                let x = p.positions()[i] + Vector3::new(r(), r(), r());
-                p.set_position(i, x)?;
-            }
+            perturb(&mut p, 1.0 / cells as f32)?;
             p.positions().to_vec()
         };
         let mut samples = Vec::with_capacity(repeats);

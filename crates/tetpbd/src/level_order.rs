@@ -1,0 +1,196 @@
+//! The order of a ground-up sweep ([`crate::project_stacked`]) within one family: items
+//! (edges or tetrahedra) by level, each level in greedy colour classes so that the SIMD
+//! kernels run a class in lanes, and the per-sweep copies of the items' data in that order.
+
+/// Colour of the overflow class of a greedy colouring (its items may share particles).
+const OVERFLOW: usize = 63;
+
+/// One family's items (edges or tetrahedra) in sweep order: by level, and within a level
+/// in greedy colour classes (items of one class touch disjoint particles, so the SIMD
+/// kernels run them in lanes).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct LevelOrder {
+    /// Item indices, level by level, each level's items sorted by colour (stable).
+    pub(crate) order: Vec<u32>,
+    /// Start of each level's items in `order` (`starts[L - 1]..starts[L]` is level `L`).
+    pub(crate) starts: Vec<u32>,
+    /// Start of each colour class in `order`, then `order.len()`.
+    classes: Vec<u32>,
+    /// Per class: whether its items may share particles (the overflow colour).
+    dependent: Vec<bool>,
+    /// First class of each level `L ≥ 1` (index `L - 1`), then the class count.
+    level_classes: Vec<u32>,
+    /// Scratch: the items' colours.
+    colours: Vec<u8>,
+    /// Scratch: one level's items while they are sorted.
+    sorted: Vec<u32>,
+}
+
+impl LevelOrder {
+    /// Sorts the items of `levels` (the level of each item) into levels `1..=top` and each
+    /// level into greedy colour classes; `used` is a per-particle scratch of zeros (left
+    /// zero). Allocates only while its buffers grow past their capacity.
+    pub(crate) fn build<const N: usize>(
+        &mut self,
+        items: &[[u32; N]],
+        levels: impl Iterator<Item = u32> + Clone,
+        top: u32,
+        used: &mut [u64],
+    ) {
+        // Every buffer at its largest size on the first build, so that a later change of
+        // the roots (inside a step) does not allocate.
+        let n = items.len();
+        self.order.reserve(n);
+        self.colours.reserve(n);
+        self.sorted.reserve(n);
+        self.classes.reserve(n + 1);
+        self.dependent.reserve(n);
+        self.level_classes.reserve(n + 1);
+        self.starts.reserve(used.len() + 1);
+        bucket(levels, top, &mut self.order, &mut self.starts);
+        self.colours.clear();
+        self.colours.resize(self.order.len(), 0);
+        self.classes.clear();
+        self.dependent.clear();
+        self.level_classes.clear();
+        for l in 0..top as usize {
+            let (a, b) = (self.starts[l] as usize, self.starts[l + 1] as usize);
+            self.level_classes.push(self.classes.len() as u32);
+            let mut count = [0u32; OVERFLOW + 1];
+            for k in a..b {
+                let item = &items[self.order[k] as usize];
+                let mask = item.iter().fold(0u64, |m, &i| m | used[i as usize]);
+                let c = ((!mask).trailing_zeros() as usize).min(OVERFLOW);
+                for &i in item {
+                    used[i as usize] |= 1u64 << c;
+                }
+                self.colours[k] = c as u8;
+                count[c] += 1;
+            }
+            // Starts of the colours within the level, then a stable placement.
+            let mut next = [0u32; OVERFLOW + 1];
+            let mut at = a as u32;
+            for (c, &n) in count.iter().enumerate() {
+                next[c] = at;
+                if n > 0 {
+                    self.classes.push(at);
+                    self.dependent.push(c == OVERFLOW);
+                }
+                at += n;
+            }
+            self.sorted.clear();
+            self.sorted.resize(b - a, 0);
+            for k in a..b {
+                let c = self.colours[k] as usize;
+                self.sorted[next[c] as usize - a] = self.order[k];
+                next[c] += 1;
+            }
+            self.order[a..b].copy_from_slice(&self.sorted);
+            for &k in &self.order[a..b] {
+                for &i in &items[k as usize] {
+                    used[i as usize] = 0;
+                }
+            }
+        }
+        self.level_classes.push(self.classes.len() as u32);
+        self.classes.push(self.order.len() as u32);
+    }
+
+    /// The classes of level `l ≥ 1`: each as its range in `order` and whether it is
+    /// independent.
+    pub(crate) fn level(
+        &self,
+        l: u32,
+    ) -> impl Iterator<Item = (std::ops::Range<usize>, bool)> + '_ {
+        let l = l as usize;
+        let (a, b) = match (self.level_classes.get(l - 1), self.level_classes.get(l)) {
+            (Some(&a), Some(&b)) => (a as usize, b as usize),
+            _ => (0, 0),
+        };
+        (a..b).map(|k| {
+            (
+                self.classes[k] as usize..self.classes[k + 1] as usize,
+                !self.dependent[k],
+            )
+        })
+    }
+}
+
+/// Per-sweep copies of one family's data in sweep order (the SIMD kernels walk contiguous
+/// runs). Gathered before a sweep, multipliers scattered back after it.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Gathered<T: Clone + Default, R: Clone + Default> {
+    pub(crate) items: Vec<T>,
+    pub(crate) rest: Vec<R>,
+    pub(crate) lambdas: Vec<R>,
+}
+
+impl<T: Copy + Default, R: Copy + Default> Gathered<T, R> {
+    pub(crate) fn gather(&mut self, order: &[u32], items: &[T], rest: &[R], lambdas: &[R]) {
+        // Sized for every item of the family at once (no allocation when more are reached).
+        self.items.reserve(items.len());
+        self.rest.reserve(items.len());
+        self.lambdas.reserve(items.len());
+        let pick = |v: &[R], k: u32| v.get(k as usize).copied().unwrap_or_default();
+        self.items.clear();
+        self.items.extend(
+            order
+                .iter()
+                .map(|&k| items.get(k as usize).copied().unwrap_or_default()),
+        );
+        self.rest.clear();
+        self.rest.extend(order.iter().map(|&k| pick(rest, k)));
+        self.lambdas.clear();
+        self.lambdas.extend(order.iter().map(|&k| pick(lambdas, k)));
+    }
+
+    pub(crate) fn scatter(&self, order: &[u32], lambdas: &mut [R]) {
+        for (&k, &l) in order.iter().zip(&self.lambdas) {
+            if let Some(x) = lambdas.get_mut(k as usize) {
+                *x = l;
+            }
+        }
+    }
+}
+
+/// Counting sort of items by level `1..=top` (level 0 and unreached ones are dropped):
+/// `order` lists the items level by level, `starts[L - 1]..starts[L]` are those of level `L`.
+fn bucket(
+    levels: impl Iterator<Item = u32> + Clone,
+    top: u32,
+    order: &mut Vec<u32>,
+    starts: &mut Vec<u32>,
+) {
+    let top = top as usize;
+    starts.clear();
+    starts.resize(top + 1, 0);
+    for l in levels.clone().map(|l| l as usize) {
+        if (1..=top).contains(&l) {
+            starts[l] += 1;
+        }
+    }
+    for j in 0..top {
+        starts[j + 1] += starts[j];
+    }
+    order.clear();
+    order.resize(starts[top] as usize, 0);
+    // `starts[L - 1]` is level L's fill cursor; afterwards it holds level L + 1's start.
+    for (k, l) in levels.map(|l| l as usize).enumerate() {
+        if (1..=top).contains(&l) {
+            order[starts[l - 1] as usize] = k as u32;
+            starts[l - 1] += 1;
+        }
+    }
+    shift_starts(starts);
+}
+
+/// After a counting-sort fill that advanced each row's start to the next row's, moves the
+/// starts back one row (no scratch buffer: the pass runs inside a step).
+pub(crate) fn shift_starts(starts: &mut [u32]) {
+    for j in (1..starts.len()).rev() {
+        starts[j] = starts[j - 1];
+    }
+    if let Some(s) = starts.first_mut() {
+        *s = 0;
+    }
+}
