@@ -126,24 +126,27 @@ pub(crate) struct Gathered<T: Clone + Default, R: Clone + Default> {
 }
 
 impl<T: Copy + Default, R: Copy + Default> Gathered<T, R> {
-    pub(crate) fn gather(&mut self, order: &[u32], items: &[T], rest: &[R], lambdas: &[R]) {
+    /// Copies the items and their rest values in `order` (once per order: they do not
+    /// change while a body lives).
+    pub(crate) fn gather_items(&mut self, order: &[u32], items: &[T], rest: &[R]) {
         // Sized for every item of the family at once (no allocation when more are reached).
         self.items.reserve(items.len());
         self.rest.reserve(items.len());
-        self.lambdas.reserve(items.len());
-        let pick = |v: &[R], k: u32| v.get(k as usize).copied().unwrap_or_default();
         self.items.clear();
-        self.items.extend(
-            order
-                .iter()
-                .map(|&k| items.get(k as usize).copied().unwrap_or_default()),
-        );
+        self.items.extend(order.iter().map(|&k| pick(items, k)));
         self.rest.clear();
         self.rest.extend(order.iter().map(|&k| pick(rest, k)));
+    }
+
+    /// Copies the multipliers in `order` (before every sweep: they accumulate over the
+    /// substep's projections).
+    pub(crate) fn gather_lambdas(&mut self, order: &[u32], lambdas: &[R]) {
+        self.lambdas.reserve(lambdas.len());
         self.lambdas.clear();
         self.lambdas.extend(order.iter().map(|&k| pick(lambdas, k)));
     }
 
+    /// Copies the multipliers back (after a sweep).
     pub(crate) fn scatter(&self, order: &[u32], lambdas: &mut [R]) {
         for (&k, &l) in order.iter().zip(&self.lambdas) {
             if let Some(x) = lambdas.get_mut(k as usize) {
@@ -151,6 +154,11 @@ impl<T: Copy + Default, R: Copy + Default> Gathered<T, R> {
             }
         }
     }
+}
+
+/// `v[k]`, or the default value where `k` is out of range.
+fn pick<T: Copy + Default>(v: &[T], k: u32) -> T {
+    v.get(k as usize).copied().unwrap_or_default()
 }
 
 /// Counting sort of items by level `1..=top` (level 0 and unreached ones are dropped):

@@ -95,6 +95,9 @@ pub struct StackingLayers {
     volume_data: Gathered<[u32; 4], f32>,
     /// The roots' inverse masses while a sweep holds them.
     held: Vec<f32>,
+    /// Whether `edge_data` and `volume_data` hold the items and rest values of the
+    /// current order (the multipliers are copied at every sweep).
+    gathered: bool,
     /// Highest level reached.
     top: u32,
 }
@@ -156,6 +159,7 @@ impl StackingLayers {
             self.queue.push(r);
         }
         self.top = 0;
+        self.gathered = false;
         self.edges
             .build::<2>(&[], std::iter::empty(), 0, &mut self.used);
         self.tets
@@ -287,20 +291,23 @@ pub fn project_stacked(
         edge_data,
         volume_data,
         held,
+        gathered,
         top,
         ..
     } = layers;
     if let Some(e) = edges.as_deref() {
-        edge_data.gather(&edge_order.order, &e.edges, &e.rest_lengths, &e.lambdas);
+        if edge_data.items.len() != edge_order.order.len() || !*gathered {
+            edge_data.gather_items(&edge_order.order, &e.edges, &e.rest_lengths);
+        }
+        edge_data.gather_lambdas(&edge_order.order, &e.lambdas);
     }
     if let Some(v) = volume.as_deref() {
-        volume_data.gather(
-            &tet_order.order,
-            &tets.indices,
-            &tets.rest_volumes,
-            &v.lambdas,
-        );
+        if volume_data.items.len() != tet_order.order.len() || !*gathered {
+            volume_data.gather_items(&tet_order.order, &tets.indices, &tets.rest_volumes);
+        }
+        volume_data.gather_lambdas(&tet_order.order, &v.lambdas);
     }
+    *gathered = true;
     work::with_access(p, work::CopyMode::PerSweep, |acc| {
         // Hold the roots: inverse mass 0 for the sweep, restored after it.
         held.clear();

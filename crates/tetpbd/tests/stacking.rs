@@ -234,3 +234,63 @@ fn simd_sweep_agrees_with_the_scalar_reference() {
         );
     }
 }
+
+/// Layers kept across sweeps and changes of the roots (as the coupling keeps them) sweep
+/// exactly as layers built afresh for each set of roots.
+#[test]
+fn kept_layers_sweep_as_fresh_ones() {
+    let squashed = |world: &mut World| {
+        let (e, bottom) = column_of(world, "edges+volume", [2, 4, 2]);
+        let mut p = world.get::<&mut Particles>(e).unwrap();
+        for x in p.positions_mut() {
+            x.y *= 0.95;
+            x.x += 0.01 * x.y;
+        }
+        drop(p);
+        (e, bottom)
+    };
+    let mut kept_world = World::new();
+    let (a, bottom) = squashed(&mut kept_world);
+    let mut fresh_world = World::new();
+    let (b, _) = squashed(&mut fresh_world);
+    let root_sets = [bottom.clone(), bottom[..3].to_vec(), bottom.clone()];
+    let mut kept: Option<StackingLayers> = None;
+    for roots in &root_sets {
+        let (p, tets, edges, vol) = kept_world
+            .query_one_mut::<(
+                &mut Particles,
+                &Tetrahedra,
+                &mut EdgeConstraints,
+                &mut VolumeConstraints,
+            )>(a)
+            .unwrap();
+        let layers = kept.get_or_insert_with(|| StackingLayers::new(p.len(), tets));
+        layers.set_roots(tets, Some(edges), roots.iter().copied());
+        let families = BodyConstraints {
+            edges: Some(edges),
+            vertex_face: None,
+            volume: Some(vol),
+        };
+        project_stacked(
+            p,
+            tets,
+            families,
+            Family::ALL,
+            1.0 / 600.0,
+            layers,
+            Kernel::Simd,
+        );
+        sweep(&mut fresh_world, b, roots);
+    }
+    let x = kept_world
+        .get::<&Particles>(a)
+        .unwrap()
+        .positions()
+        .to_vec();
+    let y = fresh_world
+        .get::<&Particles>(b)
+        .unwrap()
+        .positions()
+        .to_vec();
+    assert_eq!(x, y);
+}
