@@ -50,7 +50,7 @@ pub struct CouplingSettings {
     /// stacking pass under its own weight too, not only under a heavy rigid load (default
     /// `false`). One Gauss–Seidel iteration per substep leaves a resting body sagging by a
     /// volume error that falls only as `h²`; the sweep carries the support's reaction to the
-    /// top within the substep and cuts that error by 4–50× (1 m cubes of 4³–12³ cells at 10
+    /// top within the substep and cuts that error by 4× or more (1 m cubes of 4³–12³ cells at 10
     /// substeps: 0.025–0.117 % → 0.000–0.030 %, `docs/performance.md`), at 1.7–2.0× the
     /// cost per frame (edges and volumes in SIMD lanes, vertex–face on the scalar kernel).
     /// Only the sweep runs; the frozen-surface contact pass and
