@@ -52,7 +52,7 @@ pub struct CouplingSettings {
     /// volume error that falls only as `h²`; the sweep carries the support's reaction to the
     /// top within the substep and cuts that error by 4× or more (1 m cubes of 4³–12³ cells at 10
     /// substeps: 0.025–0.117 % → 0.000–0.030 %, `docs/performance.md`), at 1.7–2.0× the
-    /// cost per frame (edges and volumes in SIMD lanes, vertex–face on the scalar kernel).
+    /// cost per frame (edges + volume, SIMD lanes).
     /// Only the sweep runs; the frozen-surface contact pass and
     /// velocity pass stay reserved for heavy loads. The sweep is one-way (the support acts
     /// as infinitely heavy), so leave it off for bodies that are not meant to rest.
@@ -250,8 +250,8 @@ impl<'a> RapierContext<'a> {
 ///   squashed less under it than a converged solve would squash it. On a slender soft
 ///   column (a 1000 kg box on a 1 kg column 0.6 m wide and 16 cells tall) the box is held
 ///   but rocks at up to 0.5 m/s after 3 s (`tests/issue_6_stacking_deep_bodies.rs`). The
-///   pass costs about one more sweep over the whole soft body per iteration (SIMD for
-///   edges and volumes, scalar for vertex–face; `tetpbd-bench --bin stacking`).
+///   pass costs about one more sweep over the whole soft body per iteration (SIMD lanes;
+///   `tetpbd-bench --bin stacking`).
 /// * A heavy soft body on a stack of supported rigid bodies keeps a small rocking motion
 ///   (a few cm/s), the one-frame lag between the soft load and rapier's answer.
 /// * The soft load pressing an anchored body onto its supports does not reach rapier: it

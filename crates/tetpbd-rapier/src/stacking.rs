@@ -51,9 +51,9 @@
 //! the velocity pass still run only under a heavy load, and only those count as stacked.
 //!
 //! Cost: per iteration of a stacked soft body, one breadth-first pass over its tetrahedra,
-//! about one more sweep over its constraints (each constraint at most once; edges and
-//! volumes in SIMD lanes, colour class by colour class within a level, vertex–face on the
-//! scalar kernel) and one more sweep over its contacts with dynamic bodies.
+//! about one more sweep over its constraints (each constraint at most once, in SIMD lanes,
+//! colour class by colour class within a level) and one more sweep over its contacts with
+//! dynamic bodies.
 
 use hecs::{Entity, World};
 use rapier3d::geometry::ColliderSet;

@@ -341,19 +341,22 @@ pub(crate) fn volumes<L: Lane, A: ParticleAccess>(
 
 /// The four vertex–face constraints of `L::WIDTH` tetrahedra from `at` of the run, the four
 /// one after another on all lanes, corrections accumulated in registers and scattered once.
-/// See [`projection::vertex_face`]: on healthy faces
+/// See [`projection::vertex_face_held`]: on healthy faces
 /// [`crate::constraint::vertex_face_bounded`] is the seed's height, which these lanes
 /// compute. A chunk of four with a face not healthy by a margin of 2 at its start
 /// (`|b × c| ≤ 2κQ`, κ = [`VERTEX_FACE_KAPPA`]) goes to the scalar kernel (a pair of chunks
 /// with one, to this kernel chunk by chunk); a lane whose face turns thin (`|b × c| < κQ`)
 /// within the chunk skips that projection and counts it as degenerate. Every projection's
 /// `Δλ` is bounded as in the scalar kernel ([`crate::constraint::bounded_step`] with
-/// [`crate::constraint::vertex_face_step_bound`]), lane by lane.
+/// [`crate::constraint::vertex_face_step_bound`]), lane by lane. `held` (one row of four
+/// 1/0 masks per tetrahedron of the run, or empty for all) leaves the constraints with 0
+/// alone, as [`projection::vertex_face_held`] does.
 #[inline(always)]
 pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
     bd: &mut Bounded<'_, A, 4>,
     at: usize,
     heights: &[[f32; 4]],
+    held: &[[f32; 4]],
     lambdas: &mut [[f32; 4]],
     alpha_tilde: f32,
 ) -> ProjectionCount {
@@ -372,15 +375,22 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
             let mut count = ProjectionCount::default();
             if L::WIDTH > LANES {
                 for c in (0..L::WIDTH).step_by(LANES) {
-                    count += vertex_faces::<f32x4, A>(bd, at + c, heights, lambdas, alpha_tilde);
+                    count +=
+                        vertex_faces::<f32x4, A>(bd, at + c, heights, held, lambdas, alpha_tilde);
                 }
                 return count;
             }
             let tets = chunk(bd.items(), at);
             for (l, &t) in tets.iter().enumerate() {
                 let k = at + l;
-                let (a, d) =
-                    projection::vertex_face(bd.acc(), t, &heights[k], &mut lambdas[k], alpha_tilde);
+                let (a, d) = projection::vertex_face_held(
+                    bd.acc(),
+                    t,
+                    &heights[k],
+                    &mut lambdas[k],
+                    alpha_tilde,
+                    projection::held_mask(held, k),
+                );
                 count.applied += u64::from(a);
                 count.degenerate += u64::from(d);
             }
@@ -391,6 +401,14 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
     // Per constraint k, the tetrahedra's heights and multipliers as lanes.
     let h: [L; 4] = transpose_rows(heights, at);
     let mut lam: [L; 4] = transpose_rows(lambdas, at);
+    // Per constraint k, 1 where it is projected, 0 where it is left alone (all held when
+    // the run has no masks).
+    let masked = !held.is_empty();
+    let mask: [L; 4] = if masked {
+        transpose_rows(held, at)
+    } else {
+        [L::ONE; 4]
+    };
     // The move bound, as in `constraint::vertex_face_step_bound`: a fraction of max_k |d_k|
     // (`√(d²) = |d|` exactly in IEEE arithmetic).
     let size = h.iter().fold(L::ZERO, |m, &d| m.vmax(d * d)).vsqrt();
@@ -423,6 +441,12 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
         let wo = [w[order[0]], w[order[1]], w[order[2]], w[order[3]]];
         let w_grad_sq = (0..4).fold(L::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
         let (dl, ok) = delta_lambda(na - h[k], lam[k], alpha, w_grad_sq);
+        let (dl, ok) = if masked {
+            let on = mask[k].vgt(L::ZERO);
+            (on.vsel(dl, L::ZERO), ok & on)
+        } else {
+            (dl, ok)
+        };
         let dl = bounded_step(valid.vsel(dl, L::ZERO), w_grad_sq, limit, max_step, w_max);
         let ok = ok & valid;
         lam[k] += dl;
@@ -430,7 +454,12 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
             dp[order[s]] = dp[order[s]].add(g[s].scale(wo[s] * dl));
         }
         count.applied += u64::from(ok.vbits().count_ones());
-        count.degenerate += u64::from((!valid.vbits() & all_lanes::<L>()).count_ones());
+        let counted = if masked {
+            mask[k].vgt(L::ZERO).vbits()
+        } else {
+            all_lanes::<L>()
+        };
+        count.degenerate += u64::from((!valid.vbits() & counted).count_ones());
     }
     untranspose_rows(lam, lambdas, at);
     for (k, d) in dp.into_iter().enumerate() {

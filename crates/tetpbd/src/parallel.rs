@@ -317,6 +317,7 @@ pub(crate) fn vertex_face(
             a,
             &tets.indices[r.clone()],
             &heights[r],
+            &[],
             lam,
             alpha_tilde,
             kernel,

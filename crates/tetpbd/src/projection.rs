@@ -128,24 +128,13 @@ pub(crate) fn edge<A: ParticleAccess>(
 
 /// The four vertex–face constraints of one tetrahedron, one after another, in the
 /// degeneracy-aware form [`constraint::vertex_face_bounded`] with
-/// [`constraint::VERTEX_FACE_KAPPA`]. A face collapsed to a point falls back to holding
-/// `p1` at its rest value above `p0` along the face's rest normal (linear in `p0`, `p1`;
-/// re-expands a collapsed tetrahedron). No projection moves a particle further than
-/// [`constraint::vertex_face_step_bound`] of the tetrahedron's rest values (bounded
+/// [`constraint::VERTEX_FACE_KAPPA`]; only the constraints `k` with `held[k]` (constraint `k`
+/// holds vertex `tet[VERTEX_FACE_ORDER[k][1]]` above the face of the other three; all four
+/// in an ordinary sweep), the others are left alone. A face collapsed to a point falls back
+/// to holding `p1` at its rest value above `p0` along the face's rest normal (linear in
+/// `p0`, `p1`; re-expands a collapsed tetrahedron). No projection moves a particle further
+/// than [`constraint::vertex_face_step_bound`] of the tetrahedron's rest values (bounded
 /// corrections: [`constraint::bounded_step`]).
-#[inline(always)]
-pub(crate) fn vertex_face<A: ParticleAccess>(
-    acc: &mut A,
-    tet: [u32; 4],
-    rest_heights: &[f32; 4],
-    lambdas: &mut [f32; 4],
-    alpha_tilde: f32,
-) -> (u32, u32) {
-    vertex_face_held(acc, tet, rest_heights, lambdas, alpha_tilde, |_| true)
-}
-
-/// [`vertex_face`] for the constraints whose held vertex (`p1`, a particle index) passes
-/// `held`; the others are left alone.
 #[inline(always)]
 pub(crate) fn vertex_face_held<A: ParticleAccess>(
     acc: &mut A,
@@ -153,15 +142,15 @@ pub(crate) fn vertex_face_held<A: ParticleAccess>(
     rest_heights: &[f32; 4],
     lambdas: &mut [f32; 4],
     alpha_tilde: f32,
-    held: impl Fn(usize) -> bool,
+    held: [bool; 4],
 ) -> (u32, u32) {
     let (mut applied, mut degenerate) = (0, 0);
     let max_step = constraint::vertex_face_step_bound(rest_heights);
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
-        let idx = order.map(|o| tet[o] as usize);
-        if !held(idx[1]) {
+        if !held[k] {
             continue;
         }
+        let idx = order.map(|o| tet[o] as usize);
         let p = idx.map(|i| acc.x(i));
         match constraint::vertex_face_bounded(
             &p[0],
@@ -212,4 +201,11 @@ pub(crate) fn volume<A: ParticleAccess>(
     } else {
         Outcome::Skipped
     }
+}
+
+/// Constraint `k`'s entry of a run's held masks (`1.0` held, `0.0` left alone; an empty
+/// slice holds every constraint), as [`vertex_face_held`] takes it.
+#[inline(always)]
+pub(crate) fn held_mask(held: &[[f32; 4]], k: usize) -> [bool; 4] {
+    held.get(k).map_or([true; 4], |h| h.map(|x| x > 0.0))
 }

@@ -27,13 +27,13 @@
 //!
 //! Within a level the order is free, so each level's edges and tetrahedra are sorted into
 //! greedy colour classes when the levels are built (items of one class share no particle),
-//! and the edge and volume constraints run through the same SIMD kernels as the ordinary
-//! sweep, four or eight at a time (on a 1 m cube of 8³ cells 97 % of the edges and 93 % of
-//! the tetrahedra fall in full lanes). The kernels walk contiguous runs, so the sweep copies
-//! the families' indices, rest values and multipliers into level order before it and the
-//! multipliers back after it. The vertex–face constraints of a level stay on the scalar
-//! kernel, one vertex at a time (only the level's own vertices are held above their faces).
-//! The roots are held by an inverse mass of 0 in the working copy for the length of the
+//! and every family runs through the same SIMD kernels as the ordinary sweep, four or eight
+//! at a time (on a 1 m cube of 8³ cells 97 % of the edges and 93 % of the tetrahedra fall in
+//! full lanes). The kernels walk contiguous runs, so the sweep copies the families' indices
+//! and rest values into level order when the order changes, and the multipliers before and
+//! after every sweep. Of a tetrahedron's four vertex–face constraints only those holding a
+//! vertex of the tetrahedron's level run: a mask per constraint, built with the levels, that
+//! the kernel applies lane by lane. The roots are held by an inverse mass of 0 in the working copy for the length of the
 //! sweep. The scalar kernel in the same order is the reference (`tests/stacking.rs`).
 //!
 //! Why the levels above the roots are not frozen too, as shock propagation freezes the
@@ -56,11 +56,11 @@
 //! (the rapier coupling runs it for a soft body on an immovable support that carries a much
 //! heavier rigid body).
 
+use crate::constraint::VERTEX_FACE_ORDER;
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::level_order::{shift_starts, Gathered, LevelOrder};
 use crate::mesh::Tetrahedra;
 use crate::particles::Particles;
-use crate::projection;
 use crate::runs;
 use crate::stats::Family;
 use crate::systems::{Kernel, ProjectionCount};
@@ -90,9 +90,13 @@ pub struct StackingLayers {
     /// Edges and tetrahedra in sweep order.
     edges: LevelOrder,
     tets: LevelOrder,
-    /// Per-sweep data of the edge and volume families in sweep order.
+    /// Per-sweep data of the edge, vertex–face and volume families in sweep order.
     edge_data: Gathered<[u32; 2], f32>,
+    vertex_face_data: Gathered<[u32; 4], [f32; 4]>,
     volume_data: Gathered<[u32; 4], f32>,
+    /// Per tetrahedron in sweep order, per vertex–face constraint: 1 where it holds a vertex
+    /// of the tetrahedron's own level, 0 otherwise.
+    vf_held: Vec<[f32; 4]>,
     /// The roots' inverse masses while a sweep holds them.
     held: Vec<f32>,
     /// Whether `edge_data` and `volume_data` hold the items and rest values of the
@@ -195,6 +199,20 @@ impl StackingLayers {
             top,
             &mut self.used,
         );
+        self.vf_held.reserve(tets.len());
+        self.vf_held.clear();
+        for l in 1..=top {
+            let (a, b) = (
+                self.tets.starts[l as usize - 1],
+                self.tets.starts[l as usize],
+            );
+            for &t in &self.tets.order[a as usize..b as usize] {
+                let tet = tets.indices()[t as usize];
+                let held =
+                    VERTEX_FACE_ORDER.map(|o| f32::from(u8::from(level[tet[o[1]] as usize] == l)));
+                self.vf_held.push(held);
+            }
+        }
         if let Some(e) = edges {
             self.edges.build(
                 &e.edges,
@@ -259,12 +277,12 @@ pub struct BodyConstraints<'a> {
 /// compliances and the substep length `h` (s); multipliers accumulate with the substep's
 /// other projections.
 ///
-/// Within a level, edges and volume constraints run colour class by colour class with
-/// `kernel` ([`Kernel::Simd`]: four or eight independent projections at once, the overflow
-/// class and each class's remainder on the scalar kernel; [`Kernel::Scalar`]: the same order
-/// one by one, the reference). The level's vertex–face constraints run on the scalar kernel
-/// (only the heights of the level's own vertices are projected). The roots are held by
-/// setting their inverse mass to 0 in the working copy for the sweep.
+/// Within a level, each family runs colour class by colour class with `kernel`
+/// ([`Kernel::Simd`]: four or eight independent projections at once, the overflow class and
+/// each class's remainder on the scalar kernel; [`Kernel::Scalar`]: the same order one by
+/// one, the reference). Of the vertex–face constraints only the heights of the level's own
+/// vertices are projected. The roots are held by setting their inverse mass to 0 in the
+/// working copy for the sweep.
 pub fn project_stacked(
     p: &mut Particles,
     tets: &Tetrahedra,
@@ -280,16 +298,17 @@ pub fn project_stacked(
     }
     let BodyConstraints {
         edges,
-        mut vertex_face,
+        vertex_face,
         volume,
     } = families;
     let StackingLayers {
-        level,
         roots,
         edges: edge_order,
         tets: tet_order,
         edge_data,
+        vertex_face_data,
         volume_data,
+        vf_held,
         held,
         gathered,
         top,
@@ -300,6 +319,12 @@ pub fn project_stacked(
             edge_data.gather_items(&edge_order.order, &e.edges, &e.rest_lengths);
         }
         edge_data.gather_lambdas(&edge_order.order, &e.lambdas);
+    }
+    if let Some(v) = vertex_face.as_deref() {
+        if vertex_face_data.items.len() != tet_order.order.len() || !*gathered {
+            vertex_face_data.gather_items(&tet_order.order, &tets.indices, &v.rest_heights);
+        }
+        vertex_face_data.gather_lambdas(&tet_order.order, &v.lambdas);
     }
     if let Some(v) = volume.as_deref() {
         if volume_data.items.len() != tet_order.order.len() || !*gathered {
@@ -338,30 +363,25 @@ pub fn project_stacked(
                         }
                     }
                     Family::VertexFace => {
-                        let Some(vf) = vertex_face.as_deref_mut() else {
+                        let Some(vf) = vertex_face.as_deref() else {
                             continue;
                         };
                         let alpha_tilde = vf.compliance / (h * h);
-                        let (a, b) = (
-                            tet_order.starts[l as usize - 1],
-                            tet_order.starts[l as usize],
-                        );
-                        for &t in &tet_order.order[a as usize..b as usize] {
-                            let t = t as usize;
-                            // Only a vertex of this level is held above its face: moving a
-                            // face alone to hold a root is ill-conditioned (the
-                            // height barely depends on a face point whose opposite edge
-                            // passes under the vertex) and blew the slab up.
-                            let (ap, d) = projection::vertex_face_held(
+                        // Only a vertex of this level is held above its face (`vf_held`):
+                        // moving a face alone to hold a root is ill-conditioned (the height
+                        // barely depends on a face point whose opposite edge passes under
+                        // the vertex) and blew the slab up.
+                        for (r, independent) in tet_order.level(l) {
+                            count += runs::vertex_face_run(
                                 acc,
-                                tets.indices[t],
-                                &vf.rest_heights[t],
-                                &mut vf.lambdas[t],
+                                &vertex_face_data.items[r.clone()],
+                                &vertex_face_data.rest[r.clone()],
+                                &vf_held[r.clone()],
+                                &mut vertex_face_data.lambdas[r],
                                 alpha_tilde,
-                                |i| level[i] == l,
+                                kernel,
+                                independent,
                             );
-                            count.applied += u64::from(ap);
-                            count.degenerate += u64::from(d);
                         }
                     }
                     Family::Volume => {
@@ -392,6 +412,9 @@ pub fn project_stacked(
     });
     if let Some(e) = edges {
         edge_data.scatter(&edge_order.order, &mut e.lambdas);
+    }
+    if let Some(v) = vertex_face {
+        vertex_face_data.scatter(&tet_order.order, &mut v.lambdas);
     }
     if let Some(v) = volume {
         volume_data.scatter(&tet_order.order, &mut v.lambdas);

@@ -286,7 +286,7 @@ fn vertex_faces_of(
             &vf.rest_heights[r.clone()],
             &mut vf.lambdas[r],
         );
-        count += vertex_face_run(acc, t, hgt, lam, alpha_tilde, kernel, independent);
+        count += vertex_face_run(acc, t, hgt, &[], lam, alpha_tilde, kernel, independent);
     }
     count
 }

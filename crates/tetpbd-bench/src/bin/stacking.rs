@@ -3,8 +3,10 @@
 //! ground, for slabs of increasing resolution, at the default 10 substeps × 1 iteration.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --bin stacking [-- --frames F]
+//! cargo run --release -p tetpbd-bench --bin stacking [-- --frames F] [--vertex-face]
 //! ```
+//!
+//! `--vertex-face`: the slab with vertex–face + edges constraints instead of edges + volume.
 //!
 //! Prints, per slab, medians over the measured frames (after 60 frames of settling): ms per
 //! coupled frame, ms of it spent in the stacking passes (`CouplingStats::stacking_time`),
@@ -16,7 +18,7 @@ use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{SoftBodyBuilder, SolverSettings};
-use tetpbd_bench::arg;
+use tetpbd_bench::{arg, flag};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider};
 
 /// What one run measured.
@@ -33,7 +35,12 @@ fn median(v: &mut [f64]) -> f64 {
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
-fn run(cells: [u32; 3], ratio: f32, frames: usize) -> Result<Run, Box<dyn std::error::Error>> {
+fn run(
+    cells: [u32; 3],
+    ratio: f32,
+    frames: usize,
+    vertex_face: bool,
+) -> Result<Run, Box<dyn std::error::Error>> {
     let settings = CouplingSettings {
         stacking_mass_ratio: ratio,
         ..CouplingSettings::default()
@@ -46,12 +53,16 @@ fn run(cells: [u32; 3], ratio: f32, frames: usize) -> Result<Run, Box<dyn std::e
     let size = Vector3::new(2.0, 0.4, 2.0);
     let mesh = box_grid(size, cells, CellSplit::Six)?;
     let tets = mesh.tets.len();
-    let body = SoftBodyBuilder::new(mesh)
+    let b = SoftBodyBuilder::new(mesh)
         .density(1.0 / (size.x * size.y * size.z))
         .edges(0.0)
-        .volume(0.0)
-        .translation(Vector3::new(0.0, 0.2 + 0.003, 0.0))
-        .build()?;
+        .translation(Vector3::new(0.0, 0.2 + 0.003, 0.0));
+    let body = if vertex_face {
+        b.vertex_face(0.0)
+    } else {
+        b.volume(0.0)
+    }
+    .build()?;
     let e = body.spawn(&mut s.soft);
     s.soft.insert_one(e, SoftCollider::default())?;
     let (rb, _) = s.physics.insert(
@@ -84,6 +95,7 @@ fn run(cells: [u32; 3], ratio: f32, frames: usize) -> Result<Run, Box<dyn std::e
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames = arg("--frames", 120);
+    let vertex_face = flag("--vertex-face");
     println!(
         "| slab cells | tetrahedra | ms/frame | of it stacking, ms | passes/frame | box bottom, m | pass off: ms/frame | pass off: box bottom, m |"
     );
@@ -93,8 +105,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             cells,
             CouplingSettings::default().stacking_mass_ratio,
             frames,
+            vertex_face,
         )?;
-        let off = run(cells, f32::INFINITY, frames)?;
+        let off = run(cells, f32::INFINITY, frames, vertex_face)?;
         println!(
             "| {}×{}×{} | {} | {:.3} | {:.3} ({:.0} %) | {:.0} | {:.3} | {:.3} | {:.3} |",
             cells[0],
