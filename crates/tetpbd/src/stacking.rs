@@ -275,7 +275,8 @@ pub struct BodyConstraints<'a> {
 /// last [`StackingLayers::set_roots`] for this body: for each level `L ≥ 1`, the constraints
 /// of level `L` in the family `order`, the roots held. XPBD with the families'
 /// compliances and the substep length `h` (s); multipliers accumulate with the substep's
-/// other projections.
+/// other projections. Does nothing when no root reaches the body or the layers were built
+/// for another body ([`StackingLayers::fits`]).
 ///
 /// Within a level, each family runs colour class by colour class with `kernel`
 /// ([`Kernel::Simd`]: four or eight independent projections at once, the overflow class and
@@ -293,7 +294,7 @@ pub fn project_stacked(
     kernel: Kernel,
 ) -> ProjectionCount {
     let mut count = ProjectionCount::default();
-    if layers.top == 0 || layers.level.len() != p.len() {
+    if layers.top == 0 || !layers.fits(p.len(), tets) {
         return count;
     }
     let BodyConstraints {

@@ -294,3 +294,48 @@ fn kept_layers_sweep_as_fresh_ones() {
         .to_vec();
     assert_eq!(x, y);
 }
+
+/// Layers built for another body (other particle and tetrahedron counts) leave the body
+/// alone.
+#[test]
+fn layers_of_another_body_do_nothing() {
+    let mut world = World::new();
+    let (a, bottom) = column_of(&mut world, "edges+volume", [2, 3, 2]);
+    let (b, _) = column_of(&mut world, "edges+volume", [2, 2, 2]);
+    let mut layers = {
+        let (p, tets, edges) = world
+            .query_one_mut::<(&Particles, &Tetrahedra, &EdgeConstraints)>(a)
+            .unwrap();
+        let mut l = StackingLayers::new(p.len(), tets);
+        assert!(l.set_roots(tets, Some(edges), bottom.iter().copied()) > 0);
+        l
+    };
+    let (p, tets, edges, vol) = world
+        .query_one_mut::<(
+            &mut Particles,
+            &Tetrahedra,
+            &mut EdgeConstraints,
+            &mut VolumeConstraints,
+        )>(b)
+        .unwrap();
+    for x in p.positions_mut() {
+        x.y *= 0.9;
+    }
+    let before = p.positions().to_vec();
+    let families = BodyConstraints {
+        edges: Some(edges),
+        vertex_face: None,
+        volume: Some(vol),
+    };
+    let count = project_stacked(
+        p,
+        tets,
+        families,
+        Family::ALL,
+        1.0 / 600.0,
+        &mut layers,
+        Kernel::Simd,
+    );
+    assert_eq!(count.applied, 0);
+    assert_eq!(p.positions(), &before[..]);
+}
