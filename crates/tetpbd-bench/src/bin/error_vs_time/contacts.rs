@@ -76,6 +76,10 @@ fn engines(scene: &ContactScene, quick: bool) -> Vec<ContactEngine> {
             damping: 0.0,
             self_weight: false,
         },
+        ContactEngine::Tetpbd {
+            damping: 0.0,
+            self_weight: true,
+        },
         ContactEngine::Rapier {
             cell: SoftBodyCellModel::Volume,
             solver: SoftBodySolver::Constraints,

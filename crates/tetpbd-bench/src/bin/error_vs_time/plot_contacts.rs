@@ -38,7 +38,11 @@ fn engines(rows: &[ContactRow]) -> Vec<ContactEngine> {
 }
 
 fn color(e: &ContactEngine, k: usize) -> RGBColor {
-    const OURS: [RGBColor; 2] = [RGBColor(0, 90, 200), RGBColor(0, 150, 150)];
+    const OURS: [RGBColor; 3] = [
+        RGBColor(0, 90, 200),
+        RGBColor(0, 150, 150),
+        RGBColor(20, 160, 40),
+    ];
     const RAPIER: [RGBColor; 3] = [
         RGBColor(200, 0, 0),
         RGBColor(150, 0, 150),
@@ -77,7 +81,7 @@ fn draw_on<DB: DrawingBackend>(
         "Contact scenes, tetpbd vs rapier 0.36 soft bodies (frame 1/60 s, 1 thread; log-log)",
         ("sans-serif", 26),
     )?;
-    let (main, legend) = root.split_horizontally(SIZE.0 - 360);
+    let (main, legend) = root.split_horizontally(SIZE.0 - 440);
     let all = engines(rows);
     let (mut o, mut r) = (0, 0);
     let colors: Vec<RGBColor> = all
