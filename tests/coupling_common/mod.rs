@@ -8,7 +8,9 @@ use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, ColliderHandle, RigidBodyBuilder, RigidBodyHandle};
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings, Tetrahedra};
-use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider, SoftColliderBuilder};
+use tetpbd_rapier::{
+    CoupledWorld, CouplingSettings, CouplingStats, SoftCollider, SoftColliderBuilder,
+};
 
 /// Compliances of (edges, vertex–face, volume), `None` for a family the body does not have.
 pub type Families = (Option<f32>, Option<f32>, Option<f32>);
@@ -135,6 +137,24 @@ pub fn run(scene: &mut CoupledWorld, frames: usize, tail: usize) -> f32 {
         }
     }
     pen
+}
+
+/// Steps one frame of `scene` (frame number `frame`, for the messages), asserting that no
+/// particle state was reset for being non-finite and that soft body `e` moves at a finite
+/// speed; returns the frame's statistics and `e`'s largest particle speed, m/s.
+pub fn step_checked(scene: &mut CoupledWorld, e: Entity, frame: usize) -> (CouplingStats, f32) {
+    let stats = scene.step().expect("step");
+    assert_eq!(
+        stats.soft.non_finite_resets, 0,
+        "frame {frame}: non-finite reset"
+    );
+    let v = scene
+        .soft
+        .get::<&Particles>(e)
+        .expect("soft body")
+        .max_speed();
+    assert!(v.is_finite(), "frame {frame}: non-finite particle speed");
+    (stats, v)
 }
 
 /// Particles of a soft body (cloned).

@@ -2,8 +2,10 @@
 //! (edges or tetrahedra) by level, each level in greedy colour classes so that the SIMD
 //! kernels run a class in lanes, and the per-sweep copies of the items' data in that order.
 
+use crate::ordering::{greedy_colour, OVERFLOW_COLOUR};
+
 /// Colour of the overflow class of a greedy colouring (its items may share particles).
-const OVERFLOW: usize = 63;
+const OVERFLOW: usize = OVERFLOW_COLOUR as usize;
 
 /// One family's items (edges or tetrahedra) in sweep order: by level, and within a level
 /// in greedy colour classes (items of one class touch disjoint particles, so the SIMD
@@ -58,14 +60,9 @@ impl LevelOrder {
             self.level_classes.push(self.classes.len() as u32);
             let mut count = [0u32; OVERFLOW + 1];
             for k in a..b {
-                let item = &items[self.order[k] as usize];
-                let mask = item.iter().fold(0u64, |m, &i| m | used[i as usize]);
-                let c = ((!mask).trailing_zeros() as usize).min(OVERFLOW);
-                for &i in item {
-                    used[i as usize] |= 1u64 << c;
-                }
-                self.colours[k] = c as u8;
-                count[c] += 1;
+                let c = greedy_colour(&items[self.order[k] as usize], used);
+                self.colours[k] = c;
+                count[c as usize] += 1;
             }
             // Starts of the colours within the level, then a stable placement.
             let mut next = [0u32; OVERFLOW + 1];
@@ -126,24 +123,33 @@ pub(crate) struct Gathered<T: Clone + Default, R: Clone + Default> {
 }
 
 impl<T: Copy + Default, R: Copy + Default> Gathered<T, R> {
-    /// Copies the items and their rest values in `order` (once per order: they do not
-    /// change while a body lives).
-    pub(crate) fn gather_items(&mut self, order: &[u32], items: &[T], rest: &[R]) {
-        // Sized for every item of the family at once (no allocation when more are reached).
-        self.items.reserve(items.len());
-        self.rest.reserve(items.len());
-        self.items.clear();
-        self.items.extend(order.iter().map(|&k| pick(items, k)));
-        self.rest.clear();
-        self.rest.extend(order.iter().map(|&k| pick(rest, k)));
-    }
-
-    /// Copies the multipliers in `order` (before every sweep: they accumulate over the
-    /// substep's projections).
-    pub(crate) fn gather_lambdas(&mut self, order: &[u32], lambdas: &[R]) {
+    /// Copies the family's data in `order`: the items and their rest values when `fresh`
+    /// is false or the copies are not of `order`'s length (they do not change while a body
+    /// lives, so once per order), the multipliers always (they accumulate over the
+    /// substep's projections). Returns whether the items were copied.
+    pub(crate) fn gather(
+        &mut self,
+        order: &[u32],
+        items: &[T],
+        rest: &[R],
+        lambdas: &[R],
+        fresh: bool,
+    ) -> bool {
+        let copy_items = !fresh || self.items.len() != order.len();
+        if copy_items {
+            // Sized for every item of the family at once (no allocation when more are
+            // reached).
+            self.items.reserve(items.len());
+            self.rest.reserve(items.len());
+            self.items.clear();
+            self.items.extend(order.iter().map(|&k| pick(items, k)));
+            self.rest.clear();
+            self.rest.extend(order.iter().map(|&k| pick(rest, k)));
+        }
         self.lambdas.reserve(lambdas.len());
         self.lambdas.clear();
         self.lambdas.extend(order.iter().map(|&k| pick(lambdas, k)));
+        copy_items
     }
 
     /// Copies the multipliers back (after a sweep).

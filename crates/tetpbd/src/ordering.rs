@@ -16,15 +16,24 @@ pub fn greedy_colours<const N: usize>(items: &[[u32; N]], particles: usize) -> V
     let mut used = vec![0u64; particles];
     items
         .iter()
-        .map(|item| {
-            let mask = item.iter().fold(0u64, |m, &i| m | used[i as usize]);
-            let colour = (!mask).trailing_zeros().min(63);
-            for &i in item {
-                used[i as usize] |= 1u64 << colour;
-            }
-            colour as u8
-        })
+        .map(|item| greedy_colour(item, &mut used))
         .collect()
+}
+
+/// The last colour of a greedy colouring: items that found every lower colour taken share
+/// it, so its class may hold items with a common particle (it runs one item after another).
+pub(crate) const OVERFLOW_COLOUR: u8 = 63;
+
+/// The colour of one item in a greedy colouring: the lowest colour (at most 63) none of its
+/// particles has used yet, marked as used in `used` (one bit per colour and particle).
+#[inline]
+pub(crate) fn greedy_colour(item: &[u32], used: &mut [u64]) -> u8 {
+    let mask = item.iter().fold(0u64, |m, &i| m | used[i as usize]);
+    let colour = (!mask).trailing_zeros().min(u32::from(OVERFLOW_COLOUR));
+    for &i in item {
+        used[i as usize] |= 1u64 << colour;
+    }
+    colour as u8
 }
 
 /// Items sorted into colour classes, and the classes grouped into the tasks and phases of a
@@ -146,6 +155,6 @@ pub fn colour_order<const N: usize>(
         }
     }
     starts.push(items.len() as u32);
-    let overflow = last == Some(63);
+    let overflow = last == Some(OVERFLOW_COLOUR);
     (order, ColourClasses::plain(starts, overflow))
 }

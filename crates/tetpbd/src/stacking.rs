@@ -95,7 +95,7 @@ pub struct StackingLayers {
     vertex_face_data: Gathered<[u32; 4], [f32; 4]>,
     volume_data: Gathered<[u32; 4], f32>,
     /// Per tetrahedron in sweep order, per vertex–face constraint: 1 where it holds a vertex
-    /// of the tetrahedron's own level, 0 otherwise.
+    /// of the tetrahedron's own level, 0 otherwise (built with the vertex–face copies).
     vf_held: Vec<[f32; 4]>,
     /// The roots' inverse masses while a sweep holds them.
     held: Vec<f32>,
@@ -199,20 +199,6 @@ impl StackingLayers {
             top,
             &mut self.used,
         );
-        self.vf_held.reserve(tets.len());
-        self.vf_held.clear();
-        for l in 1..=top {
-            let (a, b) = (
-                self.tets.starts[l as usize - 1],
-                self.tets.starts[l as usize],
-            );
-            for &t in &self.tets.order[a as usize..b as usize] {
-                let tet = tets.indices()[t as usize];
-                let held =
-                    VERTEX_FACE_ORDER.map(|o| f32::from(u8::from(level[tet[o[1]] as usize] == l)));
-                self.vf_held.push(held);
-            }
-        }
         if let Some(e) = edges {
             self.edges.build(
                 &e.edges,
@@ -261,6 +247,33 @@ impl StackingLayers {
     }
 }
 
+/// The held masks of the vertex–face constraints in sweep order (`StackingLayers::vf_held`):
+/// constraint `k` of a tetrahedron of level `L` runs when its held vertex has level `L`.
+fn held_masks(
+    masks: &mut Vec<[f32; 4]>,
+    order: &LevelOrder,
+    tets: &[[u32; 4]],
+    level: &[u32],
+    top: u32,
+) {
+    masks.reserve(tets.len());
+    masks.clear();
+    for l in 1..=top {
+        let (a, b) = (order.starts[l as usize - 1], order.starts[l as usize]);
+        for &t in &order.order[a as usize..b as usize] {
+            let tet = tets[t as usize];
+            let on = |o: [usize; 4]| {
+                if level[tet[o[1]] as usize] == l {
+                    1.0
+                } else {
+                    0.0
+                }
+            };
+            masks.push(VERTEX_FACE_ORDER.map(on));
+        }
+    }
+}
+
 /// The constraint families of one body, as [`project_stacked`] borrows them.
 pub struct BodyConstraints<'a> {
     /// Edge distance constraints, if the body has them.
@@ -303,6 +316,7 @@ pub fn project_stacked(
         volume,
     } = families;
     let StackingLayers {
+        level,
         roots,
         edges: edge_order,
         tets: tet_order,
@@ -316,22 +330,18 @@ pub fn project_stacked(
         ..
     } = layers;
     if let Some(e) = edges.as_deref() {
-        if edge_data.items.len() != edge_order.order.len() || !*gathered {
-            edge_data.gather_items(&edge_order.order, &e.edges, &e.rest_lengths);
-        }
-        edge_data.gather_lambdas(&edge_order.order, &e.lambdas);
+        let o = &edge_order.order;
+        edge_data.gather(o, &e.edges, &e.rest_lengths, &e.lambdas, *gathered);
     }
     if let Some(v) = vertex_face.as_deref() {
-        if vertex_face_data.items.len() != tet_order.order.len() || !*gathered {
-            vertex_face_data.gather_items(&tet_order.order, &tets.indices, &v.rest_heights);
+        let o = &tet_order.order;
+        if vertex_face_data.gather(o, &tets.indices, &v.rest_heights, &v.lambdas, *gathered) {
+            held_masks(vf_held, tet_order, &tets.indices, level, *top);
         }
-        vertex_face_data.gather_lambdas(&tet_order.order, &v.lambdas);
     }
     if let Some(v) = volume.as_deref() {
-        if volume_data.items.len() != tet_order.order.len() || !*gathered {
-            volume_data.gather_items(&tet_order.order, &tets.indices, &tets.rest_volumes);
-        }
-        volume_data.gather_lambdas(&tet_order.order, &v.lambdas);
+        let o = &tet_order.order;
+        volume_data.gather(o, &tets.indices, &tets.rest_volumes, &v.lambdas, *gathered);
     }
     *gathered = true;
     work::with_access(p, work::CopyMode::PerSweep, |acc| {

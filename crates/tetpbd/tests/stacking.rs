@@ -84,6 +84,18 @@ fn sweep(world: &mut World, e: hecs::Entity, bottom: &[u32]) {
 
 /// [`sweep`] with the given kernel.
 fn sweep_with(world: &mut World, e: hecs::Entity, bottom: &[u32], kernel: Kernel) {
+    sweep_kept(world, e, bottom, kernel, &mut None);
+}
+
+/// [`sweep_with`] on the layers in `kept` (built there on the first call), as a caller
+/// that keeps them across sweeps does.
+fn sweep_kept(
+    world: &mut World,
+    e: hecs::Entity,
+    bottom: &[u32],
+    kernel: Kernel,
+    kept: &mut Option<StackingLayers>,
+) {
     let (p, tets, edges, vf, vol) = world
         .query_one_mut::<(
             &mut Particles,
@@ -93,7 +105,7 @@ fn sweep_with(world: &mut World, e: hecs::Entity, bottom: &[u32], kernel: Kernel
             Option<&mut VolumeConstraints>,
         )>(e)
         .unwrap();
-    let mut layers = StackingLayers::new(p.len(), tets);
+    let layers = kept.get_or_insert_with(|| StackingLayers::new(p.len(), tets));
     layers.set_roots(tets, edges.as_deref(), bottom.iter().copied());
     project_stacked(
         p,
@@ -105,7 +117,7 @@ fn sweep_with(world: &mut World, e: hecs::Entity, bottom: &[u32], kernel: Kernel
         },
         Family::ALL,
         1.0 / 600.0,
-        &mut layers,
+        layers,
         kernel,
     );
 }
@@ -239,60 +251,39 @@ fn simd_sweep_agrees_with_the_scalar_reference() {
 /// exactly as layers built afresh for each set of roots.
 #[test]
 fn kept_layers_sweep_as_fresh_ones() {
-    let squashed = |world: &mut World| {
-        let (e, bottom) = column_of(world, "edges+volume", [2, 4, 2]);
-        let mut p = world.get::<&mut Particles>(e).unwrap();
-        for x in p.positions_mut() {
-            x.y *= 0.95;
-            x.x += 0.01 * x.y;
-        }
-        drop(p);
-        (e, bottom)
-    };
-    let mut kept_world = World::new();
-    let (a, bottom) = squashed(&mut kept_world);
-    let mut fresh_world = World::new();
-    let (b, _) = squashed(&mut fresh_world);
-    let root_sets = [bottom.clone(), bottom[..3].to_vec(), bottom.clone()];
-    let mut kept: Option<StackingLayers> = None;
-    for roots in &root_sets {
-        let (p, tets, edges, vol) = kept_world
-            .query_one_mut::<(
-                &mut Particles,
-                &Tetrahedra,
-                &mut EdgeConstraints,
-                &mut VolumeConstraints,
-            )>(a)
-            .unwrap();
-        let layers = kept.get_or_insert_with(|| StackingLayers::new(p.len(), tets));
-        layers.set_roots(tets, Some(edges), roots.iter().copied());
-        let families = BodyConstraints {
-            edges: Some(edges),
-            vertex_face: None,
-            volume: Some(vol),
+    for families in ["edges+volume", "vertex-face+edges"] {
+        let squashed = |world: &mut World| {
+            let (e, bottom) = column_of(world, families, [2, 4, 2]);
+            let mut p = world.get::<&mut Particles>(e).unwrap();
+            for x in p.positions_mut() {
+                x.y *= 0.95;
+                x.x += 0.01 * x.y;
+            }
+            drop(p);
+            (e, bottom)
         };
-        project_stacked(
-            p,
-            tets,
-            families,
-            Family::ALL,
-            1.0 / 600.0,
-            layers,
-            Kernel::Simd,
-        );
-        sweep(&mut fresh_world, b, roots);
+        let mut kept_world = World::new();
+        let (a, bottom) = squashed(&mut kept_world);
+        let mut fresh_world = World::new();
+        let (b, _) = squashed(&mut fresh_world);
+        let root_sets = [bottom.clone(), bottom[..3].to_vec(), bottom.clone()];
+        let mut kept: Option<StackingLayers> = None;
+        for roots in &root_sets {
+            sweep_kept(&mut kept_world, a, roots, Kernel::Simd, &mut kept);
+            sweep(&mut fresh_world, b, roots);
+        }
+        let x = kept_world
+            .get::<&Particles>(a)
+            .unwrap()
+            .positions()
+            .to_vec();
+        let y = fresh_world
+            .get::<&Particles>(b)
+            .unwrap()
+            .positions()
+            .to_vec();
+        assert_eq!(x, y, "{families}");
     }
-    let x = kept_world
-        .get::<&Particles>(a)
-        .unwrap()
-        .positions()
-        .to_vec();
-    let y = fresh_world
-        .get::<&Particles>(b)
-        .unwrap()
-        .positions()
-        .to_vec();
-    assert_eq!(x, y);
 }
 
 /// Layers built for another body (other particle and tetrahedron counts) leave the body
