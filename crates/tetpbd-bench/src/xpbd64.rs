@@ -7,14 +7,16 @@
 //! It reuses the core's constraint math ([`tetpbd::constraint`], generic over the scalar)
 //! and mirrors [`tetpbd::systems`]: prediction with `v ← (v + h g)·max(0, 1 − damping·h)`,
 //! multipliers reset every substep, `iterations` Gauss–Seidel sweeps over the families in
-//! [`SolverSettings::order`], each in the body's stored (colour) order, then `v = (x − x_prev)/h`
-//! (with the correction-speed safety net's clamp and momentum restoration when it is set).
+//! [`SolverSettings::order`], each in the body's stored (colour) order, followed by the spin
+//! removal on a free body ([`SolverSettings::conserve_angular_momentum`]), then
+//! `v = (x − x_prev)/h` (with the correction-speed safety net's clamp and momentum
+//! restoration when it is set).
 //! Degenerate configurations get the core's fallbacks (edge: rest direction; vertex–face: rest
 //! normal; volume: skipped). Not mirrored: `f32` compensated summation (not needed in `f64`),
 //! SIMD lanes (the same sweep to rounding), external accelerations and hooks (no scene of the
 //! report has them).
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use tetpbd::constraint::{self, Evaluated, VERTEX_FACE_ORDER};
 use tetpbd::{Family, SoftBody, SolverSettings};
 
@@ -65,6 +67,7 @@ pub struct Xpbd64 {
     damping: f64,
     order: [Family; 3],
     max_correction_speed: Option<f64>,
+    conserve_angular_momentum: bool,
     degenerate: u64,
 }
 
@@ -126,6 +129,7 @@ impl Xpbd64 {
             damping: f64::from(settings.damping),
             order: settings.order,
             max_correction_speed: settings.max_correction_speed.map(f64::from),
+            conserve_angular_momentum: settings.conserve_angular_momentum,
             degenerate: 0,
         })
     }
@@ -157,13 +161,18 @@ impl Xpbd64 {
                 self.x[i] += self.v[i] * h;
             }
             let mut lambdas = Lambdas::new(self);
+            let free = self.w.iter().all(|&w| w > 0.0);
             for _ in 0..self.iterations {
+                let before = self.x.clone();
                 for family in self.order {
                     match family {
                         Family::Edge => self.project_edges(h, &mut lambdas.edge),
                         Family::VertexFace => self.project_vertex_face(h, &mut lambdas.vf),
                         Family::Volume => self.project_volume(h, &mut lambdas.volume),
                     }
+                }
+                if self.conserve_angular_momentum && free {
+                    self.remove_spin(&before);
                 }
             }
             let mut clamped = false;
@@ -185,23 +194,37 @@ impl Xpbd64 {
         }
     }
 
-    /// The safety net's momentum restoration (as tetpbd's): the linear momentum the clamp
-    /// removed from the free body, given back as a uniform velocity change.
+    /// The solver's spin removal (as tetpbd's `spin` module): the rigid-rotation part of the
+    /// families' corrections `x − before`, about the centre of mass at the substep start.
+    fn remove_spin(&mut self, before: &[V3]) {
+        let m = self.w.iter().map(|w| 1.0 / w);
+        let (c, inertia) = centre_and_inertia(&self.prev, m.clone());
+        let mut torque = V3::zeros();
+        for ((x, b), (p, mi)) in self.x.iter().zip(before).zip(self.prev.iter().zip(m)) {
+            torque += (p - c).cross(&(x - b)) * mi;
+        }
+        let theta = pseudo_solve(&inertia, &torque);
+        for (x, p) in self.x.iter_mut().zip(&self.prev) {
+            *x -= theta.cross(&(p - c));
+        }
+    }
+
+    /// The safety net's momentum restoration (as tetpbd's): the linear and angular momentum
+    /// the clamp removed from the free body, given back as a rigid velocity change.
     fn restore_momentum(&mut self, h: f64) {
-        let (mut total, mut dp) = (0.0, V3::zeros());
-        for ((x, p), (v, w)) in self
-            .x
-            .iter()
-            .zip(&self.prev)
-            .zip(self.v.iter().zip(&self.w))
-        {
-            let mi = 1.0 / w;
+        let m = self.w.iter().map(|w| 1.0 / w);
+        let (c, inertia) = centre_and_inertia(&self.x, m.clone());
+        let (mut total, mut dp, mut dl) = (0.0, V3::zeros(), V3::zeros());
+        for ((x, p), (v, mi)) in self.x.iter().zip(&self.prev).zip(self.v.iter().zip(m)) {
             total += mi;
-            dp += (v - (x - p) / h) * mi;
+            let dv = (v - (x - p) / h) * mi;
+            dp += dv;
+            dl += (x - c).cross(&dv);
         }
         let u = -dp / total;
-        for v in &mut self.v {
-            *v += u;
+        let omega = pseudo_solve(&inertia, &-dl);
+        for (v, x) in self.v.iter_mut().zip(&self.x) {
+            *v += u + omega.cross(&(x - c));
         }
     }
 
@@ -293,4 +316,31 @@ impl Lambdas {
             volume: vec![0.0; s.volume.as_ref().map_or(0, |_| s.tets.len())],
         }
     }
+}
+
+/// Centre of mass and inertia tensor about it of points `x` with masses `m`.
+fn centre_and_inertia(x: &[V3], m: impl Iterator<Item = f64> + Clone) -> (V3, Matrix3<f64>) {
+    let total: f64 = m.clone().sum();
+    let c = x.iter().zip(m.clone()).map(|(x, mi)| x * mi).sum::<V3>() / total;
+    let mut inertia = Matrix3::zeros();
+    for (x, mi) in x.iter().zip(m) {
+        let r = x - c;
+        inertia += (Matrix3::identity() * r.norm_squared() - r * r.transpose()) * mi;
+    }
+    (c, inertia)
+}
+
+/// `I⁺ b`, eigenvalues of `I` below 1e-9 of the largest taken as zero (as tetpbd's).
+fn pseudo_solve(inertia: &Matrix3<f64>, b: &V3) -> V3 {
+    let eig = inertia.symmetric_eigen();
+    let largest = eig.eigenvalues.max();
+    let mut x = V3::zeros();
+    for k in 0..3 {
+        let l = eig.eigenvalues[k];
+        if largest > 0.0 && l > largest * 1e-9 {
+            let u = eig.eigenvectors.column(k);
+            x += u * (u.dot(b) / l);
+        }
+    }
+    x
 }

@@ -48,6 +48,7 @@ mod runs;
 mod schedule;
 mod simd;
 mod solver;
+mod spin;
 mod stacking;
 mod stats;
 #[cfg(feature = "sync-stats")]

@@ -3,32 +3,32 @@
 //!
 //! The per-particle clamp of [`crate::systems::update_velocities`] removes a velocity
 //! `δvᵢ = v_clampedᵢ − v_unclampedᵢ` from each clamped particle, and with it the linear
-//! momentum `ΔP = Σ mᵢδvᵢ`: an asymmetric snap-back clamped particle by particle used to
+//! momentum `ΔP = Σ mᵢδvᵢ` and the angular momentum `ΔL = Σ mᵢ rᵢ × δvᵢ` about the centre of
+//! mass `c` (`rᵢ = xᵢ − c`): an asymmetric snap-back clamped particle by particle used to
 //! throw the whole body (2150 kg·m/s, 2.15 m/s of drift, three frames after a tangled
-//! release). [`restore`] gives it back as a uniform velocity change of the whole body,
+//! release) and set it turning. [`restore`] gives both back as a rigid velocity field,
 //!
 //! ```text
-//! vᵢ += −ΔP / M,
+//! vᵢ += −ΔP / M + ω × rᵢ,   I ω = −ΔL,
 //! ```
 //!
-//! `M` the body's mass: the net never changes the body's linear momentum.
+//! `M` the body's mass, `I = Σ mᵢ(|rᵢ|²𝟙 − rᵢrᵢᵀ)` its inertia tensor at the end of the
+//! substep (inverted through its eigenvalues, those below 10⁻⁹ of the largest taken as zero,
+//! as in the `spin` module): the net never changes a free body's linear or angular momentum.
 //!
-//! The angular momentum the clamp removes is not given back, by measurement. The
-//! projections conserve angular momentum only to second order in the correction (each
-//! gradient is taken before its finite correction), so a snap-back violent enough to be
-//! clamped spins the body up through the projections themselves, with or without the net
-//! (a mirrored 1 m cube: 8e3 kg·m²/s after one frame without it). What the clamp removes
-//! about the centre of mass is mostly that spurious spin: giving it back as a rigid rotation
-//! (the inertia tensor's pseudo-inverse) took the stability matrix with the net from 95 to
-//! 90 of 108 cells and left two recovery tests' bodies tangled; restoring the angular
-//! momentum to its value before the substep instead (93 of 108) kept a collapsed body from
-//! re-expanding. With the linear part alone: 94 of 108 (the cells that changed are chaotic
-//! releases, crates/tetpbd-stability/src/bin/findings.md).
+//! The angular part is given back since the projections stopped creating spin of their own
+//! ([`crate::SolverSettings::conserve_angular_momentum`]). Before that, a snap-back violent
+//! enough to be clamped spun the body up through the projections themselves (a mirrored 1 m
+//! cube: 8e3 kg·m²/s after one frame without the net), what the clamp removed was mostly that
+//! spurious spin, and giving it back took the stability matrix with the net from 95 to 90 of
+//! 108 cells. With the spin removal it takes the matrix with the net from 92 to 93 of 108
+//! (hard vertex–face dragged 100 cells now recovers), the rest unchanged
+//! (crates/tetpbd-stability/src/bin/findings.md).
 //!
 //! The sums run over the particles in index order, in f64, on one thread: the result does
 //! not depend on the thread count.
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// The arrays of one body [`restore`] reads and writes.
 pub(crate) struct RestoreRun<'a> {
@@ -44,8 +44,8 @@ pub(crate) struct RestoreRun<'a> {
     pub masses: &'a [f32],
 }
 
-/// Gives back the linear momentum the clamp removed from one body whose velocities were
-/// just set by [`crate::systems::VelocityRun::update`] with step `h` (s).
+/// Gives back the linear and angular momentum the clamp removed from one body whose
+/// velocities were just set by [`crate::systems::VelocityRun::update`] with step `h` (s).
 ///
 /// The unclamped velocity of each particle is recomputed with the same expression the
 /// update used, so a particle the clamp left alone contributes exactly zero. A particle the
@@ -65,27 +65,40 @@ pub(crate) fn restore(run: RestoreRun<'_>, h: f32) {
         .min(residuals.len())
         .min(velocities.len())
         .min(masses.len());
-    let (mut total, mut dp) = (0.0f64, Vector3::<f64>::zeros());
+    let (mut total, mut dp, mut dl) = (0.0f64, Vector3::<f64>::zeros(), Vector3::zeros());
+    let (mut first, mut second) = (Vector3::<f64>::zeros(), Matrix3::<f64>::zeros());
     for i in 0..n {
         let m = f64::from(masses[i]);
+        let x = positions[i].cast::<f64>();
         total += m;
+        first += x * m;
+        second += x * x.transpose() * m;
         let reset = velocities[i] == Vector3::zeros() && positions[i] == prev_positions[i];
         // The update's own expression (see `VelocityRun::update`), bit for bit.
         let unclamped = ((positions[i] - prev_positions[i]) + residuals[i]) / h;
         if reset || !unclamped.iter().all(|x| x.is_finite()) {
             continue;
         }
-        dp += (velocities[i] - unclamped).cast::<f64>() * m;
+        let dv = (velocities[i] - unclamped).cast::<f64>() * m;
+        dp += dv;
+        dl += x.cross(&dv);
     }
     if !(total.is_finite() && total > 0.0) {
         return;
     }
     let u = -dp / total;
+    // About the centre of mass: Σ m r × δv and Σ m r rᵀ from the sums about the origin.
+    let c = first / total;
+    let dl = dl - c.cross(&dp);
+    let spread = second - c * c.transpose() * total;
+    let inertia = Matrix3::identity() * spread.trace() - spread;
+    let omega = crate::spin::solve_pseudo(&inertia, &-dl).unwrap_or_default();
     if !u.iter().all(|x| x.is_finite()) {
         return;
     }
-    for v in velocities[..n].iter_mut() {
-        let w = (v.cast::<f64>() + u).cast::<f32>();
+    for (v, x) in velocities[..n].iter_mut().zip(positions) {
+        let rot = omega.cross(&(x.cast::<f64>() - c));
+        let w = (v.cast::<f64>() + u + rot).cast::<f32>();
         if w.iter().all(|x| x.is_finite()) {
             *v = w;
         }

@@ -32,14 +32,22 @@ pub struct SolverSettings {
     pub order: [Family; 3],
     /// Safety net: the velocity a substep's projections add to a particle is clamped to this
     /// length, m/s (positions keep their full correction). `None` = no clamp. On a body
-    /// without pinned particles, the linear momentum the clamps removed is given back as a
-    /// uniform velocity change of the whole body, so the net never changes the body's linear
-    /// momentum (angular momentum it may damp); a body with pinned particles gets the
-    /// per-particle clamp alone. Cost: a compare per particle per substep, plus two serial
+    /// without pinned particles, the linear and angular momentum the clamps removed are
+    /// given back as a rigid velocity change of the whole body, so the net never changes the
+    /// body's momentum; a body with pinned particles gets the per-particle clamp alone. Cost: a compare per particle per substep, plus two serial
     /// passes over a body's particles in substeps where it clamped one of them. See
     /// [`systems::update_velocities`]; clamps are counted in
     /// [`StepStats::velocity_clamps`].
     pub max_correction_speed: Option<f32>,
+    /// Remove the rigid rotation the families' corrections carry, once per iteration, so
+    /// that a free body's internal constraints conserve its angular momentum (default on).
+    /// Gauss–Seidel projections conserve it only to second order, which in a body that
+    /// cannot meet all its constraints (a tangled, self-intersecting state) is a steady
+    /// torque: undamped, such a body spins itself up from rest. Bodies with pinned
+    /// particles are left alone, as are a hook's contacts. Cost: two serial passes over a
+    /// body's particles per iteration, counted in [`StepStats::spin_time`]; see the `spin`
+    /// module docs.
+    pub conserve_angular_momentum: bool,
     /// Scalar or SIMD projection kernels (default SIMD; they agree to rounding).
     pub kernel: systems::Kernel,
     /// Evaluate every constraint after the step to fill [`crate::FamilyStats::after`] and
@@ -59,6 +67,7 @@ impl Default for SolverSettings {
             damping: 0.0,
             order: Family::ALL,
             max_correction_speed: None,
+            conserve_angular_momentum: true,
             kernel: systems::Kernel::Simd,
             measure_error: false,
             measure_before: false,
@@ -178,7 +187,8 @@ impl<H: SubstepHook + ?Sized> SubstepHook for &mut H {
 ///     reset λ
 ///     repeat `iterations` times:
 ///         copy the particles into the projections' working copy (crate::work)
-///         project families in `order` on it, copy back, then hook.project
+///         project families in `order` on it, remove the rigid rotation of their
+///         corrections (conserve_angular_momentum), copy back, then hook.project
 ///     update velocities  v ← (x − x_prev) / h
 ///     hook.end_substep
 /// ```
@@ -260,6 +270,11 @@ impl Solver {
                     f.time += t.elapsed();
                     f.projections += c.applied;
                     f.degenerate += c.degenerate;
+                }
+                if s.conserve_angular_momentum {
+                    let t = Instant::now();
+                    crate::spin::remove_spin_bodies(world);
+                    stats.spin_time += t.elapsed();
                 }
                 let t = Instant::now();
                 work::store_bodies(world);

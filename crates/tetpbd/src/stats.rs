@@ -116,6 +116,9 @@ pub struct StepStats {
     pub predict_time: Duration,
     /// Time in the velocity update.
     pub velocity_time: Duration,
+    /// Time removing the rigid rotation of the families' corrections
+    /// ([`crate::SolverSettings::conserve_angular_momentum`]).
+    pub spin_time: Duration,
     /// Time copying the particles into the projections' working copy and back, once per
     /// iteration (the families' times exclude it).
     pub copy_time: Duration,

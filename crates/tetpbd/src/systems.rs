@@ -335,19 +335,17 @@ pub struct VelocityUpdate {
 /// inverted body snapping back), which otherwise turn into a velocity of `Δx/h`; each clamp
 /// is counted.
 ///
-/// Clamping particles one by one removes linear momentum (an asymmetric snap-back would
-/// push the body). So when at least one particle of a body was clamped and the body has no
-/// pinned particle, the linear momentum the clamp removed is given back as a uniform
-/// velocity change of the whole body (see the `momentum` module): the net never changes a
-/// free body's linear momentum. That costs two more serial passes over the body's
-/// particles, only in substeps where the net clamped one of them; bodies it leaves alone are
-/// bit-identical to running without it. A body with pinned particles (inverse mass 0) gets
-/// the per-particle clamp alone: its pins exchange momentum with the outside anyway. A
+/// Clamping particles one by one removes linear and angular momentum (an asymmetric
+/// snap-back would push and turn the body). So when at least one particle of a body was
+/// clamped and the body has no pinned particle, the momentum the clamp removed is given back
+/// as a rigid velocity change of the whole body, a uniform velocity plus a rotation about its
+/// centre of mass (see the `momentum` module): the net never changes a free body's linear or
+/// angular momentum. That costs two more serial passes over the body's particles, only in
+/// substeps where the net clamped one of them; bodies it leaves alone are bit-identical to
+/// running without it. A body with pinned particles (inverse mass 0) gets the per-particle
+/// clamp alone: its pins exchange momentum with the outside anyway. A
 /// [`crate::SubstepHook`]'s corrections (e.g. collision push-out) are clamped and given back
-/// like the projections'. The angular momentum the clamp removes is not given back: in the
-/// violent snap-backs the net is for, it is mostly spin the projections themselves create
-/// (PBD's gradients are taken before each finite correction), and giving it back made the
-/// stability matrix worse (`momentum` module docs).
+/// like the projections'.
 ///
 /// A particle whose position became non-finite is put back to its substep start with zero
 /// velocity and counted (a safety net that never acts in a healthy run).

@@ -1,6 +1,6 @@
-//! The correction-speed safety net (`SolverSettings::max_correction_speed`) never creates
-//! linear momentum on a free body: what the per-particle clamp removes is given back as a
-//! uniform velocity change of the whole body. Where the net never acts, the result is
+//! The correction-speed safety net (`SolverSettings::max_correction_speed`) never changes a
+//! free body's linear or angular momentum: what the per-particle clamp removes is given back
+//! as a rigid velocity change of the whole body. Where the net never acts, the result is
 //! bit-identical to running without it.
 
 mod common;
@@ -77,30 +77,28 @@ fn released(start: Start, net: f32) -> (f64, f64, u64) {
 }
 
 /// A mirrored or scrambled body snapping back with the net at 10 m/s. Measured: linear
-/// ≤ 4e-7 relative; with the per-particle clamp alone 0.54 (mirrored) and 0.3 (scrambled).
-/// The angular momentum is not checked: a snap-back this violent (corrections of ~1 m per
-/// substep) spins the body up through the projections themselves (PBD's gradients are taken
-/// before the correction, see `conservation.rs`), with or without the net (measured 0.6 of
-/// the scale in frame 1 without it); the net gives back only the linear momentum its clamp
-/// removed.
+/// 1.0–1.4e-6 relative; with the per-particle clamp alone 0.54 (mirrored) and 0.3
+/// (scrambled). Angular 1.0–1.5e-6 (since the solver removes the projections' own spin and
+/// the net gives back the angular momentum it removed); before, 0.6 of the scale in frame 1.
 #[test]
-fn released_tangled_body_keeps_zero_linear_momentum() {
+fn released_tangled_body_keeps_zero_momentum() {
     for start in [Start::Mirrored, Start::Scrambled] {
-        let (dp, _, clamps) = released(start, 10.0);
+        let (dp, dl, clamps) = released(start, 10.0);
         assert!(clamps > 0, "{start:?}: the net acts");
         assert!(dp < 1e-5, "{start:?}: linear momentum {dp:e} (relative)");
+        assert!(dl < 1e-5, "{start:?}: angular momentum {dl:e} (relative)");
     }
 }
 
 /// A one-sided strain snapping back with the net at 1 m/s: the clamp acts on the top only,
-/// which used to push the body. Measured: linear 1.5e-7 relative; with the per-particle
-/// clamp alone 0.45. (The angular momentum the clamp removes is not given back, see the
-/// crate's `momentum` module: 0.34 of the scale here, 2e-3 without the net.)
+/// which used to push the body and set it turning. Measured: linear 0.9e-7 relative,
+/// angular 1.5e-7; with the per-particle clamp alone 0.45 and 0.34.
 #[test]
-fn released_strained_body_keeps_zero_linear_momentum() {
-    let (dp, _, clamps) = released(Start::Strained, 1.0);
+fn released_strained_body_keeps_zero_momentum() {
+    let (dp, dl, clamps) = released(Start::Strained, 1.0);
     assert!(clamps > 0, "the net acts");
     assert!(dp < 1e-5, "linear momentum {dp:e} (relative)");
+    assert!(dl < 1e-5, "angular momentum {dl:e} (relative)");
 }
 
 /// Positions, velocities as bits after 100 frames of a ball with a random internal velocity
@@ -144,8 +142,8 @@ fn net_that_never_acts_changes_nothing() {
     assert!(off == on, "bit-identical with and without the net");
 }
 
-/// Every particle on one line with the net on: nothing turns non-finite and linear
-/// momentum stays zero.
+/// Every particle on one line with the net on (an inertia tensor of rank 2): nothing turns
+/// non-finite and the momenta stay zero.
 #[test]
 fn collinear_body_stays_finite() {
     let mut world = World::new();
@@ -171,8 +169,9 @@ fn collinear_body_stays_finite() {
             .iter()
             .chain(p.velocities())
             .all(|v| v.iter().all(|c| c.is_finite())));
-        let (lin, _, sp, _) = momenta(&p);
+        let (lin, ang, sp, sl) = momenta(&p);
         assert!(lin.norm() <= 1e-5 * sp, "linear momentum {lin:?}");
+        assert!(ang.norm() <= 1e-5 * sl, "angular momentum {ang:?}");
     }
     assert!(clamps > 0, "the net acts");
 }

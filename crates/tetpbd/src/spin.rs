@@ -1,0 +1,199 @@
+//! Removing the spin Gauss–Seidel creates
+//! ([`crate::SolverSettings::conserve_angular_momentum`]).
+//!
+//! A body's internal constraints exert no net force and no net torque. Each projection's
+//! correction `Δᵢ = wᵢ∇ᵢC Δλ` is free of both *about the positions it was computed at*
+//! (the gradients of a rotation-invariant `C` sum to zero, and `Σ pᵢ × ∇ᵢC = 0`), so linear
+//! momentum is conserved exactly. Angular momentum is not, for two second-order reasons:
+//!
+//! * the velocity is `vᵢ = (xᵢ − x̄ᵢ)/h` with `x̄ᵢ` the substep start. Moving the particles
+//!   by `Δᵢ` changes `L = Σ mᵢ xᵢ × vᵢ` by
+//!
+//!   ```text
+//!   h ΔL = Σ mᵢ [(xᵢ + Δᵢ) × (xᵢ + Δᵢ − x̄ᵢ) − xᵢ × (xᵢ − x̄ᵢ)] = Σ mᵢ x̄ᵢ × Δᵢ,
+//!   ```
+//!
+//!   which vanishes for a torque-free correction only where the body has not moved since
+//!   the substep start (`xᵢ = x̄ᵢ`);
+//! * Gauss–Seidel applies the corrections one after another, each computed at positions the
+//!   previous ones moved, so even from rest the sum carries a commutator term `Σ mᵢ Δ₂ × Δ₁`.
+//!
+//! In a body whose constraints cannot all be met (a tangled, self-intersecting equilibrium,
+//! crates/tetpbd-stability/src/bin/findings.md) the corrections are centimetres every
+//! substep and the error is a steady torque: undamped, a tangled 1 m cube released at rest
+//! reached 22 kJ of rotation in 10 s.
+//!
+//! The fix removes the rigid-rotation part of the families' corrections, once per
+//! iteration. With `rᵢ = x̄ᵢ − c` (`c` the centre of mass at the substep start), the
+//! mass-weighted least-squares rotation of the correction field,
+//!
+//! ```text
+//! θ = argmin Σ mᵢ |Δᵢ − θ × rᵢ|²,   I θ = Σ mᵢ rᵢ × Δᵢ = h ΔL,
+//! I = Σ mᵢ (|rᵢ|² 𝟙 − rᵢ rᵢᵀ)  (the inertia tensor at the substep start),
+//! ```
+//!
+//! is subtracted, `Δᵢ ← Δᵢ − θ × rᵢ`: afterwards `Σ mᵢ rᵢ × Δᵢ = 0`, so the families leave
+//! `L` unchanged, and `Σ mᵢ θ × rᵢ = θ × Σ mᵢ rᵢ = 0` leaves the linear momentum as it was.
+//! It is an orthogonal projection in the mass-weighted norm, so it never lengthens the
+//! correction field: `Σ mᵢ|θ × rᵢ|² ≤ Σ mᵢ|Δᵢ|²`. `I` is inverted through its eigenvalues,
+//! those below `10⁻⁹` of the largest taken as zero (a body collapsed onto a line or a
+//! point has no rotation about that axis to remove, and `h ΔL` has no component there).
+//! A rotation is `C`-invariant to first order, so the constraint errors change by
+//! `O(|θ|²)`.
+//!
+//! Only the families' own corrections are measured (between the working copy's load and
+//! store, [`crate::work`]): a [`crate::SubstepHook`]'s contacts and attachments apply real
+//! torques and are left alone. A body with a pinned particle is skipped: its pins exert
+//! torque. Sums in f64, in particle order, on one thread: the result does not depend on
+//! the thread count. Cost: two passes over a body's particles per iteration.
+
+use hecs::World;
+use nalgebra::{Matrix3, Vector3};
+use wide::f32x4;
+
+use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::mesh::Tetrahedra;
+use crate::particles::Particles;
+
+/// Eigenvalues of the inertia tensor below this fraction of the largest count as zero.
+const INERTIA_CUTOFF: f64 = 1e-9;
+
+/// Removes the rigid-rotation part of the corrections the families made on every swept
+/// body's working copy since it was loaded (the copy still in the slots, `Particles`
+/// holding the positions before the families). Returns the bodies corrected.
+pub(crate) fn remove_spin_bodies(world: &mut World) -> u64 {
+    let mut n = 0;
+    for (p, e, t, vf, vol) in world.query_mut::<(
+        &mut Particles,
+        Option<&EdgeConstraints>,
+        Option<&Tetrahedra>,
+        Option<&VertexFaceConstraints>,
+        Option<&VolumeConstraints>,
+    )>() {
+        let swept = e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some()));
+        if swept && remove_spin(p) {
+            n += 1;
+        }
+    }
+    n
+}
+
+/// [`remove_spin_bodies`] for one body; `false` where it changed nothing (a pinned
+/// particle, no mass, nothing to remove, or a non-finite sum).
+fn remove_spin(p: &mut Particles) -> bool {
+    let n = p.positions.len();
+    if n == 0 || p.work.0.len() != n || p.inv_masses.contains(&0.0) {
+        return false;
+    }
+    // One pass: raw moments about the first particle's start `o` (small numbers, little
+    // cancellation), summed in f32 over blocks of `BLOCK` particles and in f64 across blocks.
+    let o = p.prev_positions[0];
+    let mut sums = Moments::<f64>::default();
+    for start in (0..n).step_by(BLOCK) {
+        let mut block = Moments::<f32>::default();
+        for i in start..(start + BLOCK).min(n) {
+            let m = p.masses[i];
+            let xb = p.prev_positions[i] - o;
+            // The correction as the velocity update will see it: position plus rounding
+            // residual (see `systems::add_compensated`); at rest most of it is residual.
+            let [a, b, c, _] = p.work.0[i].xw.to_array();
+            let [ra, rb, rc, _] = p.work.0[i].r.to_array();
+            let d = (Vector3::new(a, b, c) - p.positions[i])
+                + (Vector3::new(ra, rb, rc) - p.residuals[i]);
+            block.add(m, xb, d);
+        }
+        sums.fold(&block);
+    }
+    let mass = sums.mass;
+    if !(mass > 0.0) {
+        return false;
+    }
+    let c = sums.first / mass;
+    // Σ m r × Δ with r = x̄ − c, and Σ m r rᵀ, from the raw sums.
+    let torque = sums.torque - c.cross(&sums.push);
+    let [xx, yy, zz, xy, xz, yz] = sums.second;
+    let spread = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz) - c * c.transpose() * mass;
+    let inertia = Matrix3::identity() * spread.trace() - spread;
+    let Some(theta) = solve_pseudo(&inertia, &torque) else {
+        return false;
+    };
+    if theta == Vector3::zeros() {
+        return false;
+    }
+    // Δᵢ −= θ × rᵢ = rᵢ × θ, with rᵢ = x̄ᵢ − o − c.
+    let (theta, c) = (theta.cast::<f32>(), c.cast::<f32>());
+    for i in 0..n {
+        let d = (p.prev_positions[i] - o - c).cross(&theta);
+        p.work.0[i].add(f32x4::new([d.x, d.y, d.z, 0.0]));
+    }
+    true
+}
+
+/// Particles per f32 block of [`remove_spin`]'s sums.
+const BLOCK: usize = 256;
+
+/// Mass-weighted moments of the substep starts `x̄` and corrections `Δ` of some particles.
+#[derive(Default)]
+struct Moments<T: nalgebra::Scalar> {
+    /// Σ m.
+    mass: T,
+    /// Σ m x̄.
+    first: Vector3<T>,
+    /// Σ m x̄ x̄ᵀ as `[xx, yy, zz, xy, xz, yz]`.
+    second: [T; 6],
+    /// Σ m x̄ × Δ.
+    torque: Vector3<T>,
+    /// Σ m Δ.
+    push: Vector3<T>,
+}
+
+impl Moments<f32> {
+    #[inline(always)]
+    fn add(&mut self, m: f32, x: Vector3<f32>, d: Vector3<f32>) {
+        let mx = x * m;
+        self.mass += m;
+        self.first += mx;
+        self.second[0] += mx.x * x.x;
+        self.second[1] += mx.y * x.y;
+        self.second[2] += mx.z * x.z;
+        self.second[3] += mx.x * x.y;
+        self.second[4] += mx.x * x.z;
+        self.second[5] += mx.y * x.z;
+        self.torque += mx.cross(&d);
+        self.push += d * m;
+    }
+}
+
+impl Moments<f64> {
+    fn fold(&mut self, b: &Moments<f32>) {
+        self.mass += f64::from(b.mass);
+        self.first += b.first.cast::<f64>();
+        for k in 0..6 {
+            self.second[k] += f64::from(b.second[k]);
+        }
+        self.torque += b.torque.cast::<f64>();
+        self.push += b.push.cast::<f64>();
+    }
+}
+
+/// `I⁺ b` for the symmetric positive semi-definite `I`, eigenvalues below
+/// [`INERTIA_CUTOFF`] of the largest taken as zero; `None` when not finite.
+pub(crate) fn solve_pseudo(inertia: &Matrix3<f64>, b: &Vector3<f64>) -> Option<Vector3<f64>> {
+    if !inertia.iter().chain(b.iter()).all(|x| x.is_finite()) {
+        return None;
+    }
+    let eig = inertia.symmetric_eigen();
+    let largest = eig.eigenvalues.max();
+    if !(largest > 0.0) {
+        return None;
+    }
+    let mut x = Vector3::zeros();
+    for k in 0..3 {
+        let l = eig.eigenvalues[k];
+        if l > largest * INERTIA_CUTOFF {
+            let u = eig.eigenvectors.column(k);
+            x += u * (u.dot(b) / l);
+        }
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
