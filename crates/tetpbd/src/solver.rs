@@ -44,9 +44,11 @@ pub struct SolverSettings {
     /// Gauss–Seidel projections conserve it only to second order, which in a body that
     /// cannot meet all its constraints (a tangled, self-intersecting state) is a steady
     /// torque: undamped, such a body spins itself up from rest. Bodies with pinned
-    /// particles are left alone, as are a hook's contacts. Cost: two serial passes over a
-    /// body's particles per iteration, counted in [`StepStats::spin_time`]; see the `spin`
-    /// module docs.
+    /// particles are left alone, as are a hook's contacts. Cost: the copy back from the
+    /// working copy becomes a serial pass that also measures the corrections, plus one more
+    /// serial pass over a free body's particles per iteration; both counted in
+    /// [`StepStats::spin_time`] instead of [`StepStats::copy_time`] (see the `spin` module
+    /// docs).
     pub conserve_angular_momentum: bool,
     /// Scalar or SIMD projection kernels (default SIMD; they agree to rounding).
     pub kernel: systems::Kernel,
@@ -271,14 +273,14 @@ impl Solver {
                     f.projections += c.applied;
                     f.degenerate += c.degenerate;
                 }
-                if s.conserve_angular_momentum {
-                    let t = Instant::now();
-                    crate::spin::remove_spin_bodies(world);
-                    stats.spin_time += t.elapsed();
-                }
                 let t = Instant::now();
-                work::store_bodies(world);
-                stats.copy_time += t.elapsed();
+                if s.conserve_angular_momentum {
+                    crate::spin::store_bodies_without_spin(world);
+                    stats.spin_time += t.elapsed();
+                } else {
+                    work::store_bodies(world);
+                    stats.copy_time += t.elapsed();
+                }
                 let t = Instant::now();
                 hook.project(world, h);
                 hook_time += t.elapsed();

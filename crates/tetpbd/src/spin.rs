@@ -44,25 +44,27 @@
 //! Only the families' own corrections are measured (between the working copy's load and
 //! store, [`crate::work`]): a [`crate::SubstepHook`]'s contacts and attachments apply real
 //! torques and are left alone. A body with a pinned particle is skipped: its pins exert
-//! torque. Sums in f64, in particle order, on one thread: the result does not depend on
-//! the thread count. Cost: two passes over a body's particles per iteration.
+//! torque. Sums in f32 over blocks of 256 particles and in f64 across blocks, in particle
+//! order, on one thread: the result does not depend on the thread count. Cost: the copy
+//! back from the working copy, which this pass takes over, measures the corrections on the
+//! way, plus one more pass to apply `θ`; both serial (the copy back alone runs in parallel
+//! on large bodies with the `parallel` feature).
 
 use hecs::World;
 use nalgebra::{Matrix3, Vector3};
-use wide::f32x4;
 
 use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::mesh::Tetrahedra;
 use crate::particles::Particles;
+use crate::systems::add_compensated;
 
 /// Eigenvalues of the inertia tensor below this fraction of the largest count as zero.
 const INERTIA_CUTOFF: f64 = 1e-9;
 
-/// Removes the rigid-rotation part of the corrections the families made on every swept
-/// body's working copy since it was loaded (the copy still in the slots, `Particles`
-/// holding the positions before the families). Returns the bodies corrected.
-pub(crate) fn remove_spin_bodies(world: &mut World) -> u64 {
-    let mut n = 0;
+/// Copies every swept body's working copy back ([`crate::work::store`]) and removes the
+/// rigid-rotation part of the corrections the families made on it since it was loaded (the
+/// copy in the slots, `Particles` still holding the positions before the families).
+pub(crate) fn store_bodies_without_spin(world: &mut World) {
     for (p, e, t, vf, vol) in world.query_mut::<(
         &mut Particles,
         Option<&EdgeConstraints>,
@@ -70,43 +72,42 @@ pub(crate) fn remove_spin_bodies(world: &mut World) -> u64 {
         Option<&VertexFaceConstraints>,
         Option<&VolumeConstraints>,
     )>() {
-        let swept = e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some()));
-        if swept && remove_spin(p) {
-            n += 1;
+        if e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some())) {
+            store_without_spin(p);
         }
     }
-    n
 }
 
-/// [`remove_spin_bodies`] for one body; `false` where it changed nothing (a pinned
-/// particle, no mass, nothing to remove, or a non-finite sum).
-fn remove_spin(p: &mut Particles) -> bool {
+/// [`store_bodies_without_spin`] for one body. A free body is stored and measured in one
+/// serial pass, then corrected in a second; a body with a pinned particle is only stored.
+fn store_without_spin(p: &mut Particles) {
     let n = p.positions.len();
     if n == 0 || p.work.0.len() != n || p.inv_masses.contains(&0.0) {
-        return false;
+        crate::work::store(p);
+        return;
     }
-    // One pass: raw moments about the first particle's start `o` (small numbers, little
+    // Raw moments about the first particle's start `o` (small numbers, little
     // cancellation), summed in f32 over blocks of `BLOCK` particles and in f64 across blocks.
     let o = p.prev_positions[0];
     let mut sums = Moments::<f64>::default();
     for start in (0..n).step_by(BLOCK) {
         let mut block = Moments::<f32>::default();
         for i in start..(start + BLOCK).min(n) {
-            let m = p.masses[i];
-            let xb = p.prev_positions[i] - o;
-            // The correction as the velocity update will see it: position plus rounding
-            // residual (see `systems::add_compensated`); at rest most of it is residual.
             let [a, b, c, _] = p.work.0[i].xw.to_array();
             let [ra, rb, rc, _] = p.work.0[i].r.to_array();
-            let d = (Vector3::new(a, b, c) - p.positions[i])
-                + (Vector3::new(ra, rb, rc) - p.residuals[i]);
-            block.add(m, xb, d);
+            let (x, r) = (Vector3::new(a, b, c), Vector3::new(ra, rb, rc));
+            // The correction as the velocity update will see it: position plus rounding
+            // residual (see `systems::add_compensated`); at rest most of it is residual.
+            let d = (x - p.positions[i]) + (r - p.residuals[i]);
+            block.add(p.masses[i], p.prev_positions[i] - o, d);
+            p.positions[i] = x;
+            p.residuals[i] = r;
         }
         sums.fold(&block);
     }
     let mass = sums.mass;
-    if !(mass > 0.0) {
-        return false;
+    if !(mass.is_finite() && mass > 0.0) {
+        return;
     }
     let c = sums.first / mass;
     // Σ m r × Δ with r = x̄ − c, and Σ m r rᵀ, from the raw sums.
@@ -115,21 +116,20 @@ fn remove_spin(p: &mut Particles) -> bool {
     let spread = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz) - c * c.transpose() * mass;
     let inertia = Matrix3::identity() * spread.trace() - spread;
     let Some(theta) = solve_pseudo(&inertia, &torque) else {
-        return false;
+        return;
     };
     if theta == Vector3::zeros() {
-        return false;
+        return;
     }
     // Δᵢ −= θ × rᵢ = rᵢ × θ, with rᵢ = x̄ᵢ − o − c.
     let (theta, c) = (theta.cast::<f32>(), c.cast::<f32>());
     for i in 0..n {
         let d = (p.prev_positions[i] - o - c).cross(&theta);
-        p.work.0[i].add(f32x4::new([d.x, d.y, d.z, 0.0]));
+        add_compensated(&mut p.positions[i], &mut p.residuals[i], d);
     }
-    true
 }
 
-/// Particles per f32 block of [`remove_spin`]'s sums.
+/// Particles per f32 block of [`store_without_spin`]'s sums.
 const BLOCK: usize = 256;
 
 /// Mass-weighted moments of the substep starts `x̄` and corrections `Δ` of some particles.
@@ -184,7 +184,7 @@ pub(crate) fn solve_pseudo(inertia: &Matrix3<f64>, b: &Vector3<f64>) -> Option<V
     }
     let eig = inertia.symmetric_eigen();
     let largest = eig.eigenvalues.max();
-    if !(largest > 0.0) {
+    if !(largest.is_finite() && largest > 0.0) {
         return None;
     }
     let mut x = Vector3::zeros();

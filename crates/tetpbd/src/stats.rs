@@ -117,10 +117,12 @@ pub struct StepStats {
     /// Time in the velocity update.
     pub velocity_time: Duration,
     /// Time removing the rigid rotation of the families' corrections
-    /// ([`crate::SolverSettings::conserve_angular_momentum`]).
+    /// ([`crate::SolverSettings::conserve_angular_momentum`]), including the copy back from
+    /// the working copy that it takes over (then not in [`StepStats::copy_time`]).
     pub spin_time: Duration,
     /// Time copying the particles into the projections' working copy and back, once per
-    /// iteration (the families' times exclude it).
+    /// iteration (the families' times exclude it; the copy back is in
+    /// [`StepStats::spin_time`] when the spin removal is on).
     pub copy_time: Duration,
     /// Time in user hooks (e.g. collision constraints).
     pub hook_time: Duration,

@@ -2,7 +2,8 @@
 //! particle, so the spin removal runs) of about 1k, 10k and 100k tetrahedra, stepped with
 //! the removal on and off in alternating frames (two copies of the body, so a change of the
 //! machine's load hits both alike). Prints median ms per frame of each, their ratio, and the
-//! median ms per frame in the removal itself ([`tetpbd::StepStats::spin_time`]).
+//! median ms per frame in the removal, including the copy back from the working copy it takes
+//! over ([`tetpbd::StepStats::spin_time`]).
 //!
 //! ```text
 //! cargo run --release -p tetpbd-bench --bin spin_cost [-- --frames F --set edges+volume|vertex-face]
@@ -33,7 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .to_string();
     println!("free cube, {set}, zero gravity, slowly spinning; 10 substeps × 1 iteration per 1/60 s frame; median of {frames} frames per column");
     println!(
-        "| tetrahedra | particles | off, ms/frame | on, ms/frame | on/off | removal, ms/frame |"
+        "| tetrahedra | particles | off, ms/frame | on, ms/frame | on/off | removal with the copy back, ms/frame |"
     );
     println!("|---|---|---|---|---|---|");
     for cells in [6u32, 13, 28] {
