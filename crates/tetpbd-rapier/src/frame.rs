@@ -342,7 +342,12 @@ impl Frame {
                     let Some(caabb) = self.swept_aabb(ci, qp.colliders) else {
                         continue;
                     };
-                    let caabb = caabb.loosened(reach - p.max_speed() * dt);
+                    // Loosened by the body's fastest motion too, not only by each
+                    // particle's own path below: a slow particle of a body being struck
+                    // (another body landing on it) is sped up within the frame and would
+                    // sink through the collider until the next gathering (issue 6, the
+                    // pile's launch, crates/tetpbd-bench/tests/issue_6_pile_launch.rs).
+                    let caabb = caabb.loosened(reach);
                     let Some(co) = qp.colliders.get(handle) else {
                         continue;
                     };
