@@ -6,7 +6,9 @@
 //! (the overflow class, see [`crate::ordering`], runs on one thread); the tasks of a
 //! partitioned body ([`crate::partition`]) run each whole on one thread, on disjoint slabs. The passes over the particles of a large body (prediction, the copies into
 //! and out of the working copy, the velocity update) run the same way as one phase of runs
-//! of particles: each particle's update is independent, so they are bit-identical too.
+//! of particles: each particle's update is independent, so they are bit-identical too. The
+//! spin removal's copy back ([`crate::spin`]) sums per block of particles, one block per
+//! unit, and the blocks are folded in order on one thread: bit-identical as well.
 //! Inside [`crate::Solver::step`] every region is posted to the step's team
 //! ([`crate::team`]) instead of waking the pool's threads.
 
@@ -21,6 +23,7 @@ use crate::ordering::{ColourClasses, Phase};
 use crate::projection::ParticleAccess;
 use crate::runs::{edge_run, vertex_face_run, volume_run};
 use crate::schedule::{run_phases, Nothing, Shared, Split, PARTICLE_CHUNK};
+use crate::spin::{self, Moments, StoreRun, BLOCK};
 use crate::systems::{Kernel, PredictRun, ProjectionCount, VelocityRun, VelocityUpdate};
 use crate::work::{self, Slot, WorkAccess};
 
@@ -324,4 +327,59 @@ pub(crate) fn vertex_face(
             ind,
         )
     })
+}
+
+/// The spin removal's measuring copy back ([`crate::spin`]) of one body: one unit per
+/// block of [`crate::spin::BLOCK`] particles, each block's f32 sums written to its entry of
+/// `blocks` (the caller folds them in block order, as the serial path does, so the result
+/// does not depend on the thread count).
+pub(crate) fn store_measuring(run: StoreRun<'_>, o: Vector3<f32>, blocks: &mut [Moments<f32>]) {
+    let n = run.slots.len();
+    let (x, r) = (Shared::new(run.positions), Shared::new(run.residuals));
+    let out = Shared::new(blocks);
+    let (slots, xp, m) = (run.slots, run.prev_positions, run.masses);
+    run_phases(
+        1,
+        1,
+        |_| (n.div_ceil(BLOCK), Split::Units),
+        |_, units| {
+            for b in units {
+                let i = b * BLOCK..((b + 1) * BLOCK).min(n);
+                // SAFETY: `run_phases` hands each unit, so each block of particles and its
+                // entry of `blocks`, to one call only.
+                let (x, r, out) =
+                    unsafe { (x.run(i.clone()), r.run(i.clone()), out.run(b..b + 1)) };
+                let block = StoreRun {
+                    slots: &slots[i.clone()],
+                    positions: x,
+                    residuals: r,
+                    prev_positions: &xp[i.clone()],
+                    masses: &m[i],
+                };
+                out[0] = block.store_measuring(o);
+            }
+            Nothing
+        },
+    );
+}
+
+/// [`crate::spin::rotate_back`] in runs of particles.
+pub(crate) fn rotate_back(
+    positions: &mut [Vector3<f32>],
+    residuals: &mut [Vector3<f32>],
+    prev_positions: &[Vector3<f32>],
+    origin_centre: [Vector3<f32>; 2],
+    theta: Vector3<f32>,
+) {
+    let n = positions
+        .len()
+        .min(residuals.len())
+        .min(prev_positions.len());
+    let (x, r) = (Shared::new(positions), Shared::new(residuals));
+    particle_pass(n, |i| {
+        // SAFETY: `particle_pass` hands each particle to one call only.
+        let (x, r) = unsafe { (x.run(i.clone()), r.run(i.clone())) };
+        spin::rotate_back(x, r, &prev_positions[i], origin_centre, theta);
+        Nothing
+    });
 }

@@ -45,8 +45,8 @@ pub struct SolverSettings {
     /// cannot meet all its constraints (a tangled, self-intersecting state) is a steady
     /// torque: undamped, such a body spins itself up from rest. Bodies with pinned
     /// particles are left alone, as are a hook's contacts. Cost: the copy back from the
-    /// working copy becomes a serial pass that also measures the corrections, plus one more
-    /// serial pass over a free body's particles per iteration; both counted in
+    /// working copy also measures the corrections, plus one more pass over a free body's
+    /// particles per iteration (+2–13 % per frame, docs/performance.md); both counted in
     /// [`StepStats::spin_time`] instead of [`StepStats::copy_time`] (see the `spin` module
     /// docs).
     pub conserve_angular_momentum: bool,

@@ -44,11 +44,11 @@
 //! Only the families' own corrections are measured (between the working copy's load and
 //! store, [`crate::work`]): a [`crate::SubstepHook`]'s contacts and attachments apply real
 //! torques and are left alone. A body with a pinned particle is skipped: its pins exert
-//! torque. Sums in f32 over blocks of 256 particles and in f64 across blocks, in particle
-//! order, on one thread: the result does not depend on the thread count. Cost: the copy
-//! back from the working copy, which this pass takes over, measures the corrections on the
-//! way, plus one more pass to apply `θ`; both serial (the copy back alone runs in parallel
-//! on large bodies with the `parallel` feature).
+//! torque. Sums in f32 over blocks of 256 particles and in f64 across blocks, in block
+//! order on one thread: the result does not depend on the thread count (with the
+//! `parallel` feature the blocks of a large body are summed concurrently, then folded in
+//! order). Cost: the copy back from the working copy, which this pass takes over, measures
+//! the corrections on the way, plus one more pass to apply `θ`.
 
 use hecs::World;
 use nalgebra::{Matrix3, Vector3};
@@ -57,6 +57,7 @@ use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints}
 use crate::mesh::Tetrahedra;
 use crate::particles::Particles;
 use crate::systems::add_compensated;
+use crate::work::Slot;
 
 /// Eigenvalues of the inertia tensor below this fraction of the largest count as zero.
 const INERTIA_CUTOFF: f64 = 1e-9;
@@ -79,7 +80,7 @@ pub(crate) fn store_bodies_without_spin(world: &mut World) {
 }
 
 /// [`store_bodies_without_spin`] for one body. A free body is stored and measured in one
-/// serial pass, then corrected in a second; a body with a pinned particle is only stored.
+/// pass, then corrected in a second; a body with a pinned particle is only stored.
 fn store_without_spin(p: &mut Particles) {
     let n = p.positions.len();
     if n == 0 || p.work.0.len() != n || p.inv_masses.contains(&0.0) {
@@ -87,24 +88,67 @@ fn store_without_spin(p: &mut Particles) {
         return;
     }
     // Raw moments about the first particle's start `o` (small numbers, little
-    // cancellation), summed in f32 over blocks of `BLOCK` particles and in f64 across blocks.
+    // cancellation), summed in f32 over blocks of `BLOCK` particles and in f64 across blocks,
+    // in block order (the same sums for any thread count).
     let o = p.prev_positions[0];
     let mut sums = Moments::<f64>::default();
+    let Particles {
+        positions,
+        prev_positions,
+        residuals,
+        masses,
+        work,
+        ..
+    } = p;
+    let run = StoreRun {
+        slots: &work.0,
+        positions,
+        residuals,
+        prev_positions,
+        masses,
+    };
+    #[cfg(feature = "parallel")]
+    if crate::parallel::particles_worth_it(n) {
+        BLOCKS.with_borrow_mut(|blocks| {
+            blocks.clear();
+            blocks.resize(n.div_ceil(BLOCK), Moments::default());
+            crate::parallel::store_measuring(run, o, blocks);
+            for block in blocks.iter() {
+                sums.fold(block);
+            }
+        });
+        return finish(sums, positions, residuals, prev_positions, o);
+    }
+    let StoreRun {
+        slots,
+        positions,
+        residuals,
+        prev_positions,
+        masses,
+    } = run;
     for start in (0..n).step_by(BLOCK) {
-        let mut block = Moments::<f32>::default();
-        for i in start..(start + BLOCK).min(n) {
-            let [a, b, c, _] = p.work.0[i].xw.to_array();
-            let [ra, rb, rc, _] = p.work.0[i].r.to_array();
-            let (x, r) = (Vector3::new(a, b, c), Vector3::new(ra, rb, rc));
-            // The correction as the velocity update will see it: position plus rounding
-            // residual (see `systems::add_compensated`); at rest most of it is residual.
-            let d = (x - p.positions[i]) + (r - p.residuals[i]);
-            block.add(p.masses[i], p.prev_positions[i] - o, d);
-            p.positions[i] = x;
-            p.residuals[i] = r;
+        let r = start..(start + BLOCK).min(n);
+        let block = StoreRun {
+            slots: &slots[r.clone()],
+            positions: &mut positions[r.clone()],
+            residuals: &mut residuals[r.clone()],
+            prev_positions: &prev_positions[r.clone()],
+            masses: &masses[r],
         }
+        .store_measuring(o);
         sums.fold(&block);
     }
+    finish(sums, positions, residuals, prev_positions, o);
+}
+
+/// Solves for `θ` from the sums and applies `Δᵢ −= θ × rᵢ` to the stored positions.
+fn finish(
+    sums: Moments<f64>,
+    positions: &mut [Vector3<f32>],
+    residuals: &mut [Vector3<f32>],
+    prev_positions: &[Vector3<f32>],
+    o: Vector3<f32>,
+) {
     let mass = sums.mass;
     if !(mass.is_finite() && mass > 0.0) {
         return;
@@ -123,18 +167,74 @@ fn store_without_spin(p: &mut Particles) {
     }
     // Δᵢ −= θ × rᵢ = rᵢ × θ, with rᵢ = x̄ᵢ − o − c.
     let (theta, c) = (theta.cast::<f32>(), c.cast::<f32>());
-    for i in 0..n {
-        let d = (p.prev_positions[i] - o - c).cross(&theta);
-        add_compensated(&mut p.positions[i], &mut p.residuals[i], d);
+    #[cfg(feature = "parallel")]
+    if crate::parallel::particles_worth_it(positions.len()) {
+        crate::parallel::rotate_back(positions, residuals, prev_positions, [o, c], theta);
+        return;
+    }
+    rotate_back(positions, residuals, prev_positions, [o, c], theta);
+}
+
+/// `xᵢ += (x̄ᵢ − o − c) × θ` (compensated) for a run of particles, `[o, c]` the sums'
+/// origin and the centre of mass relative to it.
+pub(crate) fn rotate_back(
+    positions: &mut [Vector3<f32>],
+    residuals: &mut [Vector3<f32>],
+    prev_positions: &[Vector3<f32>],
+    [o, c]: [Vector3<f32>; 2],
+    theta: Vector3<f32>,
+) {
+    for ((x, r), xb) in positions.iter_mut().zip(residuals).zip(prev_positions) {
+        add_compensated(x, r, (xb - o - c).cross(&theta));
     }
 }
 
+/// The arrays of a run of particles the measuring copy back reads and writes.
+pub(crate) struct StoreRun<'a> {
+    /// The working copy (after the families).
+    pub slots: &'a [Slot],
+    /// Positions: before the families on entry, the slots' on return, m.
+    pub positions: &'a mut [Vector3<f32>],
+    /// Rounding residuals, likewise, m.
+    pub residuals: &'a mut [Vector3<f32>],
+    /// Substep starts, m.
+    pub prev_positions: &'a [Vector3<f32>],
+    /// Lumped masses, kg.
+    pub masses: &'a [f32],
+}
+
+impl StoreRun<'_> {
+    /// Copies the slots back and returns the moments of the corrections (one block: f32,
+    /// in particle order), `x̄` taken about `o`.
+    pub(crate) fn store_measuring(self, o: Vector3<f32>) -> Moments<f32> {
+        let mut m = Moments::<f32>::default();
+        for (i, slot) in self.slots.iter().enumerate() {
+            let [a, b, c, _] = slot.xw.to_array();
+            let [ra, rb, rc, _] = slot.r.to_array();
+            let (x, r) = (Vector3::new(a, b, c), Vector3::new(ra, rb, rc));
+            // The correction as the velocity update will see it: position plus rounding
+            // residual (see `systems::add_compensated`); at rest most of it is residual.
+            let d = (x - self.positions[i]) + (r - self.residuals[i]);
+            m.add(self.masses[i], self.prev_positions[i] - o, d);
+            self.positions[i] = x;
+            self.residuals[i] = r;
+        }
+        m
+    }
+}
+
+#[cfg(feature = "parallel")]
+thread_local! {
+    /// Per-block sums of the parallel path (grown once per body size, then reused).
+    static BLOCKS: std::cell::RefCell<Vec<Moments<f32>>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
 /// Particles per f32 block of [`store_without_spin`]'s sums.
-const BLOCK: usize = 256;
+pub(crate) const BLOCK: usize = 256;
 
 /// Mass-weighted moments of the substep starts `x̄` and corrections `Δ` of some particles.
-#[derive(Default)]
-struct Moments<T: nalgebra::Scalar> {
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Moments<T: nalgebra::Scalar + Copy> {
     /// Σ m.
     mass: T,
     /// Σ m x̄.
