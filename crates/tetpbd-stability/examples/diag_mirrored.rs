@@ -12,7 +12,7 @@
 
 use nalgebra::Vector3;
 use tetpbd::{unique_edges, Particles, SoftBodyBuilder, Solver, Surface, Tetrahedra};
-use tetpbd_stability::{all_cases, Config, ConstraintSet};
+use tetpbd_stability::{all_cases, Config, ConstraintSet, Start};
 
 fn seg_tri(
     p: Vector3<f32>,
@@ -64,11 +64,7 @@ fn main() {
     let e = body.spawn(&mut world);
     {
         let mut p = world.get::<&mut Particles>(e).unwrap();
-        for i in 0..p.len() {
-            let x = p.positions()[i];
-            p.set_position(i, Vector3::new(2.0 * centre.x - x.x, x.y, x.z))
-                .unwrap();
-        }
+        Start::Mirrored.apply(&mut p, centre).unwrap();
     }
     let n = if frames > 0 { frames } else { scene.frames };
     let mut clamps = 0;

@@ -1,7 +1,9 @@
 //! Running one scene under one configuration and measuring it.
 
 use nalgebra::Vector3;
-use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats, TetMesh, Tetrahedra};
+use tetpbd::{
+    Particles, SoftBodyBuilder, Solver, SolverSettings, StateError, StepStats, TetMesh, Tetrahedra,
+};
 
 use crate::config::Config;
 
@@ -138,6 +140,30 @@ pub struct FrameView<'a> {
     pub reference: f32,
 }
 
+impl Start {
+    /// Moves the particles of `p` to this start, `centre` the centre of the rest bounding
+    /// box (mirroring plane, flattening plane, collapse point, scrambling box).
+    pub fn apply(&self, p: &mut Particles, centre: Vector3<f32>) -> Result<(), StateError> {
+        for i in 0..p.len() {
+            let x = p.positions()[i];
+            let y = match self {
+                Start::Rest => x,
+                Start::Mirrored => Vector3::new(2.0 * centre.x - x.x, x.y, x.z),
+                Start::Flattened => Vector3::new(x.x, centre.y, x.z),
+                Start::Collapsed => centre,
+                Start::Scrambled(half) => {
+                    let s = i as u64 * 3;
+                    centre + Vector3::new(hash_unit(s), hash_unit(s + 1), hash_unit(s + 2)) * *half
+                }
+                Start::Dragged(v, offset) if *v as usize == i => x + offset,
+                Start::Dragged(..) => x,
+            };
+            p.set_position(i, y)?;
+        }
+        Ok(())
+    }
+}
+
 /// Runs `scene` under `config`.
 pub fn run_scene(scene: &Scene, config: &Config) -> Outcome {
     run_scene_observed(scene, config, |_| {})
@@ -183,25 +209,9 @@ pub fn run_scene_observed(
         let Ok(mut p) = world.get::<&mut Particles>(e) else {
             return out;
         };
-        let centre = (lo + hi) / 2.0;
-        for i in 0..p.len() {
-            let x = p.positions()[i];
-            let y = match &scene.start {
-                Start::Rest => x,
-                Start::Mirrored => Vector3::new(2.0 * centre.x - x.x, x.y, x.z),
-                Start::Flattened => Vector3::new(x.x, centre.y, x.z),
-                Start::Collapsed => centre,
-                Start::Scrambled(half) => {
-                    let s = i as u64 * 3;
-                    centre + Vector3::new(hash_unit(s), hash_unit(s + 1), hash_unit(s + 2)) * *half
-                }
-                Start::Dragged(v, offset) if *v as usize == i => x + offset,
-                Start::Dragged(..) => x,
-            };
-            if p.set_position(i, y).is_err() {
-                out.finite = false;
-                return out;
-            }
+        if scene.start.apply(&mut p, (lo + hi) / 2.0).is_err() {
+            out.finite = false;
+            return out;
         }
     }
     let ke0 = world

@@ -5,7 +5,7 @@
 use hecs::{Entity, World};
 use nalgebra::Vector3;
 use tetpbd::{Particles, SoftBodyBuilder, Solver, Tetrahedra};
-use tetpbd_stability::{all_cases, Config, ConstraintSet};
+use tetpbd_stability::{all_cases, Config, ConstraintSet, Start};
 
 /// The matrix's `long / mirrored` case under soft edges + volume without the spin removal,
 /// which lands in a tangled state within its first frames; returns it settled and at rest,
@@ -22,16 +22,11 @@ fn tangled() -> (World, Entity, Solver) {
     let builder = SoftBodyBuilder::new(case.scene.mesh.clone()).density(1000.0);
     let body = config.apply(builder, 1.0).build().unwrap();
     let (lo, hi) = body.particles.aabb();
-    let centre = (lo + hi) / 2.0;
     let mut world = World::new();
     let e = body.spawn(&mut world);
     {
         let mut p = world.get::<&mut Particles>(e).unwrap();
-        for i in 0..p.len() {
-            let x = p.positions()[i];
-            p.set_position(i, Vector3::new(2.0 * centre.x - x.x, x.y, x.z))
-                .unwrap();
-        }
+        Start::Mirrored.apply(&mut p, (lo + hi) / 2.0).unwrap();
     }
     let mut settings = case.scene.settings.clone();
     settings.conserve_angular_momentum = false;
