@@ -133,6 +133,50 @@ struct Ours {
     contacts: Option<SoftContacts>,
 }
 
+/// tetpbd's side of `sc`: the coupled world (ground, frame [`DT`], `substeps` ×
+/// `iterations`, `self_weight` as `CouplingSettings::self_weight_stacking`) and one soft body
+/// per placement, edges and volumes at compliance 0, with `DeformationDamping` at `damping`
+/// 1/s when it is above 0. Soft–soft contacts are the caller's hook
+/// ([`SoftContacts`]): how a test steps the scene with a hook of its own.
+pub fn tetpbd_contact_world(
+    sc: &ContactScene,
+    damping: f32,
+    self_weight: bool,
+    substeps: u32,
+    iterations: u32,
+) -> Result<(CoupledWorld, Vec<hecs::Entity>), Box<dyn Error>> {
+    let solver = SolverSettings {
+        dt: DT,
+        substeps,
+        iterations,
+        ..SolverSettings::default()
+    };
+    let coupling = CouplingSettings {
+        self_weight_stacking: self_weight,
+        ..CouplingSettings::default()
+    };
+    let mut scene = CoupledWorld::new(solver, coupling)?;
+    let (body, collider) = ground();
+    scene.physics.insert(body, collider);
+    let mut bodies = Vec::new();
+    for at in &sc.placements {
+        let e = SoftBodyBuilder::new(sc.cube.clone())
+            .density(sc.density)
+            .edges(0.0)
+            .volume(0.0)
+            .translation(*at)
+            .build()?
+            .spawn(&mut scene.soft);
+        if damping > 0.0 {
+            scene
+                .soft
+                .insert_one(e, DeformationDamping::new(damping)?)?;
+        }
+        bodies.push(e);
+    }
+    Ok((scene, bodies))
+}
+
 impl Ours {
     fn new(
         sc: &ContactScene,
@@ -141,35 +185,7 @@ impl Ours {
         substeps: u32,
         iterations: u32,
     ) -> Result<Ours, Box<dyn Error>> {
-        let solver = SolverSettings {
-            dt: DT,
-            substeps,
-            iterations,
-            ..SolverSettings::default()
-        };
-        let coupling = CouplingSettings {
-            self_weight_stacking: self_weight,
-            ..CouplingSettings::default()
-        };
-        let mut scene = CoupledWorld::new(solver, coupling)?;
-        let (body, collider) = ground();
-        scene.physics.insert(body, collider);
-        let mut bodies = Vec::new();
-        for at in &sc.placements {
-            let e = SoftBodyBuilder::new(sc.cube.clone())
-                .density(sc.density)
-                .edges(0.0)
-                .volume(0.0)
-                .translation(*at)
-                .build()?
-                .spawn(&mut scene.soft);
-            if damping > 0.0 {
-                scene
-                    .soft
-                    .insert_one(e, DeformationDamping::new(damping)?)?;
-            }
-            bodies.push(e);
-        }
+        let (scene, bodies) = tetpbd_contact_world(sc, damping, self_weight, substeps, iterations)?;
         let contacts = match bodies.len() {
             1 => None,
             _ => Some(SoftContacts::new(SoftContactSettings::default())?),

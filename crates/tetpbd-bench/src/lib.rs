@@ -14,14 +14,14 @@ mod perturb;
 mod rapier_setup;
 mod xpbd64;
 
-pub use args::{arg, flag, orders};
+pub use args::{arg, arg_str, flag, orders};
 pub use clock::thread_cpu_ms;
 pub use contact_metrics::{
     interpenetration, observe_contact, run_contact, ContactObservables, ContactResult,
     SETTLED_SPEED,
 };
 pub use contact_scene::{ContactKind, ContactScene, GROUND_HALF_EXTENTS};
-pub use contact_sim::{build_contact, ContactEngine, ContactSim};
+pub use contact_sim::{build_contact, tetpbd_contact_world, ContactEngine, ContactSim};
 pub use perturb::perturb;
 pub use rapier_setup::{
     lumped_masses, rapier_label, rapier_material, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON,

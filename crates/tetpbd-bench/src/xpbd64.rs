@@ -68,6 +68,8 @@ pub struct Xpbd64 {
     order: [Family; 3],
     max_correction_speed: Option<f64>,
     conserve_angular_momentum: bool,
+    /// Positions before an iteration's families (scratch of the spin removal).
+    before: Vec<V3>,
     degenerate: u64,
 }
 
@@ -130,6 +132,7 @@ impl Xpbd64 {
             order: settings.order,
             max_correction_speed: settings.max_correction_speed.map(f64::from),
             conserve_angular_momentum: settings.conserve_angular_momentum,
+            before: Vec::new(),
             degenerate: 0,
         })
     }
@@ -161,9 +164,13 @@ impl Xpbd64 {
                 self.x[i] += self.v[i] * h;
             }
             let mut lambdas = Lambdas::new(self);
-            let free = self.w.iter().all(|&w| w > 0.0);
+            // The spin removal's centre and inertia (substep start, fixed over the
+            // iterations) and the positions before the families (a reused buffer).
+            let spin = (self.conserve_angular_momentum && self.w.iter().all(|&w| w > 0.0))
+                .then(|| centre_and_inertia(&self.prev, self.w.iter().map(|w| 1.0 / w)));
+            let mut before = std::mem::take(&mut self.before);
             for _ in 0..self.iterations {
-                let before = self.x.clone();
+                before.clone_from(&self.x);
                 for family in self.order {
                     match family {
                         Family::Edge => self.project_edges(h, &mut lambdas.edge),
@@ -171,10 +178,11 @@ impl Xpbd64 {
                         Family::Volume => self.project_volume(h, &mut lambdas.volume),
                     }
                 }
-                if self.conserve_angular_momentum && free {
-                    self.remove_spin(&before);
+                if let Some(fit) = spin {
+                    self.remove_spin(&before, fit);
                 }
             }
+            self.before = before;
             let mut clamped = false;
             for i in 0..self.x.len() {
                 let mut v = (self.x[i] - self.prev[i]) / h;
@@ -196,9 +204,8 @@ impl Xpbd64 {
 
     /// The solver's spin removal (as tetpbd's `spin` module): the rigid-rotation part of the
     /// families' corrections `x − before`, about the centre of mass at the substep start.
-    fn remove_spin(&mut self, before: &[V3]) {
+    fn remove_spin(&mut self, before: &[V3], (c, inertia): (V3, Matrix3<f64>)) {
         let m = self.w.iter().map(|w| 1.0 / w);
-        let (c, inertia) = centre_and_inertia(&self.prev, m.clone());
         let mut torque = V3::zeros();
         for ((x, b), (p, mi)) in self.x.iter().zip(before).zip(self.prev.iter().zip(m)) {
             torque += (p - c).cross(&(x - b)) * mi;

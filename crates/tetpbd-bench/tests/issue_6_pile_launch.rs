@@ -9,14 +9,10 @@
 //! 60 frames (about 1 s): it fails without the change (a particle 2.7 cm inside the ground at
 //! frame 56) and checks every substep's end.
 
-use rapier3d::math::Vector;
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 use tetpbd::hecs::{Entity, World};
-use tetpbd::{Particles, SoftBodyBuilder, SolverSettings, SubstepHook};
-use tetpbd_bench::{ContactScene, GROUND_HALF_EXTENTS};
-use tetpbd_rapier::{
-    CoupledWorld, CouplingSettings, DeformationDamping, SoftContactSettings, SoftContacts,
-};
+use tetpbd::{Particles, SubstepHook};
+use tetpbd_bench::{tetpbd_contact_world, ContactScene};
+use tetpbd_rapier::{SoftContactSettings, SoftContacts};
 
 /// The lowest particle of any body at the end of every substep, m.
 struct Lowest {
@@ -38,36 +34,7 @@ impl SubstepHook for Lowest {
 #[test]
 fn struck_cube_stays_out_of_the_ground() {
     let scene = ContactScene::pile(60).unwrap();
-    let solver = SolverSettings {
-        substeps: 80,
-        ..Default::default()
-    };
-    let coupling = CouplingSettings {
-        self_weight_stacking: true,
-        ..Default::default()
-    };
-    let mut world = CoupledWorld::new(solver, coupling).unwrap();
-    let [x, y, z] = GROUND_HALF_EXTENTS;
-    world.physics.insert(
-        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -y, 0.0)),
-        ColliderBuilder::cuboid(x, y, z),
-    );
-    let mut bodies = Vec::new();
-    for at in &scene.placements {
-        let e = SoftBodyBuilder::new(scene.cube.clone())
-            .density(scene.density)
-            .edges(0.0)
-            .volume(0.0)
-            .translation(*at)
-            .build()
-            .unwrap()
-            .spawn(&mut world.soft);
-        world
-            .soft
-            .insert_one(e, DeformationDamping::new(5.0).unwrap())
-            .unwrap();
-        bodies.push(e);
-    }
+    let (mut world, bodies) = tetpbd_contact_world(&scene, 5.0, true, 80, 1).unwrap();
     let contacts = SoftContacts::new(SoftContactSettings::default()).unwrap();
     let lowest = Lowest {
         bodies: bodies.clone(),

@@ -87,12 +87,8 @@ pub(crate) fn restore(run: RestoreRun<'_>, h: f32) {
         return;
     }
     let u = -dp / total;
-    // About the centre of mass: Σ m r × δv and Σ m r rᵀ from the sums about the origin.
-    let c = first / total;
-    let dl = dl - c.cross(&dp);
-    let spread = second - c * c.transpose() * total;
-    let inertia = Matrix3::identity() * spread.trace() - spread;
-    let omega = crate::spin::solve_pseudo(&inertia, &-dl).unwrap_or_default();
+    let (c, omega) = crate::spin::rigid_fit(total, first, second, -dl, -dp)
+        .unwrap_or((first / total, Vector3::zeros()));
     if !u.iter().all(|x| x.is_finite()) {
         return;
     }

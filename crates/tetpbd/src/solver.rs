@@ -34,8 +34,9 @@ pub struct SolverSettings {
     /// length, m/s (positions keep their full correction). `None` = no clamp. On a body
     /// without pinned particles, the linear and angular momentum the clamps removed are
     /// given back as a rigid velocity change of the whole body, so the net never changes the
-    /// body's momentum; a body with pinned particles gets the per-particle clamp alone. Cost: a compare per particle per substep, plus two serial
-    /// passes over a body's particles in substeps where it clamped one of them. See
+    /// body's momentum; a body with pinned particles gets the per-particle clamp alone.
+    /// Cost: a compare per particle per substep, plus two serial passes over a body's
+    /// particles in substeps where it clamped one of them. See
     /// [`systems::update_velocities`]; clamps are counted in
     /// [`StepStats::velocity_clamps`].
     pub max_correction_speed: Option<f32>,

@@ -53,8 +53,6 @@
 use hecs::World;
 use nalgebra::{Matrix3, Vector3};
 
-use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-use crate::mesh::Tetrahedra;
 use crate::particles::Particles;
 use crate::systems::add_compensated;
 use crate::work::Slot;
@@ -66,17 +64,7 @@ const INERTIA_CUTOFF: f64 = 1e-9;
 /// rigid-rotation part of the corrections the families made on it since it was loaded (the
 /// copy in the slots, `Particles` still holding the positions before the families).
 pub(crate) fn store_bodies_without_spin(world: &mut World) {
-    for (p, e, t, vf, vol) in world.query_mut::<(
-        &mut Particles,
-        Option<&EdgeConstraints>,
-        Option<&Tetrahedra>,
-        Option<&VertexFaceConstraints>,
-        Option<&VolumeConstraints>,
-    )>() {
-        if e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some())) {
-            store_without_spin(p);
-        }
-    }
+    crate::work::for_each_swept(world, store_without_spin);
 }
 
 /// [`store_bodies_without_spin`] for one body. A free body is stored and measured in one
@@ -149,17 +137,9 @@ fn finish(
     prev_positions: &[Vector3<f32>],
     o: Vector3<f32>,
 ) {
-    let mass = sums.mass;
-    if !(mass.is_finite() && mass > 0.0) {
-        return;
-    }
-    let c = sums.first / mass;
-    // Σ m r × Δ with r = x̄ − c, and Σ m r rᵀ, from the raw sums.
-    let torque = sums.torque - c.cross(&sums.push);
     let [xx, yy, zz, xy, xz, yz] = sums.second;
-    let spread = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz) - c * c.transpose() * mass;
-    let inertia = Matrix3::identity() * spread.trace() - spread;
-    let Some(theta) = solve_pseudo(&inertia, &torque) else {
+    let second = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+    let Some((c, theta)) = rigid_fit(sums.mass, sums.first, second, sums.torque, sums.push) else {
         return;
     };
     if theta == Vector3::zeros() {
@@ -276,9 +256,28 @@ impl Moments<f64> {
     }
 }
 
-/// `I⁺ b` for the symmetric positive semi-definite `I`, eigenvalues below
-/// [`INERTIA_CUTOFF`] of the largest taken as zero; `None` when not finite.
-pub(crate) fn solve_pseudo(inertia: &Matrix3<f64>, b: &Vector3<f64>) -> Option<Vector3<f64>> {
+/// The rigid rotation that best fits a field `wᵢ` on particles of masses `mᵢ` at `xᵢ`,
+/// from sums about any origin: `mass = Σ mᵢ`, `first = Σ mᵢ xᵢ`, `second = Σ mᵢ xᵢ xᵢᵀ`,
+/// `moment = Σ mᵢ xᵢ × wᵢ`, `total = Σ mᵢ wᵢ`. Returns the centre of mass `c` and
+/// `θ = I⁺ Σ mᵢ rᵢ × wᵢ` with `rᵢ = xᵢ − c` and `I = Σ mᵢ(|rᵢ|²𝟙 − rᵢrᵢᵀ)` (eigenvalues
+/// below [`INERTIA_CUTOFF`] of the largest taken as zero): the least-squares `θ` of
+/// `Σ mᵢ |wᵢ − θ × rᵢ|²` for the part of `w` without its mean. `None` without mass or when
+/// not finite. Used by the spin removal (`w` the corrections) and the safety net's momentum
+/// restoration (`crate::momentum`, `w` the velocity the clamp removed).
+pub(crate) fn rigid_fit(
+    mass: f64,
+    first: Vector3<f64>,
+    second: Matrix3<f64>,
+    moment: Vector3<f64>,
+    total: Vector3<f64>,
+) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    if !(mass.is_finite() && mass > 0.0) {
+        return None;
+    }
+    let c = first / mass;
+    let spread = second - c * c.transpose() * mass;
+    let inertia = Matrix3::identity() * spread.trace() - spread;
+    let b = moment - c.cross(&total);
     if !inertia.iter().chain(b.iter()).all(|x| x.is_finite()) {
         return None;
     }
@@ -287,13 +286,13 @@ pub(crate) fn solve_pseudo(inertia: &Matrix3<f64>, b: &Vector3<f64>) -> Option<V
     if !(largest.is_finite() && largest > 0.0) {
         return None;
     }
-    let mut x = Vector3::zeros();
+    let mut theta = Vector3::zeros();
     for k in 0..3 {
         let l = eig.eigenvalues[k];
         if l > largest * INERTIA_CUTOFF {
             let u = eig.eigenvectors.column(k);
-            x += u * (u.dot(b) / l);
+            theta += u * (u.dot(&b) / l);
         }
     }
-    x.iter().all(|v| v.is_finite()).then_some(x)
+    theta.iter().all(|v| v.is_finite()).then_some((c, theta))
 }

@@ -131,26 +131,23 @@ type Swept<'a> = (
     Option<&'a VolumeConstraints>,
 );
 
-fn swept(e: bool, t: bool, vf: bool, vol: bool) -> bool {
-    e || (t && (vf || vol))
+/// Runs `f` on every body a family system sweeps.
+pub(crate) fn for_each_swept(world: &mut World, mut f: impl FnMut(&mut Particles)) {
+    for (p, e, t, vf, vol) in world.query_mut::<Swept<'_>>() {
+        if e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some())) {
+            f(p);
+        }
+    }
 }
 
 /// [`load`] for every body a family system sweeps.
 pub(crate) fn load_bodies(world: &mut World) {
-    for (p, e, t, vf, vol) in world.query_mut::<Swept<'_>>() {
-        if swept(e.is_some(), t.is_some(), vf.is_some(), vol.is_some()) {
-            load(p);
-        }
-    }
+    for_each_swept(world, load);
 }
 
 /// [`store`] for every body a family system sweeps.
 pub(crate) fn store_bodies(world: &mut World) {
-    for (p, e, t, vf, vol) in world.query_mut::<Swept<'_>>() {
-        if swept(e.is_some(), t.is_some(), vf.is_some(), vol.is_some()) {
-            store(p);
-        }
-    }
+    for_each_swept(world, store);
 }
 
 /// Serial access to the slots.

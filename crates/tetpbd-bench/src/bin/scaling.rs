@@ -50,7 +50,7 @@ use std::time::Instant;
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, shuffled, CellSplit};
 use tetpbd::{EdgeConstraints, SoftBodyBuilder, Solver, SolverSettings, StepStats, TetMesh};
-use tetpbd_bench::{arg, flag, orders};
+use tetpbd_bench::{arg, arg_str, flag, orders};
 
 /// Warm-up frames of each body, not measured.
 const WARM_UP: usize = 2;
@@ -263,11 +263,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames = arg("--frames", 15).max(1);
     let parts = arg("--parts", 0);
     let sequential = flag("--sequential");
-    let args: Vec<String> = std::env::args().collect();
-    let only = args
-        .iter()
-        .position(|a| a == "--set")
-        .and_then(|i| args.get(i + 1).cloned());
+    let only = arg_str("--set");
     let shuffle = flag("--shuffle");
     let breakdown = flag("--breakdown");
     let parallel = cfg!(feature = "parallel");

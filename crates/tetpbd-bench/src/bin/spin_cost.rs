@@ -12,7 +12,7 @@
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{SoftBodyBuilder, Solver, SolverSettings, StepStats};
-use tetpbd_bench::{arg, DT};
+use tetpbd_bench::{arg, arg_str, DT};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -25,13 +25,7 @@ fn ms(d: std::time::Duration) -> f64 {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames = arg("--frames", 40);
-    let args: Vec<String> = std::env::args().collect();
-    let set = args
-        .iter()
-        .position(|a| a == "--set")
-        .and_then(|i| args.get(i + 1))
-        .map_or("edges+volume", String::as_str)
-        .to_string();
+    let set = arg_str("--set").unwrap_or_else(|| "edges+volume".to_string());
     println!("free cube, {set}, zero gravity, slowly spinning; 10 substeps × 1 iteration per 1/60 s frame; median of {frames} frames per column");
     println!(
         "| tetrahedra | particles | off, ms/frame | on, ms/frame | on/off | removal with the copy back, ms/frame |"
