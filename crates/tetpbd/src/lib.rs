@@ -1,15 +1,23 @@
 //! Tetrahedral soft bodies solved with (extended) position-based dynamics, stored as
 //! [`hecs`] components.
 //!
-//! Three layers:
+//! The crate, folder by folder:
 //!
-//! * [`constraint`] — the math of the three constraints Müller et al. (2006) use for
+//! * [`constraints`] — the math of the three constraints Müller et al. (2006) use for
 //!   tetrahedra (edge distance, vertex–face, signed volume) as pure functions, with the XPBD
 //!   update written once in its module docs;
 //! * components — [`Particles`] (flat arrays per quantity), [`Tetrahedra`], [`Surface`] and
 //!   one optional component per constraint family ([`EdgeConstraints`],
 //!   [`VertexFaceConstraints`], [`VolumeConstraints`]): a body pays only for the families it has;
-//! * [`systems`] — plain functions over `&mut hecs::World`, run in order by [`Solver`].
+//! * [`systems`] — plain functions over `&mut hecs::World`, run in order by [`Solver`]
+//!   (the `solver` folder: [`Solver`], [`SolverSettings`], [`SubstepHook`], [`StepStats`]).
+//!
+//! Inside the crate, `body/` builds bodies and holds their components, `stabilisation/` the
+//! optional passes that keep a body well-behaved (the correction-speed safety net's momentum
+//! restoration, the angular-momentum conservation, the ground-up sweep), `kernels/` the
+//! scalar and SIMD projections over the working copy of the particles, `parallel/` the
+//! parallel sweeps (feature `parallel`) and `ordering/` the build-time orders (colour
+//! classes, spatial renumbering, domain decomposition).
 //!
 //! ```
 //! use nalgebra::Vector3;
@@ -25,47 +33,35 @@
 //! ```
 #![warn(missing_docs)]
 
-#[cfg(feature = "parallel")]
-mod affinity;
-mod builder;
-pub mod constraint;
+mod body;
+pub mod constraints;
 mod error;
-mod families;
-pub mod generators;
-mod lanes;
-mod level_order;
-pub mod locality;
-mod mesh;
-mod momentum;
-pub mod ordering;
+mod kernels;
+mod ordering;
 #[cfg(feature = "parallel")]
 mod parallel;
-mod particles;
-pub mod partition;
-mod projection;
-mod runs;
-#[cfg(feature = "parallel")]
-mod schedule;
-mod simd;
 mod solver;
-mod spin;
-mod stacking;
-mod stats;
-#[cfg(feature = "sync-stats")]
-pub mod sync_stats;
-pub mod systems;
-#[cfg(feature = "parallel")]
-mod team;
-mod work;
+mod stabilisation;
 
-pub use builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
+pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
+pub use body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+pub use body::generators;
+pub use body::mesh::{Surface, Tetrahedra};
+pub use body::particles::{ExternalAcceleration, Particles};
 pub use error::{BuildError, SettingsError, StateError};
-pub use families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-pub use mesh::{Surface, Tetrahedra};
-pub use particles::{ExternalAcceleration, Particles};
-pub use solver::{Solver, SolverSettings, SubstepHook};
-pub use stacking::{project_stacked, BodyConstraints, StackingLayers};
-pub use stats::{ErrorAccumulator, ErrorStats, Family, FamilyStats, StepStats};
+pub use ordering::ColourClasses;
+pub use solver::hook::SubstepHook;
+pub use solver::settings::SolverSettings;
+pub use solver::stats::{ErrorAccumulator, ErrorStats, Family, FamilyStats, StepStats};
+pub use solver::step::Solver;
+pub use solver::systems;
+pub use stabilisation::ground_up::{project_stacked, BodyConstraints, StackingLayers};
+
+/// The constraint math under its former name; the same module as [`constraints`].
+#[doc(hidden)]
+pub use constraints as constraint;
+#[cfg(feature = "sync-stats")]
+pub use parallel::sync_stats;
 
 pub use hecs;
 pub use nalgebra;

@@ -2,7 +2,7 @@
 //! (edges or tetrahedra) by level, each level in greedy colour classes so that the SIMD
 //! kernels run a class in lanes, and the per-sweep copies of the items' data in that order.
 
-use crate::ordering::{greedy_colour, OVERFLOW_COLOUR};
+use crate::ordering::colouring::{greedy_colour, OVERFLOW_COLOUR};
 
 /// Colour of the overflow class of a greedy colouring (its items may share particles).
 const OVERFLOW: usize = OVERFLOW_COLOUR as usize;

@@ -25,15 +25,15 @@ pub struct Particles {
     pub(crate) masses: Vec<f32>,
     pub(crate) rest_positions: Vec<Vector3<f32>>,
     /// Rounding residual of the current substep's position updates (see
-    /// [`crate::systems::add_compensated`]); zeroed by prediction.
+    /// [`crate::solver::systems::add_compensated`]); zeroed by prediction.
     pub(crate) residuals: Vec<Vector3<f32>>,
     /// Input vertex of each particle (see [`crate::SoftBodyBuilder::spatial_order`]).
     pub(crate) source: Vec<u32>,
     /// Particle of each input vertex (the inverse of `source`).
     pub(crate) vertex_to_particle: Vec<u32>,
-    /// The projections' working copy (scratch, see [`crate::work`]).
+    /// The projections' working copy (scratch, see [`crate::kernels::working_copy`]).
     #[cfg_attr(feature = "serde", serde(skip))]
-    pub(crate) work: crate::work::WorkCopy,
+    pub(crate) work: crate::kernels::working_copy::WorkCopy,
 }
 
 impl Particles {

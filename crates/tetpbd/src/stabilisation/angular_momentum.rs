@@ -42,7 +42,7 @@
 //! `O(|θ|²)`.
 //!
 //! Only the families' own corrections are measured (between the working copy's load and
-//! store, [`crate::work`]): a [`crate::SubstepHook`]'s contacts and attachments apply real
+//! store, [`crate::kernels::working_copy`]): a [`crate::SubstepHook`]'s contacts and attachments apply real
 //! torques and are left alone. A body with a pinned particle is skipped: its pins exert
 //! torque. Sums in f32 over blocks of 256 particles and in f64 across blocks, in block
 //! order on one thread: the result does not depend on the thread count (with the
@@ -53,18 +53,18 @@
 use hecs::World;
 use nalgebra::{Matrix3, Vector3};
 
-use crate::particles::Particles;
-use crate::systems::add_compensated;
-use crate::work::Slot;
+use crate::body::particles::Particles;
+use crate::kernels::working_copy::Slot;
+use crate::solver::systems::add_compensated;
 
 /// Eigenvalues of the inertia tensor below this fraction of the largest count as zero.
 const INERTIA_CUTOFF: f64 = 1e-9;
 
-/// Copies every swept body's working copy back ([`crate::work::store`]) and removes the
+/// Copies every swept body's working copy back ([`crate::kernels::working_copy::store`]) and removes the
 /// rigid-rotation part of the corrections the families made on it since it was loaded (the
 /// copy in the slots, `Particles` still holding the positions before the families).
 pub(crate) fn store_bodies_without_spin(world: &mut World) {
-    crate::work::for_each_swept(world, store_without_spin);
+    crate::kernels::working_copy::for_each_swept(world, store_without_spin);
 }
 
 /// [`store_bodies_without_spin`] for one body. A free body is stored and measured in one
@@ -72,7 +72,7 @@ pub(crate) fn store_bodies_without_spin(world: &mut World) {
 fn store_without_spin(p: &mut Particles) {
     let n = p.positions.len();
     if n == 0 || p.work.0.len() != n || p.inv_masses.contains(&0.0) {
-        crate::work::store(p);
+        crate::kernels::working_copy::store(p);
         return;
     }
     // Raw moments about the first particle's start `o` (small numbers, little
@@ -96,11 +96,11 @@ fn store_without_spin(p: &mut Particles) {
         masses,
     };
     #[cfg(feature = "parallel")]
-    if crate::parallel::particles_worth_it(n) {
+    if crate::parallel::sweeps::particles_worth_it(n) {
         BLOCKS.with_borrow_mut(|blocks| {
             blocks.clear();
             blocks.resize(n.div_ceil(BLOCK), Moments::default());
-            crate::parallel::store_measuring(run, o, blocks);
+            crate::parallel::sweeps::store_measuring(run, o, blocks);
             for block in blocks.iter() {
                 sums.fold(block);
             }
@@ -148,8 +148,8 @@ fn finish(
     // Δᵢ −= θ × rᵢ = rᵢ × θ, with rᵢ = x̄ᵢ − o − c.
     let (theta, c) = (theta.cast::<f32>(), c.cast::<f32>());
     #[cfg(feature = "parallel")]
-    if crate::parallel::particles_worth_it(positions.len()) {
-        crate::parallel::rotate_back(positions, residuals, prev_positions, [o, c], theta);
+    if crate::parallel::sweeps::particles_worth_it(positions.len()) {
+        crate::parallel::sweeps::rotate_back(positions, residuals, prev_positions, [o, c], theta);
         return;
     }
     rotate_back(positions, residuals, prev_positions, [o, c], theta);
@@ -263,7 +263,7 @@ impl Moments<f64> {
 /// below [`INERTIA_CUTOFF`] of the largest taken as zero): the least-squares `θ` of
 /// `Σ mᵢ |wᵢ − θ × rᵢ|²` for the part of `w` without its mean. `None` without mass or when
 /// not finite. Used by the spin removal (`w` the corrections) and the safety net's momentum
-/// restoration (`crate::momentum`, `w` the velocity the clamp removed).
+/// restoration (`crate::stabilisation::momentum_restoration`, `w` the velocity the clamp removed).
 pub(crate) fn rigid_fit(
     mass: f64,
     first: Vector3<f64>,

@@ -8,7 +8,7 @@
 //! stable sort by colour turn that chain into independent work the CPU overlaps. Within a
 //! colour the original order, and with it memory locality, is kept. The items of a class
 //! are what the parallel sweep runs concurrently; a large body's classes are grouped by the
-//! parts of the body first ([`crate::partition`]).
+//! parts of the body first ([`crate::ordering::partition`]).
 
 /// Greedy colour of each item (an edge or a tetrahedron given by its particle indices).
 /// Colours above 63 share the last class; the order stays valid, only less independent.
@@ -42,7 +42,7 @@ pub(crate) fn greedy_colour(item: &[u32], used: &mut [u64]) -> u8 {
 /// A sweep runs the phases one after another. The tasks of one phase touch pairwise disjoint
 /// particles, and a task's classes run in order (on one thread, with the `parallel`
 /// feature). In the plain layout of [`colour_order`] every class is a task and a phase of its
-/// own (its items, independent, are split among the threads); [`crate::partition`] groups
+/// own (its items, independent, are split among the threads); [`crate::ordering::partition`] groups
 /// the classes of each part of a body into one task. Serially, the classes run in storage
 /// order, which is phase order, task order within a phase and class order within a task: the
 /// same operations in the same order on any number of threads.
@@ -157,4 +157,38 @@ pub fn colour_order<const N: usize>(
     starts.push(items.len() as u32);
     let overflow = last == Some(OVERFLOW_COLOUR);
     (order, ColourClasses::plain(starts, overflow))
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector3;
+
+    use super::greedy_colours;
+    use crate::generators::{box_grid, CellSplit};
+
+    #[test]
+    fn items_of_one_colour_share_no_particle() {
+        let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [4, 4, 4], CellSplit::Six).unwrap();
+        let n = mesh.vertices.len();
+        let colours = greedy_colours(&mesh.tets, n);
+        let max = *colours.iter().max().unwrap();
+        assert!(max < 63, "the grid needs {} colours", max + 1);
+        for c in 0..=max {
+            let mut seen = vec![false; n];
+            for (t, tet) in mesh
+                .tets
+                .iter()
+                .enumerate()
+                .filter(|(t, _)| colours[*t] == c)
+            {
+                for &i in tet {
+                    assert!(
+                        !seen[i as usize],
+                        "colour {c}: tetrahedron {t} reuses particle {i}"
+                    );
+                    seen[i as usize] = true;
+                }
+            }
+        }
+    }
 }

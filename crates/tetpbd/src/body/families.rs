@@ -17,11 +17,11 @@ pub struct EdgeConstraints {
     /// Compliance α, m/N (inverse stiffness; 0 = rigid). Must be finite and ≥ 0.
     pub(crate) compliance: f32,
     /// Colour classes of `edges` (edges of one class share no particle).
-    pub(crate) classes: crate::ordering::ColourClasses,
+    pub(crate) classes: crate::ordering::colouring::ColourClasses,
 }
 
 /// Vertex–face constraints: four per tetrahedron, each vertex held at its signed rest height
-/// above the plane of the other three (see [`crate::constraint::vertex_face`]). Uses the
+/// above the plane of the other three (see [`crate::constraints::vertex_face`]). Uses the
 /// body's [`crate::Tetrahedra`].
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
@@ -79,8 +79,8 @@ impl EdgeConstraints {
     }
 
     /// The sweep order of the edges: colour classes, tasks and phases (see
-    /// [`crate::ordering::ColourClasses`]).
-    pub fn classes(&self) -> &crate::ordering::ColourClasses {
+    /// [`crate::ordering::colouring::ColourClasses`]).
+    pub fn classes(&self) -> &crate::ordering::colouring::ColourClasses {
         &self.classes
     }
 

@@ -8,41 +8,14 @@
 use hecs::World;
 use nalgebra::Vector3;
 
-use crate::constraint::{self, VERTEX_FACE_ORDER};
-use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-use crate::mesh::Tetrahedra;
-use crate::particles::{ExternalAcceleration, Particles};
-use crate::projection;
-use crate::runs::{edge_run, vertex_face_run, volume_run};
-use crate::stats::{ErrorAccumulator, ErrorStats, Family};
-use crate::work::{self, CopyMode, WorkAccess};
-
-/// Projections done and skipped by one call of a family system.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct ProjectionCount {
-    /// Projections applied.
-    pub applied: u64,
-    /// Degenerate configurations skipped or handled by a fallback direction.
-    pub degenerate: u64,
-}
-
-impl ProjectionCount {
-    #[inline(always)]
-    pub(crate) fn add(&mut self, o: projection::Outcome) {
-        match o {
-            projection::Outcome::Applied => self.applied += 1,
-            projection::Outcome::Degenerate => self.degenerate += 1,
-            projection::Outcome::Skipped => {}
-        }
-    }
-}
-
-impl std::ops::AddAssign for ProjectionCount {
-    fn add_assign(&mut self, o: ProjectionCount) {
-        self.applied += o.applied;
-        self.degenerate += o.degenerate;
-    }
-}
+use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::body::mesh::Tetrahedra;
+use crate::body::particles::{ExternalAcceleration, Particles};
+use crate::constraints::{self, VERTEX_FACE_ORDER};
+use crate::kernels::class_runs::{edge_run, vertex_face_run, volume_run};
+pub use crate::kernels::count::{Kernel, ProjectionCount};
+use crate::kernels::working_copy::{self, CopyMode, WorkAccess};
+use crate::solver::stats::{ErrorAccumulator, ErrorStats, Family};
 
 /// Saves `x` as the substep start, applies gravity plus each body's
 /// [`ExternalAcceleration`] and the linear damping `v ← v · max(0, 1 − damping·h)` to free
@@ -70,8 +43,8 @@ pub fn predict(world: &mut World, h: f32, gravity: Vector3<f32>, damping: f32) {
             residuals,
         };
         #[cfg(feature = "parallel")]
-        if crate::parallel::particles_worth_it(run.positions.len()) {
-            crate::parallel::predict(run, a, h, keep);
+        if crate::parallel::sweeps::particles_worth_it(run.positions.len()) {
+            crate::parallel::sweeps::predict(run, a, h, keep);
             continue;
         }
         run.predict(a, h, keep);
@@ -139,24 +112,11 @@ pub fn reset_lambdas(world: &mut World) {
 /// Sets every multiplier of a family to zero (in parallel on a large family).
 fn zero<T: Default + Copy + Send + Sync>(lambdas: &mut [T]) {
     #[cfg(feature = "parallel")]
-    if crate::parallel::worth_it(lambdas.len()) {
-        crate::parallel::fill(lambdas, T::default());
+    if crate::parallel::sweeps::worth_it(lambdas.len()) {
+        crate::parallel::sweeps::fill(lambdas, T::default());
         return;
     }
     lambdas.fill(T::default());
-}
-
-/// Which kernels the projections run on.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum Kernel {
-    /// One constraint at a time: the reference.
-    Scalar,
-    /// Four independent constraints of a colour class at once (`wide::f32x4`), the rest
-    /// and the overflow class on the scalar kernel. Agrees with [`Kernel::Scalar`] to
-    /// rounding.
-    #[default]
-    Simd,
 }
 
 /// One Gauss–Seidel sweep over every body's [`EdgeConstraints`] with the default kernel.
@@ -182,7 +142,7 @@ pub fn project_vertex_face(world: &mut World, h: f32) -> ProjectionCount {
 /// One Gauss–Seidel sweep over every body's [`VertexFaceConstraints`]: the four constraints
 /// of a tetrahedron one after another, tetrahedra in solver (colour) order.
 ///
-/// Each constraint is the degeneracy-aware form [`crate::constraint::vertex_face_bounded`]:
+/// Each constraint is the degeneracy-aware form [`crate::constraints::vertex_face_bounded`]:
 /// the height where the face is healthy, the signed volume over a bounded area where the face
 /// is thin (near collinear), so the gradients stay bounded. A face collapsed to a point (no
 /// plane, no direction) is counted and given a fallback: `p1` is held at its rest value above
@@ -217,7 +177,8 @@ pub(crate) fn project_family(
         Family::Edge => {
             for (p, e) in world.query_mut::<(&mut Particles, &mut EdgeConstraints)>() {
                 let alpha_tilde = e.compliance / (h * h);
-                count += work::with_access(p, mode, |acc| edges_of(acc, e, alpha_tilde, kernel));
+                count +=
+                    working_copy::with_access(p, mode, |acc| edges_of(acc, e, alpha_tilde, kernel));
             }
         }
         Family::VertexFace => {
@@ -225,7 +186,7 @@ pub(crate) fn project_family(
                 world.query_mut::<(&mut Particles, &Tetrahedra, &mut VertexFaceConstraints)>()
             {
                 let alpha_tilde = vf.compliance / (h * h);
-                count += work::with_access(p, mode, |acc| {
+                count += working_copy::with_access(p, mode, |acc| {
                     vertex_faces_of(acc, tets, vf, alpha_tilde, kernel)
                 });
             }
@@ -235,7 +196,7 @@ pub(crate) fn project_family(
                 world.query_mut::<(&mut Particles, &Tetrahedra, &mut VolumeConstraints)>()
             {
                 let alpha_tilde = vol.compliance / (h * h);
-                count += work::with_access(p, mode, |acc| {
+                count += working_copy::with_access(p, mode, |acc| {
                     volumes_of(acc, tets, vol, alpha_tilde, kernel)
                 });
             }
@@ -252,8 +213,8 @@ fn edges_of(
     kernel: Kernel,
 ) -> ProjectionCount {
     #[cfg(feature = "parallel")]
-    if crate::parallel::worth_it(e.edges.len()) {
-        return crate::parallel::edges(acc, e, alpha_tilde, kernel);
+    if crate::parallel::sweeps::worth_it(e.edges.len()) {
+        return crate::parallel::sweeps::edges(acc, e, alpha_tilde, kernel);
     }
     let mut count = ProjectionCount::default();
     for (r, independent) in e.classes.ranges() {
@@ -276,8 +237,8 @@ fn vertex_faces_of(
     kernel: Kernel,
 ) -> ProjectionCount {
     #[cfg(feature = "parallel")]
-    if crate::parallel::worth_it(tets.len()) {
-        return crate::parallel::vertex_face(acc, tets, vf, alpha_tilde, kernel);
+    if crate::parallel::sweeps::worth_it(tets.len()) {
+        return crate::parallel::sweeps::vertex_face(acc, tets, vf, alpha_tilde, kernel);
     }
     let mut count = ProjectionCount::default();
     for (r, independent) in tets.classes.ranges() {
@@ -300,8 +261,8 @@ fn volumes_of(
     kernel: Kernel,
 ) -> ProjectionCount {
     #[cfg(feature = "parallel")]
-    if crate::parallel::worth_it(tets.len()) {
-        return crate::parallel::volume(acc, tets, vol, alpha_tilde, kernel);
+    if crate::parallel::sweeps::worth_it(tets.len()) {
+        return crate::parallel::sweeps::volume(acc, tets, vol, alpha_tilde, kernel);
     }
     let mut count = ProjectionCount::default();
     for (r, independent) in tets.classes.ranges() {
@@ -372,22 +333,22 @@ pub fn update_velocities(
             residuals,
         };
         #[cfg(feature = "parallel")]
-        let u = if crate::parallel::particles_worth_it(run.positions.len()) {
-            crate::parallel::update_velocities(run, h, max_correction_speed)
+        let u = if crate::parallel::sweeps::particles_worth_it(run.positions.len()) {
+            crate::parallel::sweeps::update_velocities(run, h, max_correction_speed)
         } else {
             run.update(h, max_correction_speed)
         };
         #[cfg(not(feature = "parallel"))]
         let u = run.update(h, max_correction_speed);
         if u.clamped > 0 && !inv_masses.contains(&0.0) {
-            let run = crate::momentum::RestoreRun {
+            let run = crate::stabilisation::momentum_restoration::RestoreRun {
                 positions,
                 prev_positions,
                 residuals,
                 velocities,
                 masses,
             };
-            crate::momentum::restore(run, h);
+            crate::stabilisation::momentum_restoration::restore(run, h);
         }
         out += u;
     }
@@ -421,7 +382,7 @@ impl VelocityRun<'_> {
         let mut out = VelocityUpdate::default();
         for i in 0..positions.len() {
             // Divide, not multiply by 1/h: h · (1/h) ≠ 1 in f32, a bias every substep.
-            // `momentum::restore` recomputes this expression; keep the two the same.
+            // `momentum_restoration::restore` recomputes this expression; keep the two the same.
             let mut v = ((positions[i] - prev_positions[i]) + residuals[i]) / h;
             if let Some(limit) = max_correction_speed {
                 let dv = v - velocities[i];
@@ -476,9 +437,15 @@ pub fn measure(world: &mut World) -> Measured {
                 // A face collapsed to a point has no height; its violation is the full
                 // rest value.
                 let rest = vf.rest_heights[t][k];
-                let hgt =
-                    constraint::bounded_height(&a, &b, &c, &d, constraint::VERTEX_FACE_KAPPA, rest)
-                        .unwrap_or(0.0);
+                let hgt = constraints::bounded_height(
+                    &a,
+                    &b,
+                    &c,
+                    &d,
+                    constraints::VERTEX_FACE_KAPPA,
+                    rest,
+                )
+                .unwrap_or(0.0);
                 vface.add(hgt - rest);
             }
         }

@@ -16,7 +16,7 @@
 //! same pool each leave the other's helper loop within [`LINGER`]).
 //!
 //! A helper that finds itself on the core of the step's thread (the kernel often wakes it
-//! there) moves to another core for as long as it stays in the team ([`crate::affinity`]):
+//! there) moves to another core for as long as it stays in the team ([`crate::parallel::affinity`]):
 //! two threads spinning on one core run no faster than one.
 //!
 //! Posting: the job (a closure on this thread's stack) is published with an odd epoch, and
@@ -29,8 +29,8 @@ use std::cell::{Cell, UnsafeCell};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-use crate::affinity::{current_cpu, Moved};
-use crate::schedule::Backoff;
+use crate::parallel::affinity::{current_cpu, Moved};
+use crate::parallel::schedule::Backoff;
 
 /// How long a helper waits for the next job before it leaves the team.
 const LINGER: Duration = Duration::from_micros(500);
@@ -186,12 +186,12 @@ fn help(team: &Team) {
     team.helpers.fetch_sub(1, Ordering::SeqCst);
 }
 
-/// Moves this helper off the step thread's core if it is on it (see [`crate::affinity`]).
+/// Moves this helper off the step thread's core if it is on it (see [`crate::parallel::affinity`]).
 fn move_off_step(team: &Team, moved: &mut Moved) {
     let Some(cpu) = current_cpu() else { return };
     if team.step_cpu.load(Ordering::Relaxed) == cpu && moved.off(cpu) {
         #[cfg(feature = "sync-stats")]
-        crate::sync_stats::moved();
+        crate::parallel::sync_stats::moved();
     }
 }
 
@@ -199,7 +199,7 @@ fn move_off_step(team: &Team, moved: &mut Moved) {
 /// run) when this thread has no team or the team has no helper left.
 ///
 /// `worker` must be safe to run any number of times concurrently and must return once the
-/// pass is done, whoever did its work (the workers of [`crate::schedule::run_phases`] are).
+/// pass is done, whoever did its work (the workers of [`crate::parallel::schedule::run_phases`] are).
 pub(crate) fn post(worker: &(dyn Fn() + Sync)) -> bool {
     let team = CURRENT.with(|c| c.get());
     if team.is_null() {
@@ -245,7 +245,7 @@ impl Drop for Close<'_> {
         }
         #[cfg(feature = "sync-stats")]
         if let Some(since) = since {
-            crate::sync_stats::close(since);
+            crate::parallel::sync_stats::close(since);
         }
         // SAFETY: the epoch is even again and `active` drained: no helper reads the job.
         unsafe { *team.job.get() = None };

@@ -1,11 +1,11 @@
 //! Runs of one colour class through the kernels, and the choice of instruction set.
 //!
-//! The SIMD kernels are written once over a lane type ([`crate::simd::Lane`]). On a CPU with
+//! The SIMD kernels are written once over a lane type ([`crate::kernels::lane_types::Lane`]). On a CPU with
 //! AVX2 and FMA, the runs are also compiled with those features enabled (`#[target_feature]`)
 //! and chosen at run time (`is_x86_feature_detected!`): VEX-encoded three-operand
 //! instructions drop most of the register copies SSE2's two-operand forms need, and pairs of
-//! chunks run on one 256-bit register ([`crate::simd::Y8`]) instead of two 128-bit halves
-//! ([`crate::simd::X2`], the SSE2 build). Rust never contracts `a * b + c` into a fused
+//! chunks run on one 256-bit register ([`crate::kernels::lane_types::Y8`]) instead of two 128-bit halves
+//! ([`crate::kernels::lane_types::X2`], the SSE2 build). Rust never contracts `a * b + c` into a fused
 //! multiply–add on its own, and both pair types do the same IEEE operations on every lane in
 //! the same order, so both builds give bit-identical results: which one runs changes the
 //! speed only, never the trajectory (and the serial and parallel sweeps, on any number of
@@ -13,12 +13,12 @@
 
 use wide::f32x4;
 
-use crate::lanes;
-use crate::projection::{self, ParticleAccess};
+use crate::kernels::count::{Kernel, ProjectionCount};
 #[cfg(target_arch = "x86_64")]
-use crate::simd::Y8;
-use crate::simd::{Lane, X2};
-use crate::systems::{Kernel, ProjectionCount};
+use crate::kernels::lane_types::Y8;
+use crate::kernels::lane_types::{Lane, X2};
+use crate::kernels::lanes;
+use crate::kernels::scalar::{self, ParticleAccess};
 
 /// Projects a run of constraints of one colour class: when the class is independent and the
 /// kernel is SIMD, in pairs of chunks of [`lanes::LANES`] ([`X2`]), then one chunk of four,
@@ -69,7 +69,7 @@ fn edge_run_base<P: Lane, A: ParticleAccess>(
         acc,
         edges,
         edges(rest, lambdas, alpha_tilde),
-        |a, k| one(projection::edge(
+        |a, k| one(scalar::edge(
             a,
             edges[k],
             rest[k],
@@ -97,7 +97,7 @@ fn volume_run_base<P: Lane, A: ParticleAccess>(
         acc,
         tets,
         volumes(rest, lambdas, alpha_tilde),
-        |a, k| one(projection::volume(
+        |a, k| one(scalar::volume(
             a,
             tets[k],
             rest[k],
@@ -130,13 +130,13 @@ fn vertex_face_run_base<P: Lane, A: ParticleAccess>(
         tets,
         vertex_faces(heights, held, lambdas, alpha_tilde),
         |a, k| {
-            let (ap, d) = projection::vertex_face_held(
+            let (ap, d) = scalar::vertex_face_held(
                 a,
                 tets[k],
                 &heights[k],
                 &mut lambdas[k],
                 alpha_tilde,
-                projection::held_mask(held, k),
+                scalar::held_mask(held, k),
             );
             ProjectionCount {
                 applied: u64::from(ap),
@@ -146,7 +146,7 @@ fn vertex_face_run_base<P: Lane, A: ParticleAccess>(
     )
 }
 
-fn one(o: projection::Outcome) -> ProjectionCount {
+fn one(o: scalar::Outcome) -> ProjectionCount {
     let mut c = ProjectionCount::default();
     c.add(o);
     c
@@ -219,8 +219,8 @@ mod tests {
     use nalgebra::Vector3;
 
     use super::*;
-    use crate::generators::{box_grid, CellSplit};
-    use crate::work::{self, Slot, WorkAccess};
+    use crate::body::generators::{box_grid, CellSplit};
+    use crate::kernels::working_copy::{self, Slot, WorkAccess};
     use crate::{SoftBody, SoftBodyBuilder};
 
     /// A 1 m cube of `cells³` cells with all three families (edges 1e-6, volume 1e-9,
@@ -237,7 +237,7 @@ mod tests {
         for (i, x) in body.particles.positions.iter_mut().enumerate() {
             *x = f(i, *x);
         }
-        work::load(&mut body.particles);
+        working_copy::load(&mut body.particles);
         body
     }
 

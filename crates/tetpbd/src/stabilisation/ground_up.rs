@@ -56,15 +56,15 @@
 //! (the rapier coupling runs it for a soft body on an immovable support that carries a much
 //! heavier rigid body).
 
-use crate::constraint::VERTEX_FACE_ORDER;
-use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-use crate::level_order::{shift_starts, Gathered, LevelOrder};
-use crate::mesh::Tetrahedra;
-use crate::particles::Particles;
-use crate::runs;
-use crate::stats::Family;
-use crate::systems::{Kernel, ProjectionCount};
-use crate::work;
+use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::body::mesh::Tetrahedra;
+use crate::body::particles::Particles;
+use crate::constraints::VERTEX_FACE_ORDER;
+use crate::kernels::class_runs;
+use crate::kernels::count::{Kernel, ProjectionCount};
+use crate::kernels::working_copy;
+use crate::solver::stats::Family;
+use crate::stabilisation::ground_up_levels::{shift_starts, Gathered, LevelOrder};
 
 /// Level of a particle that no root reaches.
 const UNREACHED: u32 = u32::MAX;
@@ -344,7 +344,7 @@ pub fn project_stacked(
         volume_data.gather(o, &tets.indices, &tets.rest_volumes, &v.lambdas, *gathered);
     }
     *gathered = true;
-    work::with_access(p, work::CopyMode::PerSweep, |acc| {
+    working_copy::with_access(p, working_copy::CopyMode::PerSweep, |acc| {
         // Hold the roots: inverse mass 0 for the sweep, restored after it.
         held.clear();
         for &r in roots.iter() {
@@ -362,7 +362,7 @@ pub fn project_stacked(
                         };
                         let alpha_tilde = e.compliance / (h * h);
                         for (r, independent) in edge_order.level(l) {
-                            count += runs::edge_run(
+                            count += class_runs::edge_run(
                                 acc,
                                 &edge_data.items[r.clone()],
                                 &edge_data.rest[r.clone()],
@@ -383,7 +383,7 @@ pub fn project_stacked(
                         // barely depends on a face point whose opposite edge passes under
                         // the vertex) and blew the slab up.
                         for (r, independent) in tet_order.level(l) {
-                            count += runs::vertex_face_run(
+                            count += class_runs::vertex_face_run(
                                 acc,
                                 &vertex_face_data.items[r.clone()],
                                 &vertex_face_data.rest[r.clone()],
@@ -401,7 +401,7 @@ pub fn project_stacked(
                         };
                         let alpha_tilde = vol.compliance / (h * h);
                         for (r, independent) in tet_order.level(l) {
-                            count += runs::volume_run(
+                            count += class_runs::volume_run(
                                 acc,
                                 &volume_data.items[r.clone()],
                                 &volume_data.rest[r.clone()],
@@ -438,7 +438,7 @@ mod tests {
     use nalgebra::Vector3;
 
     use super::*;
-    use crate::generators::{box_grid, CellSplit};
+    use crate::body::generators::{box_grid, CellSplit};
     use crate::SoftBodyBuilder;
 
     /// Checks one family's sweep order: every reached item once, levels ascending, and the

@@ -6,7 +6,7 @@
 //! scatter, and the inverse mass and residual live in other arrays (other cache lines).
 //! The particles are copied into their slots ([`load`]), swept, and copied back
 //! ([`store`]): one aligned load fetches a particle's position and inverse mass, a 4 × 4
-//! transpose turns four of them into lanes (see [`crate::lanes`]), and the compensated
+//! transpose turns four of them into lanes (see [`crate::kernels::lanes`]), and the compensated
 //! update of a particle is a handful of 4-wide operations on its two rows. A public family
 //! system copies in and out around its own sweep ([`CopyMode::PerSweep`]); the solver copies
 //! once per iteration around all the families of a body ([`CopyMode::Resident`]). The
@@ -20,10 +20,10 @@ use hecs::World;
 use nalgebra::Vector3;
 use wide::f32x4;
 
-use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-use crate::mesh::Tetrahedra;
-use crate::particles::Particles;
-use crate::projection::ParticleAccess;
+use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::body::mesh::Tetrahedra;
+use crate::body::particles::Particles;
+use crate::kernels::scalar::ParticleAccess;
 
 /// One particle during a sweep.
 #[derive(Clone, Copy, Default)]
@@ -37,7 +37,7 @@ pub(crate) struct Slot {
 
 impl Slot {
     /// Moves the particle by `d` (`[dx, dy, dz, 0]`), keeping the rounding error in the
-    /// residual: [`crate::systems::add_compensated`] on four lanes (the inverse mass lane
+    /// residual: [`crate::solver::systems::add_compensated`] on four lanes (the inverse mass lane
     /// adds 0 and stays as it is).
     #[inline(always)]
     pub fn add(&mut self, d: f32x4) {
@@ -73,8 +73,8 @@ pub(crate) fn load(p: &mut Particles) {
         slots.resize(n, Slot::default());
     }
     #[cfg(feature = "parallel")]
-    if crate::parallel::particles_worth_it(n) {
-        crate::parallel::load(slots, &p.positions, &p.inv_masses, &p.residuals);
+    if crate::parallel::sweeps::particles_worth_it(n) {
+        crate::parallel::sweeps::load(slots, &p.positions, &p.inv_masses, &p.residuals);
         return;
     }
     load_run(slots, &p.positions, &p.inv_masses, &p.residuals);
@@ -91,8 +91,8 @@ pub(crate) fn load_run(slots: &mut [Slot], x: &[Vector3<f32>], w: &[f32], r: &[V
 /// Copies positions and residuals back from the slots.
 pub(crate) fn store(p: &mut Particles) {
     #[cfg(feature = "parallel")]
-    if crate::parallel::particles_worth_it(p.positions.len()) {
-        crate::parallel::store(&p.work.0, &mut p.positions, &mut p.residuals);
+    if crate::parallel::sweeps::particles_worth_it(p.positions.len()) {
+        crate::parallel::sweeps::store(&p.work.0, &mut p.positions, &mut p.residuals);
         return;
     }
     store_run(&p.work.0, &mut p.positions, &mut p.residuals);

@@ -3,14 +3,14 @@
 use hecs::{Entity, World};
 use nalgebra::Vector3;
 
-use crate::constraint::{bounded_height, signed_volume, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
+use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::body::mesh::{Surface, Tetrahedra};
+use crate::body::particles::Particles;
+use crate::constraints::{bounded_height, signed_volume, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
 use crate::error::BuildError;
-use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-use crate::locality::{inverse, mean_edge_length, relabel_tets, row_order};
-use crate::mesh::{Surface, Tetrahedra};
-use crate::particles::Particles;
-use crate::partition::{auto_parts, longest_axis, part_order, slab_parts};
-use crate::work::{Slot, WorkCopy};
+use crate::kernels::working_copy::{Slot, WorkCopy};
+use crate::ordering::partition::{auto_parts, longest_axis, part_order, slab_parts};
+use crate::ordering::spatial::{inverse, mean_edge_length, relabel_tets, row_order};
 
 /// A tetrahedral mesh: vertex positions (m) and tetrahedra as vertex indices.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -162,7 +162,7 @@ impl SoftBodyBuilder {
         self
     }
 
-    /// Renumbers the particles in rows of about one edge length (see [`crate::locality`]) so that
+    /// Renumbers the particles in rows of about one edge length (see [`crate::ordering::spatial`]) so that
     /// particles close in space are close in memory, which speeds up the projections of
     /// meshes whose vertex numbering is unrelated to space (mesh files). When on, particle `k`
     /// of the built body is input vertex [`Particles::source`]`()[k]`, and
@@ -174,7 +174,7 @@ impl SoftBodyBuilder {
     }
 
     /// Cuts the body into `parts` slabs for the solver's sweep order (see
-    /// [`crate::partition`]); 0 (the default) chooses by size ([`crate::partition::auto_parts`]:
+    /// [`crate::ordering::partition`]); 0 (the default) chooses by size ([`crate::ordering::partition::auto_parts`]:
     /// 1, the plain colour classes, below 50,000 tetrahedra). The order changes which
     /// constraint is projected after which (so the rounding and, slightly, the convergence),
     /// never what a step does on a given number of threads versus another.

@@ -2,8 +2,8 @@
 
 use nalgebra::Vector3;
 
-use crate::builder::TetMesh;
-use crate::constraint::signed_volume;
+use crate::body::builder::TetMesh;
+use crate::constraints::signed_volume;
 use crate::error::BuildError;
 
 /// How a grid cell is split into tetrahedra.

@@ -1,4 +1,4 @@
-//! The lane types the kernels of [`crate::lanes`] are written over: `wide::f32x4` (four
+//! The lane types the kernels of [`crate::kernels::lanes`] are written over: `wide::f32x4` (four
 //! constraints, one chunk) and [`X2`] (two chunks side by side, eight constraints).
 //!
 //! Every operation of [`X2`] is the same `f32x4` operation on each half, so a lane computes

@@ -1,7 +1,7 @@
 //! The momentum restoration of the correction-speed safety net
 //! ([`crate::SolverSettings::max_correction_speed`]).
 //!
-//! The per-particle clamp of [`crate::systems::update_velocities`] removes a velocity
+//! The per-particle clamp of [`crate::solver::systems::update_velocities`] removes a velocity
 //! `δvᵢ = v_clampedᵢ − v_unclampedᵢ` from each clamped particle, and with it the linear
 //! momentum `ΔP = Σ mᵢδvᵢ` and the angular momentum `ΔL = Σ mᵢ rᵢ × δvᵢ` about the centre of
 //! mass `c` (`rᵢ = xᵢ − c`): an asymmetric snap-back clamped particle by particle used to
@@ -45,7 +45,7 @@ pub(crate) struct RestoreRun<'a> {
 }
 
 /// Gives back the linear and angular momentum the clamp removed from one body whose
-/// velocities were just set by [`crate::systems::VelocityRun::update`] with step `h` (s).
+/// velocities were just set by [`crate::solver::systems::VelocityRun::update`] with step `h` (s).
 ///
 /// The unclamped velocity of each particle is recomputed with the same expression the
 /// update used, so a particle the clamp left alone contributes exactly zero. A particle the
@@ -87,8 +87,9 @@ pub(crate) fn restore(run: RestoreRun<'_>, h: f32) {
         return;
     }
     let u = -dp / total;
-    let (c, omega) = crate::spin::rigid_fit(total, first, second, -dl, -dp)
-        .unwrap_or((first / total, Vector3::zeros()));
+    let (c, omega) =
+        crate::stabilisation::angular_momentum::rigid_fit(total, first, second, -dl, -dp)
+            .unwrap_or((first / total, Vector3::zeros()));
     if !u.iter().all(|x| x.is_finite()) {
         return;
     }

@@ -2,30 +2,31 @@
 //! share a particle, so a class's projections run concurrently and the result is
 //! bit-identical to the serial sweep, for any number of threads. A family's sweep is one
 //! parallel region whose phases are those of its [`ColourClasses`], run one after another
-//! ([`crate::schedule::run_phases`]): a class alone in its phase is split among the threads
-//! (the overflow class, see [`crate::ordering`], runs on one thread); the tasks of a
-//! partitioned body ([`crate::partition`]) run each whole on one thread, on disjoint slabs. The passes over the particles of a large body (prediction, the copies into
+//! ([`crate::parallel::schedule::run_phases`]): a class alone in its phase is split among the threads
+//! (the overflow class, see [`crate::ordering::colouring`], runs on one thread); the tasks of a
+//! partitioned body ([`crate::ordering::partition`]) run each whole on one thread, on disjoint slabs. The passes over the particles of a large body (prediction, the copies into
 //! and out of the working copy, the velocity update) run the same way as one phase of runs
 //! of particles: each particle's update is independent, so they are bit-identical too. The
-//! spin removal's copy back ([`crate::spin`]) sums per block of particles, one block per
+//! spin removal's copy back ([`crate::stabilisation::angular_momentum`]) sums per block of particles, one block per
 //! unit, and the blocks are folded in order on one thread: bit-identical as well.
 //! Inside [`crate::Solver::step`] every region is posted to the step's team
-//! ([`crate::team`]) instead of waking the pool's threads.
+//! ([`crate::parallel::team`]) instead of waking the pool's threads.
 
 use std::ops::Range;
 
 use nalgebra::Vector3;
 use wide::f32x4;
 
-use crate::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-use crate::mesh::Tetrahedra;
-use crate::ordering::{ColourClasses, Phase};
-use crate::projection::ParticleAccess;
-use crate::runs::{edge_run, vertex_face_run, volume_run};
-use crate::schedule::{run_phases, Nothing, Shared, Split, PARTICLE_CHUNK};
-use crate::spin::{self, Moments, StoreRun, BLOCK};
-use crate::systems::{Kernel, PredictRun, ProjectionCount, VelocityRun, VelocityUpdate};
-use crate::work::{self, Slot, WorkAccess};
+use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::body::mesh::Tetrahedra;
+use crate::kernels::class_runs::{edge_run, vertex_face_run, volume_run};
+use crate::kernels::count::{Kernel, ProjectionCount};
+use crate::kernels::scalar::ParticleAccess;
+use crate::kernels::working_copy::{self, Slot, WorkAccess};
+use crate::ordering::colouring::{ColourClasses, Phase};
+use crate::parallel::schedule::{run_phases, Nothing, Shared, Split, PARTICLE_CHUNK};
+use crate::solver::systems::{PredictRun, VelocityRun, VelocityUpdate};
+use crate::stabilisation::angular_momentum::{self, Moments, StoreRun, BLOCK};
 
 /// Bodies with fewer constraints in a family than this take the serial path.
 const MIN_PARALLEL: usize = 4096;
@@ -66,7 +67,7 @@ fn particle_pass<C: Default + std::ops::AddAssign + Send>(
     run_phases(1, PARTICLE_CHUNK, |_| (len, Split::Lanes), |_, r| f(r))
 }
 
-/// [`crate::systems::predict`] of one body, in runs of particles.
+/// [`crate::solver::systems::predict`] of one body, in runs of particles.
 pub(crate) fn predict(run: PredictRun<'_>, a: Vector3<f32>, h: f32, keep: f32) {
     let n = run.positions.len();
     let (x, xp, v, r) = (
@@ -92,7 +93,7 @@ pub(crate) fn predict(run: PredictRun<'_>, a: Vector3<f32>, h: f32, keep: f32) {
     });
 }
 
-/// [`crate::systems::update_velocities`] of one body, in runs of particles (the counts are
+/// [`crate::solver::systems::update_velocities`] of one body, in runs of particles (the counts are
 /// sums, whatever the split). The safety net's momentum restoration that may follow runs on
 /// one thread, after this pass (its sums in particle order, so the result does not depend on
 /// the thread count).
@@ -129,26 +130,26 @@ pub(crate) fn fill<T: Copy + Send + Sync>(items: &mut [T], value: T) {
     });
 }
 
-/// [`crate::work::load`] in runs of particles.
+/// [`crate::kernels::working_copy::load`] in runs of particles.
 pub(crate) fn load(slots: &mut [Slot], x: &[Vector3<f32>], w: &[f32], r: &[Vector3<f32>]) {
     let n = slots.len().min(x.len()).min(w.len()).min(r.len());
     let s = Shared::new(slots);
     particle_pass(n, |i| {
         // SAFETY: `particle_pass` hands each particle to one call only.
         let slots = unsafe { s.run(i.clone()) };
-        work::load_run(slots, &x[i.clone()], &w[i.clone()], &r[i]);
+        working_copy::load_run(slots, &x[i.clone()], &w[i.clone()], &r[i]);
         Nothing
     });
 }
 
-/// [`crate::work::store`] in runs of particles.
+/// [`crate::kernels::working_copy::store`] in runs of particles.
 pub(crate) fn store(slots: &[Slot], x: &mut [Vector3<f32>], r: &mut [Vector3<f32>]) {
     let n = slots.len().min(x.len()).min(r.len());
     let (xs, rs) = (Shared::new(x), Shared::new(r));
     particle_pass(n, |i| {
         // SAFETY: `particle_pass` hands each particle to one call only.
         let (x, r) = unsafe { (xs.run(i.clone()), rs.run(i.clone())) };
-        work::store_run(&slots[i], x, r);
+        working_copy::store_run(&slots[i], x, r);
         Nothing
     });
 }
@@ -164,7 +165,7 @@ struct SharedAccess {
 // SAFETY: a `SharedAccess` is only handed to the projections of one colour class, which
 // touch pairwise disjoint particles (greedy colouring; the overflow class, whose items may
 // overlap, never runs in parallel), or to the tasks of one phase of a partitioned sweep,
-// which touch disjoint slabs of particles (crate::partition). The slices it points into outlive the parallel loop and
+// which touch disjoint slabs of particles (crate::ordering::partition). The slices it points into outlive the parallel loop and
 // are borrowed mutably by it, so no other access exists meanwhile.
 unsafe impl Send for SharedAccess {}
 // SAFETY: as above.
@@ -218,7 +219,7 @@ impl ParticleAccess for SharedAccess {
     }
 }
 
-/// Runs `f` over every class, in one parallel region ([`crate::schedule::run_phases`]: the
+/// Runs `f` over every class, in one parallel region ([`crate::parallel::schedule::run_phases`]: the
 /// phases of `classes` are its phases). A phase of one class is split among the threads in
 /// chunks; a phase of tasks hands each task whole to one thread, which runs its classes in
 /// order. `f` gets the access, the run's first item index, the run's multipliers and whether
@@ -240,7 +241,7 @@ fn sweep<T: Send>(
     };
     run_phases(
         classes.phase_count(),
-        crate::schedule::CLASS_CHUNK,
+        crate::parallel::schedule::CLASS_CHUNK,
         |j| match classes.phase(j) {
             Phase::Class(k) => {
                 let (r, independent) = classes.class(k);
@@ -329,8 +330,8 @@ pub(crate) fn vertex_face(
     })
 }
 
-/// The spin removal's measuring copy back ([`crate::spin`]) of one body: one unit per
-/// block of [`crate::spin::BLOCK`] particles, each block's f32 sums written to its entry of
+/// The spin removal's measuring copy back ([`crate::stabilisation::angular_momentum`]) of one body: one unit per
+/// block of [`crate::stabilisation::angular_momentum::BLOCK`] particles, each block's f32 sums written to its entry of
 /// `blocks` (the caller folds them in block order, as the serial path does, so the result
 /// does not depend on the thread count).
 pub(crate) fn store_measuring(run: StoreRun<'_>, o: Vector3<f32>, blocks: &mut [Moments<f32>]) {
@@ -363,7 +364,7 @@ pub(crate) fn store_measuring(run: StoreRun<'_>, o: Vector3<f32>, blocks: &mut [
     );
 }
 
-/// [`crate::spin::rotate_back`] in runs of particles.
+/// [`crate::stabilisation::angular_momentum::rotate_back`] in runs of particles.
 pub(crate) fn rotate_back(
     positions: &mut [Vector3<f32>],
     residuals: &mut [Vector3<f32>],
@@ -379,7 +380,7 @@ pub(crate) fn rotate_back(
     particle_pass(n, |i| {
         // SAFETY: `particle_pass` hands each particle to one call only.
         let (x, r) = unsafe { (x.run(i.clone()), r.run(i.clone())) };
-        spin::rotate_back(x, r, &prev_positions[i], origin_centre, theta);
+        angular_momentum::rotate_back(x, r, &prev_positions[i], origin_centre, theta);
         Nothing
     });
 }

@@ -5,12 +5,12 @@ use serde::{Deserialize, Serialize};
 
 use nalgebra::Vector3;
 
-use crate::constraint::signed_volume;
+use crate::constraints::signed_volume;
 
 /// The tetrahedra of one soft body with their signed rest volumes (a hecs component).
 ///
 /// Indices refer to the body's [`crate::Particles`]. The tetrahedra are stored in solver
-/// order (colour classes, see [`crate::ordering`]), not in the order they were given:
+/// order (colour classes, see [`crate::ordering::colouring`]), not in the order they were given:
 /// [`Tetrahedra::source`] maps each back to its index in the input mesh. A tetrahedron may have either
 /// orientation; its rest volume keeps the sign it was built with, and it counts as
 /// inverted when its current signed volume has the opposite sign.
@@ -21,7 +21,7 @@ pub struct Tetrahedra {
     pub(crate) rest_volumes: Vec<f32>,
     pub(crate) source: Vec<u32>,
     /// Colour classes of `indices` (tetrahedra of one class share no particle).
-    pub(crate) classes: crate::ordering::ColourClasses,
+    pub(crate) classes: crate::ordering::colouring::ColourClasses,
 }
 
 impl Tetrahedra {
@@ -36,8 +36,8 @@ impl Tetrahedra {
     }
 
     /// The sweep order of the tetrahedra: colour classes, tasks and phases (see
-    /// [`crate::ordering::ColourClasses`]).
-    pub fn classes(&self) -> &crate::ordering::ColourClasses {
+    /// [`crate::ordering::colouring::ColourClasses`]).
+    pub fn classes(&self) -> &crate::ordering::colouring::ColourClasses {
         &self.classes
     }
 

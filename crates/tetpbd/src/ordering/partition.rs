@@ -1,6 +1,6 @@
 //! Domain decomposition of a large body, fixed at build time: fewer phases per sweep.
 //!
-//! A parallel sweep over plain colour classes ([`crate::ordering::colour_order`]) has one
+//! A parallel sweep over plain colour classes ([`crate::ordering::colouring::colour_order`]) has one
 //! phase per class, and between two phases every thread waits for the others: a
 //! 100k-tetrahedron body has 30 classes of tetrahedra and 14 of edges, each a few hundred
 //! microseconds of work or less, so the waits and the imbalance at each boundary cost a
@@ -25,7 +25,7 @@
 
 use nalgebra::Vector3;
 
-use crate::ordering::{colour_order, greedy_colours, ColourClasses};
+use crate::ordering::colouring::{colour_order, greedy_colours, ColourClasses};
 
 /// Tetrahedra per part of [`auto_parts`] at least (below it a body keeps the plain layout).
 pub const TETS_PER_PART: usize = 25_000;
@@ -51,7 +51,7 @@ pub fn auto_parts(tets: usize, extent: f32) -> usize {
 }
 
 /// The axis (0, 1, 2) of the longest extent of `positions`, preferring z, then y, on ties
-/// (row order numbers particles by z first, see [`crate::locality`]), and that extent.
+/// (row order numbers particles by z first, see [`crate::ordering::spatial`]), and that extent.
 pub fn longest_axis(positions: &[Vector3<f32>]) -> (usize, f32) {
     let mut lo = Vector3::repeat(f32::INFINITY);
     let mut hi = Vector3::repeat(f32::NEG_INFINITY);
@@ -232,7 +232,7 @@ impl Layout {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::generators::{box_grid, CellSplit};
+    use crate::body::generators::{box_grid, CellSplit};
 
     /// Every item once; the tasks of a phase touch disjoint particles; every class of a
     /// task is independent; the phases cover the tasks and the tasks the classes.

@@ -4,16 +4,16 @@
 use nalgebra::Vector3;
 use wide::f32x4;
 
-use crate::constraint::{self, Evaluated, VERTEX_FACE_ORDER};
+use crate::constraints::{self, Evaluated, VERTEX_FACE_ORDER};
 
-/// How a projection reads and moves particles (see [`crate::work`] for the layout).
+/// How a projection reads and moves particles (see [`crate::kernels::working_copy`] for the layout).
 pub(crate) trait ParticleAccess {
     /// `[x, y, z, w]`: position (m) and inverse mass (1/kg) of particle `i`.
     fn row(&self, i: usize) -> f32x4;
     /// Rest position of particle `i`.
     fn rest(&self, i: usize) -> Vector3<f32>;
     /// Moves particle `i` by `d = [dx, dy, dz, 0]`, compensated (see
-    /// [`crate::systems::add_compensated`]).
+    /// [`crate::solver::systems::add_compensated`]).
     fn add_row(&mut self, i: usize, d: f32x4);
     /// Number of particles: `i < len()` is in range. Constant while the access lives (the
     /// unchecked accesses below rely on it).
@@ -64,7 +64,7 @@ pub(crate) enum Outcome {
 }
 
 /// One XPBD projection of `e`; no particle moves further than `max_step` (m; see
-/// [`constraint::bounded_step`], `f32::INFINITY` for no bound).
+/// [`constraints::bounded_step`], `f32::INFINITY` for no bound).
 #[inline(always)]
 fn apply<A: ParticleAccess, const N: usize>(
     a: &mut A,
@@ -79,11 +79,11 @@ fn apply<A: ParticleAccess, const N: usize>(
         .iter()
         .zip(&e.grad)
         .fold(0.0f32, |s, (w, g)| s + w * g.norm_squared());
-    match constraint::xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
+    match constraints::xpbd_delta_lambda(e.c, *lambda, alpha_tilde, w_grad_sq) {
         Some(dl) => {
             // `w_max Σ wᵢ|∇ᵢC|² ≥ maxᵢ (wᵢ|∇ᵢC|)²`: the bound holds for every particle.
             let w_max = w.iter().fold(0.0f32, |m, &x| m.max(x));
-            let dl = constraint::bounded_step(dl, w_max * w_grad_sq, max_step);
+            let dl = constraints::bounded_step(dl, w_max * w_grad_sq, max_step);
             *lambda += dl;
             for k in 0..N {
                 a.add(idx[k], e.grad[k] * (w[k] * dl));
@@ -113,7 +113,7 @@ pub(crate) fn edge<A: ParticleAccess>(
         ((acc.rest(a) - acc.rest(b)) * (1.0 / d), true)
     };
     let (wa, wb) = (acc.w(a), acc.w(b));
-    let Some(dl) = constraint::xpbd_delta_lambda(len - d, *lambda, alpha_tilde, wa + wb) else {
+    let Some(dl) = constraints::xpbd_delta_lambda(len - d, *lambda, alpha_tilde, wa + wb) else {
         return Outcome::Skipped;
     };
     *lambda += dl;
@@ -127,14 +127,14 @@ pub(crate) fn edge<A: ParticleAccess>(
 }
 
 /// The four vertex–face constraints of one tetrahedron, one after another, in the
-/// degeneracy-aware form [`constraint::vertex_face_bounded`] with
-/// [`constraint::VERTEX_FACE_KAPPA`]; only the constraints `k` with `held[k]` (constraint `k`
+/// degeneracy-aware form [`constraints::vertex_face_bounded`] with
+/// [`constraints::VERTEX_FACE_KAPPA`]; only the constraints `k` with `held[k]` (constraint `k`
 /// holds vertex `tet[VERTEX_FACE_ORDER[k][1]]` above the face of the other three; all four
 /// in an ordinary sweep), the others are left alone. A face collapsed to a point falls back
 /// to holding `p1` at its rest value above `p0` along the face's rest normal (linear in
 /// `p0`, `p1`; re-expands a collapsed tetrahedron). No projection moves a particle further
-/// than [`constraint::vertex_face_step_bound`] of the tetrahedron's rest values (bounded
-/// corrections: [`constraint::bounded_step`]).
+/// than [`constraints::vertex_face_step_bound`] of the tetrahedron's rest values (bounded
+/// corrections: [`constraints::bounded_step`]).
 #[inline(always)]
 pub(crate) fn vertex_face_held<A: ParticleAccess>(
     acc: &mut A,
@@ -145,20 +145,20 @@ pub(crate) fn vertex_face_held<A: ParticleAccess>(
     held: [bool; 4],
 ) -> (u32, u32) {
     let (mut applied, mut degenerate) = (0, 0);
-    let max_step = constraint::vertex_face_step_bound(rest_heights);
+    let max_step = constraints::vertex_face_step_bound(rest_heights);
     for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
         if !held[k] {
             continue;
         }
         let idx = order.map(|o| tet[o] as usize);
         let p = idx.map(|i| acc.x(i));
-        match constraint::vertex_face_bounded(
+        match constraints::vertex_face_bounded(
             &p[0],
             &p[1],
             &p[2],
             &p[3],
             rest_heights[k],
-            constraint::VERTEX_FACE_KAPPA,
+            constraints::VERTEX_FACE_KAPPA,
         ) {
             Some(e) => {
                 if apply(acc, idx, &e, &mut lambdas[k], alpha_tilde, max_step) {
@@ -193,7 +193,7 @@ pub(crate) fn volume<A: ParticleAccess>(
 ) -> Outcome {
     let idx = tet.map(|i| i as usize);
     let p = idx.map(|i| acc.x(i));
-    let e = constraint::volume(&p[0], &p[1], &p[2], &p[3], rest_volume);
+    let e = constraints::volume(&p[0], &p[1], &p[2], &p[3], rest_volume);
     if apply(acc, idx, &e, lambda, alpha_tilde, f32::INFINITY) {
         Outcome::Applied
     } else if idx.iter().any(|&i| acc.w(i) > 0.0) {

@@ -1,6 +1,6 @@
 //! Keeping a team's helper off the core of the thread it helps (feature `parallel`, Linux).
 //!
-//! Why: the helper of [`crate::team`] is a rayon thread woken by the step's thread, and the
+//! Why: the helper of [`crate::parallel::team`] is a rayon thread woken by the step's thread, and the
 //! kernel often wakes it on the waker's core. Two threads spinning on one core of this 2-core
 //! virtual machine share it: measured at 100k tetrahedra (docs/performance.md, "Why 2-thread
 //! frames at 100k are bimodal"), frames where up to 68 % of the chunks ran with both threads

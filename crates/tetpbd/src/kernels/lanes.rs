@@ -1,27 +1,27 @@
 //! SIMD kernels: four or eight constraints of one colour class projected at once, one per
 //! lane.
 //!
-//! Constraints of one colour class share no particle (see [`crate::ordering`]), so four of
-//! them are independent: the `[x, y, z, w]` rows of their particles (see [`crate::work`])
+//! Constraints of one colour class share no particle (see [`crate::ordering::colouring`]), so four of
+//! them are independent: the `[x, y, z, w]` rows of their particles (see [`crate::kernels::working_copy`])
 //! are loaded and transposed into lanes (`wide::f32x4`), the same formulas as
-//! [`crate::constraint`] run on all lanes, and the corrections are transposed back into
+//! [`crate::constraints`] run on all lanes, and the corrections are transposed back into
 //! rows and added with the compensated update. The kernels are written over a [`Lane`] type:
-//! a chunk of four (`f32x4`) or two chunks side by side ([`crate::simd::X2`]), which gives
-//! the same bits as the two chunks one after the other (see [`crate::simd`]). The scalar
-//! kernels in [`crate::projection`] are the reference these are tested against
+//! a chunk of four (`f32x4`) or two chunks side by side ([`crate::kernels::lane_types::X2`]), which gives
+//! the same bits as the two chunks one after the other (see [`crate::kernels::lane_types`]). The scalar
+//! kernels in [`crate::kernels::scalar`] are the reference these are tested against
 //! (`tests/lanes.rs`).
 //!
 //! A chunk whose lanes hit a degenerate configuration (a zero-length edge, a face too close
 //! to collinear) or, for vertex–face, a thin face (the thin branch of
-//! [`crate::constraint::vertex_face_bounded`]) is handed to the scalar kernel, which owns the
+//! [`crate::constraints::vertex_face_bounded`]) is handed to the scalar kernel, which owns the
 //! documented fallbacks; a pair of chunks that has one goes back to chunks of four.
 
 use wide::f32x4;
 
-use crate::constraint::{VERTEX_FACE_KAPPA, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER};
-use crate::projection::{self, ParticleAccess};
-use crate::simd::Lane;
-use crate::systems::ProjectionCount;
+use crate::constraints::{VERTEX_FACE_KAPPA, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER};
+use crate::kernels::count::ProjectionCount;
+use crate::kernels::lane_types::Lane;
+use crate::kernels::scalar::{self, ParticleAccess};
 
 /// Lanes per chunk.
 pub(crate) const LANES: usize = 4;
@@ -220,7 +220,7 @@ fn delta_lambda<L: Lane>(c: L, lambda: L, alpha_tilde: L, w_grad_sq: L) -> (L, L
     (ok.vsel((-c - alpha_tilde * lambda) / safe, L::ZERO), ok)
 }
 
-/// [`crate::constraint::bounded_step`] on every lane: `dl` scaled down where a particle
+/// [`crate::constraints::bounded_step`] on every lane: `dl` scaled down where a particle
 /// could move further than `max_step` (m), the farthest move per unit `dl` taken as
 /// `√(w_max · w_grad_sq)` (an upper bound of `maxₛ wₛ |gₛ|`, as the scalar kernel takes it).
 /// `limit = max_step² / w_max` is computed once per chunk, so only `dl` and `w_grad_sq` are
@@ -257,7 +257,7 @@ fn all_lanes<L: Lane>() -> u32 {
     (1 << L::WIDTH) - 1
 }
 
-/// `L::WIDTH` edges from `at` of the run. See [`projection::edge`]. A pair of chunks with a
+/// `L::WIDTH` edges from `at` of the run. See [`scalar::edge`]. A pair of chunks with a
 /// zero-length edge goes to [`edges`] chunk by chunk, a chunk of four with one to the scalar
 /// kernel.
 #[inline(always)]
@@ -284,7 +284,7 @@ pub(crate) fn edges<L: Lane, A: ParticleAccess>(
         let edges = chunk(b.items(), at);
         for (l, &e) in edges.iter().enumerate() {
             let k = at + l;
-            count.add(projection::edge(
+            count.add(scalar::edge(
                 b.acc(),
                 e,
                 rest[k],
@@ -306,7 +306,7 @@ pub(crate) fn edges<L: Lane, A: ParticleAccess>(
     }
 }
 
-/// `L::WIDTH` volume constraints from `at` of the run. See [`projection::volume`].
+/// `L::WIDTH` volume constraints from `at` of the run. See [`scalar::volume`].
 #[inline(always)]
 pub(crate) fn volumes<L: Lane, A: ParticleAccess>(
     bd: &mut Bounded<'_, A, 4>,
@@ -341,16 +341,16 @@ pub(crate) fn volumes<L: Lane, A: ParticleAccess>(
 
 /// The four vertex–face constraints of `L::WIDTH` tetrahedra from `at` of the run, the four
 /// one after another on all lanes, corrections accumulated in registers and scattered once.
-/// See [`projection::vertex_face_held`]: on healthy faces
-/// [`crate::constraint::vertex_face_bounded`] is the seed's height, which these lanes
+/// See [`scalar::vertex_face_held`]: on healthy faces
+/// [`crate::constraints::vertex_face_bounded`] is the seed's height, which these lanes
 /// compute. A chunk of four with a face not healthy by a margin of 2 at its start
 /// (`|b × c| ≤ 2κQ`, κ = [`VERTEX_FACE_KAPPA`]) goes to the scalar kernel (a pair of chunks
 /// with one, to this kernel chunk by chunk); a lane whose face turns thin (`|b × c| < κQ`)
 /// within the chunk skips that projection and counts it as degenerate. Every projection's
-/// `Δλ` is bounded as in the scalar kernel ([`crate::constraint::bounded_step`] with
-/// [`crate::constraint::vertex_face_step_bound`]), lane by lane. `held` (one row of four
+/// `Δλ` is bounded as in the scalar kernel ([`crate::constraints::bounded_step`] with
+/// [`crate::constraints::vertex_face_step_bound`]), lane by lane. `held` (one row of four
 /// 1/0 masks per tetrahedron of the run, or empty for all) leaves the constraints with 0
-/// alone, as [`projection::vertex_face_held`] does.
+/// alone, as [`scalar::vertex_face_held`] does.
 #[inline(always)]
 pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
     bd: &mut Bounded<'_, A, 4>,
@@ -383,13 +383,13 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
             let tets = chunk(bd.items(), at);
             for (l, &t) in tets.iter().enumerate() {
                 let k = at + l;
-                let (a, d) = projection::vertex_face_held(
+                let (a, d) = scalar::vertex_face_held(
                     bd.acc(),
                     t,
                     &heights[k],
                     &mut lambdas[k],
                     alpha_tilde,
-                    projection::held_mask(held, k),
+                    scalar::held_mask(held, k),
                 );
                 count.applied += u64::from(a);
                 count.degenerate += u64::from(d);
@@ -409,7 +409,7 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
     } else {
         [L::ONE; 4]
     };
-    // The move bound, as in `constraint::vertex_face_step_bound`: a fraction of max_k |d_k|
+    // The move bound, as in `constraints::vertex_face_step_bound`: a fraction of max_k |d_k|
     // (`√(d²) = |d|` exactly in IEEE arithmetic).
     let size = h.iter().fold(L::ZERO, |m, &d| m.vmax(d * d)).vsqrt();
     let max_step = L::splat(VERTEX_FACE_MAX_STEP) * size;

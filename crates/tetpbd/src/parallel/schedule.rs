@@ -4,7 +4,7 @@
 //!
 //! Why not one rayon parallel iterator per phase: a sweep of a 100k-tetrahedron body in the
 //! plain layout has 30 classes of tetrahedra (14 of edges), each a few hundred microseconds
-//! of work or less (a partitioned body has 3 phases per family, see [`crate::partition`]).
+//! of work or less (a partitioned body has 3 phases per family, see [`crate::ordering::partition`]).
 //! Between two parallel iterators rayon's idle thread goes to sleep and has to be woken, which
 //! on this virtual machine costs tens of microseconds each time (measured in
 //! docs/performance.md, "Scaling"). Here every thread of the pool enters once per sweep and
@@ -16,7 +16,7 @@
 //! owns region `i`: consecutive classes of a family cover the mesh in the same order, so the
 //! particles a thread touches stay in its cache from one phase to the next), then takes the
 //! chunks left in other regions. A phase that is not independent (the overflow class) is one
-//! chunk. A phase of *units* (the tasks of a partitioned sweep, [`crate::partition`]) is cut
+//! chunk. A phase of *units* (the tasks of a partitioned sweep, [`crate::ordering::partition`]) is cut
 //! the same way with one unit per chunk and no lane alignment: a task is never split.
 //!
 //! **Claiming and waiting.** Each region has a claim counter and a done counter, both
@@ -39,7 +39,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use crate::lanes::LANES;
+use crate::kernels::lanes::LANES;
 
 /// Constraints per chunk of a colour class: small enough to balance the threads at a class
 /// boundary (a 100k-tetrahedron body has 7–9 chunks per thread in most classes), large
@@ -193,7 +193,7 @@ fn wait_for(counter: &AtomicUsize, target: usize) {
         backoff.wait();
     }
     #[cfg(feature = "sync-stats")]
-    crate::sync_stats::phase(since);
+    crate::parallel::sync_stats::phase(since);
 }
 
 /// How long a wait spins (yielding the core every 256 rounds) before it sleeps between
@@ -274,7 +274,7 @@ pub(crate) fn run_phases<C: Default + AddAssign + Send>(
                 count += work(k, cut.items(r, j));
                 regions[r].done.fetch_add(1, Ordering::Release);
                 #[cfg(feature = "sync-stats")]
-                crate::sync_stats::chunk(index != own);
+                crate::parallel::sync_stats::chunk(index != own);
             }
             for (r, b) in before.iter_mut().enumerate().take(regions_n) {
                 *b += cut.chunks(r);
@@ -285,7 +285,7 @@ pub(crate) fn run_phases<C: Default + AddAssign + Send>(
             *t += count;
         }
     };
-    if !crate::team::post(&worker) {
+    if !crate::parallel::team::post(&worker) {
         fan_out(threads, &worker);
     }
     total.into_inner().unwrap_or_default()
@@ -305,7 +305,7 @@ fn fan_out(n: usize, worker: &(impl Fn() + Sync)) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::systems::ProjectionCount;
+    use crate::kernels::count::ProjectionCount;
 
     /// Every item of every phase is worked exactly once, phases in order, on 1 to 3 threads,
     /// and the ranges of an independent phase start at multiples of the lanes.

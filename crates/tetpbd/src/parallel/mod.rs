@@ -1,0 +1,14 @@
+//! Parallel sweeps (feature `parallel`), bit-identical to the serial ones for any number of
+//! threads.
+//!
+//! * [`sweeps`] — the parallel family sweeps and particle passes;
+//! * [`schedule`] — one parallel region per sweep, its phases split into chunks;
+//! * [`team`] — the pool's threads kept awake for one step;
+//! * [`affinity`] — moving a team helper off the stepping thread's core (Linux).
+
+pub(crate) mod affinity;
+pub(crate) mod schedule;
+pub(crate) mod sweeps;
+#[cfg(feature = "sync-stats")]
+pub mod sync_stats;
+pub(crate) mod team;
