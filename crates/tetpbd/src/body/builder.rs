@@ -162,8 +162,7 @@ impl SoftBodyBuilder {
         self
     }
 
-    /// Renumbers the particles in rows of about one edge length (see [`crate::ordering::spatial`]) so that
-    /// particles close in space are close in memory, which speeds up the projections of
+    /// Renumbers the particles in rows of about one edge length so that particles close in space are close in memory, which speeds up the projections of
     /// meshes whose vertex numbering is unrelated to space (mesh files). When on, particle `k`
     /// of the built body is input vertex [`Particles::source`]`()[k]`, and
     /// [`Particles::particle_of`] maps a vertex index to its particle. Default
@@ -173,9 +172,9 @@ impl SoftBodyBuilder {
         self
     }
 
-    /// Cuts the body into `parts` slabs for the solver's sweep order (see
-    /// [`crate::ordering::partition`]); 0 (the default) chooses by size ([`crate::ordering::partition::auto_parts`]:
-    /// 1, the plain colour classes, below 50,000 tetrahedra). The order changes which
+    /// Cuts the body into `parts` slabs along its longest axis for the solver's sweep order
+    /// (fewer phases per parallel sweep); 0 (the default) chooses by size (1, the plain
+    /// colour classes, below 50,000 tetrahedra). The order changes which
     /// constraint is projected after which (so the rounding and, slightly, the convergence),
     /// never what a step does on a given number of threads versus another.
     pub fn parts(mut self, parts: usize) -> Self {

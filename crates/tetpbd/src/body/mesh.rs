@@ -10,7 +10,7 @@ use crate::constraints::signed_volume;
 /// The tetrahedra of one soft body with their signed rest volumes (a hecs component).
 ///
 /// Indices refer to the body's [`crate::Particles`]. The tetrahedra are stored in solver
-/// order (colour classes, see [`crate::ordering::colouring`]), not in the order they were given:
+/// order (colour classes: items of one class share no particle), not in the order they were given:
 /// [`Tetrahedra::source`] maps each back to its index in the input mesh. A tetrahedron may have either
 /// orientation; its rest volume keeps the sign it was built with, and it counts as
 /// inverted when its current signed volume has the opposite sign.

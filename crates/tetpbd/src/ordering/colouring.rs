@@ -41,8 +41,8 @@ pub(crate) fn greedy_colour(item: &[u32], used: &mut [u64]) -> u8 {
 ///
 /// A sweep runs the phases one after another. The tasks of one phase touch pairwise disjoint
 /// particles, and a task's classes run in order (on one thread, with the `parallel`
-/// feature). In the plain layout of [`colour_order`] every class is a task and a phase of its
-/// own (its items, independent, are split among the threads); [`crate::ordering::partition`] groups
+/// feature). In the plain layout (`colour_order`) every class is a task and a phase of its
+/// own (its items, independent, are split among the threads); a partitioned body groups
 /// the classes of each part of a body into one task. Serially, the classes run in storage
 /// order, which is phase order, task order within a phase and class order within a task: the
 /// same operations in the same order on any number of threads.

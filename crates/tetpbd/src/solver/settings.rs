@@ -7,7 +7,7 @@ use crate::error::SettingsError;
 use crate::solver::stats::Family;
 use crate::solver::systems;
 
-/// Settings of a [`Solver`]. Fields are public; [`SolverSettings::validate`] (called by every
+/// Settings of a [`Solver`](crate::Solver). Fields are public; [`SolverSettings::validate`] (called by every
 /// step) rejects bad values with a typed error before they reach the state.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -35,7 +35,7 @@ pub struct SolverSettings {
     /// Cost: a compare per particle per substep, plus two serial passes over a body's
     /// particles in substeps where it clamped one of them. See
     /// [`systems::update_velocities`]; clamps are counted in
-    /// [`StepStats::velocity_clamps`].
+    /// [`crate::StepStats::velocity_clamps`].
     pub max_correction_speed: Option<f32>,
     /// Remove the rigid rotation the families' corrections carry, once per iteration, so
     /// that a free body's internal constraints conserve its angular momentum (default on).
@@ -45,13 +45,13 @@ pub struct SolverSettings {
     /// particles are left alone, as are a hook's contacts. Cost: the copy back from the
     /// working copy also measures the corrections, plus one more pass over a free body's
     /// particles per iteration (+2–13 % per frame, docs/performance.md); both counted in
-    /// [`StepStats::spin_time`] instead of [`StepStats::copy_time`] (see the `spin` module
+    /// [`crate::StepStats::spin_time`] instead of [`crate::StepStats::copy_time`] (see the `spin` module
     /// docs).
     pub conserve_angular_momentum: bool,
     /// Scalar or SIMD projection kernels (default SIMD; they agree to rounding).
     pub kernel: systems::Kernel,
     /// Evaluate every constraint after the step to fill [`crate::FamilyStats::after`] and
-    /// [`StepStats::inverted`]. Costs about one extra sweep; off by default.
+    /// [`crate::StepStats::inverted`]. Costs about one extra sweep; off by default.
     pub measure_error: bool,
     /// Also evaluate every constraint before the step ([`crate::FamilyStats::before`]).
     pub measure_before: bool,
