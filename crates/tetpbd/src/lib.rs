@@ -44,7 +44,7 @@ mod solver;
 mod stabilisation;
 
 pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
-pub use body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};
 pub use body::generators;
 pub use body::mesh::{Surface, Tetrahedra};
 pub use body::particles::{ExternalAcceleration, Particles};
@@ -52,7 +52,7 @@ pub use error::{BuildError, SettingsError, StateError};
 pub use ordering::ColourClasses;
 pub use solver::hook::SubstepHook;
 pub use solver::settings::SolverSettings;
-pub use solver::stats::{ErrorAccumulator, ErrorStats, Family, FamilyStats, StepStats};
+pub use solver::stats::{ErrorAccumulator, ErrorStats, FamilyStats, StepStats};
 pub use solver::step::Solver;
 pub use solver::systems;
 pub use stabilisation::ground_up::{project_stacked, BodyConstraints, StackingLayers};

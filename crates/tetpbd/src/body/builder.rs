@@ -8,7 +8,7 @@ use crate::body::mesh::{Surface, Tetrahedra};
 use crate::body::particles::Particles;
 use crate::constraints::{bounded_height, signed_volume, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
 use crate::error::BuildError;
-use crate::kernels::working_copy::{Slot, WorkCopy};
+use crate::kernels::slots::{Slot, WorkCopy};
 use crate::ordering::partition::{auto_parts, longest_axis, part_order, slab_parts};
 use crate::ordering::spatial::{inverse, mean_edge_length, relabel_tets, row_order};
 

@@ -33,7 +33,7 @@ pub struct Particles {
     pub(crate) vertex_to_particle: Vec<u32>,
     /// The projections' working copy (scratch, see [`crate::kernels::working_copy`]).
     #[cfg_attr(feature = "serde", serde(skip))]
-    pub(crate) work: crate::kernels::working_copy::WorkCopy,
+    pub(crate) work: crate::kernels::slots::WorkCopy,
 }
 
 impl Particles {

@@ -220,7 +220,8 @@ mod tests {
 
     use super::*;
     use crate::body::generators::{box_grid, CellSplit};
-    use crate::kernels::working_copy::{self, Slot, WorkAccess};
+    use crate::kernels::slots::{Slot, WorkAccess};
+    use crate::kernels::working_copy;
     use crate::{SoftBody, SoftBodyBuilder};
 
     /// A 1 m cube of `cells³` cells with all three families (edges 1e-6, volume 1e-9,

@@ -1,6 +1,8 @@
 //! The projection kernels and the memory they run on.
 //!
-//! * [`working_copy`] — the particles copied into 32-byte slots for the sweep;
+//! * [`working_copy`] — the particles copied into 32-byte slots for the sweep ([`slots`]);
+//! * [`compensated`] — the compensated position update;
+//! * [`particle_runs`] — prediction and velocity update over a run of particles;
 //! * [`scalar`] — one projection of one constraint, the reference kernel;
 //! * [`lanes`] — SIMD kernels: four or eight constraints of one colour class at once, over
 //!   the lane types of [`lane_types`];
@@ -8,8 +10,11 @@
 //! * [`count`] — the kernel choice ([`Kernel`](count::Kernel)) and the projection counts.
 
 pub(crate) mod class_runs;
+pub(crate) mod compensated;
 pub(crate) mod count;
 pub(crate) mod lane_types;
 pub(crate) mod lanes;
+pub(crate) mod particle_runs;
 pub(crate) mod scalar;
+pub(crate) mod slots;
 pub(crate) mod working_copy;

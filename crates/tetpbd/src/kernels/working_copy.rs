@@ -14,56 +14,12 @@
 //! one thread (0.55 ms per frame of 10 substeps for 19,683 particles, docs/performance.md,
 //! "Scaling"), run in parallel on large bodies with the `parallel` feature.
 
-use std::fmt;
-
 use hecs::World;
-use nalgebra::Vector3;
-use wide::f32x4;
 
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::body::mesh::Tetrahedra;
 use crate::body::particles::Particles;
-use crate::kernels::scalar::ParticleAccess;
-
-/// One particle during a sweep.
-#[derive(Clone, Copy, Default)]
-#[repr(C)]
-pub(crate) struct Slot {
-    /// `[x, y, z, w]`: position (m) and inverse mass (1/kg).
-    pub xw: f32x4,
-    /// `[rx, ry, rz, 0]`: rounding residual of the substep's position updates (m).
-    pub r: f32x4,
-}
-
-impl Slot {
-    /// Moves the particle by `d` (`[dx, dy, dz, 0]`), keeping the rounding error in the
-    /// residual: [`crate::solver::systems::add_compensated`] on four lanes (the inverse mass lane
-    /// adds 0 and stays as it is).
-    #[inline(always)]
-    pub fn add(&mut self, d: f32x4) {
-        let old = self.xw;
-        let new = old + d;
-        self.r += d - (new - old);
-        self.xw = new;
-    }
-}
-
-/// The working copy of one body's particles (scratch, not state: always equal, never
-/// serialized, rebuilt by every sweep).
-#[derive(Clone, Default)]
-pub(crate) struct WorkCopy(pub(crate) Vec<Slot>);
-
-impl PartialEq for WorkCopy {
-    fn eq(&self, _: &WorkCopy) -> bool {
-        true
-    }
-}
-
-impl fmt::Debug for WorkCopy {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "WorkCopy({} slots)", self.0.len())
-    }
-}
+use crate::kernels::slots::{load_run, store_run, Slot, WorkAccess};
 
 /// Copies positions, inverse masses and residuals into the slots (sized on first use).
 pub(crate) fn load(p: &mut Particles) {
@@ -80,14 +36,6 @@ pub(crate) fn load(p: &mut Particles) {
     load_run(slots, &p.positions, &p.inv_masses, &p.residuals);
 }
 
-/// [`load`] of a run of particles.
-pub(crate) fn load_run(slots: &mut [Slot], x: &[Vector3<f32>], w: &[f32], r: &[Vector3<f32>]) {
-    for (((s, x), w), r) in slots.iter_mut().zip(x).zip(w).zip(r) {
-        s.xw = f32x4::new([x.x, x.y, x.z, *w]);
-        s.r = f32x4::new([r.x, r.y, r.z, 0.0]);
-    }
-}
-
 /// Copies positions and residuals back from the slots.
 pub(crate) fn store(p: &mut Particles) {
     #[cfg(feature = "parallel")]
@@ -96,16 +44,6 @@ pub(crate) fn store(p: &mut Particles) {
         return;
     }
     store_run(&p.work.0, &mut p.positions, &mut p.residuals);
-}
-
-/// [`store`] of a run of particles.
-pub(crate) fn store_run(slots: &[Slot], x: &mut [Vector3<f32>], r: &mut [Vector3<f32>]) {
-    for ((s, x), r) in slots.iter().zip(x).zip(r) {
-        let [a, b, c, _] = s.xw.to_array();
-        *x = Vector3::new(a, b, c);
-        let [a, b, c, _] = s.r.to_array();
-        *r = Vector3::new(a, b, c);
-    }
 }
 
 /// Whether a family system copies the particles into the working copy and back itself
@@ -148,41 +86,6 @@ pub(crate) fn load_bodies(world: &mut World) {
 /// [`store`] for every body a family system sweeps.
 pub(crate) fn store_bodies(world: &mut World) {
     for_each_swept(world, store);
-}
-
-/// Serial access to the slots.
-pub(crate) struct WorkAccess<'a> {
-    pub slots: &'a mut [Slot],
-    pub rest: &'a [Vector3<f32>],
-}
-
-impl ParticleAccess for WorkAccess<'_> {
-    #[inline(always)]
-    fn row(&self, i: usize) -> f32x4 {
-        self.slots[i].xw
-    }
-    #[inline(always)]
-    fn rest(&self, i: usize) -> Vector3<f32> {
-        self.rest[i]
-    }
-    #[inline(always)]
-    fn add_row(&mut self, i: usize, d: f32x4) {
-        self.slots[i].add(d);
-    }
-    #[inline(always)]
-    fn len(&self) -> usize {
-        self.slots.len()
-    }
-    #[inline(always)]
-    unsafe fn row_unchecked(&self, i: usize) -> f32x4 {
-        // SAFETY: `i < self.slots.len()` (the caller's contract).
-        unsafe { self.slots.get_unchecked(i).xw }
-    }
-    #[inline(always)]
-    unsafe fn add_row_unchecked(&mut self, i: usize, d: f32x4) {
-        // SAFETY: `i < self.slots.len()` (the caller's contract).
-        unsafe { self.slots.get_unchecked_mut(i).add(d) }
-    }
 }
 
 /// Runs `f` on the body's slots: between [`load`] and [`store`] in [`CopyMode::PerSweep`],

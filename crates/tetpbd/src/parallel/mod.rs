@@ -4,9 +4,11 @@
 //! * [`sweeps`] — the parallel family sweeps and particle passes;
 //! * [`schedule`] — one parallel region per sweep, its phases split into chunks;
 //! * [`team`] — the pool's threads kept awake for one step;
+//! * [`backoff`] — how a waiting thread spins, yields and sleeps;
 //! * [`affinity`] — moving a team helper off the stepping thread's core (Linux).
 
 pub(crate) mod affinity;
+pub(crate) mod backoff;
 pub(crate) mod schedule;
 pub(crate) mod sweeps;
 #[cfg(feature = "sync-stats")]

@@ -37,9 +37,11 @@
 use std::ops::{AddAssign, Range};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
-use std::time::{Duration, Instant};
+#[cfg(feature = "sync-stats")]
+use std::time::Instant;
 
 use crate::kernels::lanes::LANES;
+use crate::parallel::backoff::Backoff;
 
 /// Constraints per chunk of a colour class: small enough to balance the threads at a class
 /// boundary (a 100k-tetrahedron body has 7–9 chunks per thread in most classes), large
@@ -194,35 +196,6 @@ fn wait_for(counter: &AtomicUsize, target: usize) {
     }
     #[cfg(feature = "sync-stats")]
     crate::parallel::sync_stats::phase(since);
-}
-
-/// How long a wait spins (yielding the core every 256 rounds) before it sleeps between
-/// checks: on a loaded machine the thread waited for may not be running, and a spinning
-/// waiter would hold the core it needs.
-const SLEEP_AFTER: Duration = Duration::from_micros(200);
-
-/// One waiting loop's state: spin, yield now and then, sleep after [`SLEEP_AFTER`].
-#[derive(Default)]
-pub(crate) struct Backoff {
-    spins: u32,
-    start: Option<Instant>,
-}
-
-impl Backoff {
-    /// One round of waiting.
-    pub fn wait(&mut self) {
-        self.spins = self.spins.wrapping_add(1);
-        if !self.spins.is_multiple_of(256) {
-            std::hint::spin_loop();
-            return;
-        }
-        let start = *self.start.get_or_insert_with(Instant::now);
-        if start.elapsed() > SLEEP_AFTER {
-            std::thread::sleep(Duration::from_micros(20));
-        } else {
-            std::thread::yield_now();
-        }
-    }
 }
 
 /// Runs `phases` phases in order on every thread of the current rayon pool: phase `k` has

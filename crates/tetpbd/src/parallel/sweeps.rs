@@ -21,12 +21,12 @@ use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstr
 use crate::body::mesh::Tetrahedra;
 use crate::kernels::class_runs::{edge_run, vertex_face_run, volume_run};
 use crate::kernels::count::{Kernel, ProjectionCount};
+use crate::kernels::particle_runs::{PredictRun, VelocityRun, VelocityUpdate};
 use crate::kernels::scalar::ParticleAccess;
-use crate::kernels::working_copy::{self, Slot, WorkAccess};
+use crate::kernels::slots::{self, Slot, WorkAccess};
 use crate::ordering::colouring::{ColourClasses, Phase};
 use crate::parallel::schedule::{run_phases, Nothing, Shared, Split, PARTICLE_CHUNK};
-use crate::solver::systems::{PredictRun, VelocityRun, VelocityUpdate};
-use crate::stabilisation::angular_momentum::{self, Moments, StoreRun, BLOCK};
+use crate::stabilisation::rigid_fit::{self, Moments, StoreRun, BLOCK};
 
 /// Bodies with fewer constraints in a family than this take the serial path.
 const MIN_PARALLEL: usize = 4096;
@@ -137,7 +137,7 @@ pub(crate) fn load(slots: &mut [Slot], x: &[Vector3<f32>], w: &[f32], r: &[Vecto
     particle_pass(n, |i| {
         // SAFETY: `particle_pass` hands each particle to one call only.
         let slots = unsafe { s.run(i.clone()) };
-        working_copy::load_run(slots, &x[i.clone()], &w[i.clone()], &r[i]);
+        slots::load_run(slots, &x[i.clone()], &w[i.clone()], &r[i]);
         Nothing
     });
 }
@@ -149,7 +149,7 @@ pub(crate) fn store(slots: &[Slot], x: &mut [Vector3<f32>], r: &mut [Vector3<f32
     particle_pass(n, |i| {
         // SAFETY: `particle_pass` hands each particle to one call only.
         let (x, r) = unsafe { (xs.run(i.clone()), rs.run(i.clone())) };
-        working_copy::store_run(&slots[i], x, r);
+        slots::store_run(&slots[i], x, r);
         Nothing
     });
 }
@@ -364,7 +364,7 @@ pub(crate) fn store_measuring(run: StoreRun<'_>, o: Vector3<f32>, blocks: &mut [
     );
 }
 
-/// [`crate::stabilisation::angular_momentum::rotate_back`] in runs of particles.
+/// [`crate::stabilisation::rigid_fit::rotate_back`] in runs of particles.
 pub(crate) fn rotate_back(
     positions: &mut [Vector3<f32>],
     residuals: &mut [Vector3<f32>],
@@ -380,7 +380,7 @@ pub(crate) fn rotate_back(
     particle_pass(n, |i| {
         // SAFETY: `particle_pass` hands each particle to one call only.
         let (x, r) = unsafe { (x.run(i.clone()), r.run(i.clone())) };
-        angular_momentum::rotate_back(x, r, &prev_positions[i], origin_centre, theta);
+        rigid_fit::rotate_back(x, r, &prev_positions[i], origin_centre, theta);
         Nothing
     });
 }

@@ -30,7 +30,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use crate::parallel::affinity::{current_cpu, Moved};
-use crate::parallel::schedule::Backoff;
+use crate::parallel::backoff::Backoff;
 
 /// How long a helper waits for the next job before it leaves the team.
 const LINGER: Duration = Duration::from_micros(500);

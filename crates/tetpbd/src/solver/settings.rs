@@ -3,8 +3,8 @@
 
 use nalgebra::Vector3;
 
+use crate::body::families::Family;
 use crate::error::SettingsError;
-use crate::solver::stats::Family;
 use crate::solver::systems;
 
 /// Settings of a [`Solver`](crate::Solver). Fields are public; [`SolverSettings::validate`] (called by every

@@ -2,31 +2,7 @@
 
 use std::time::Duration;
 
-/// The constraint families of the core crate.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum Family {
-    /// [`crate::EdgeConstraints`].
-    Edge,
-    /// [`crate::VertexFaceConstraints`].
-    VertexFace,
-    /// [`crate::VolumeConstraints`].
-    Volume,
-}
-
-impl Family {
-    /// All families, in the solver's default order.
-    pub const ALL: [Family; 3] = [Family::Volume, Family::VertexFace, Family::Edge];
-
-    /// A short lowercase name ("edge", "vertex-face", "volume").
-    pub fn name(self) -> &'static str {
-        match self {
-            Family::Edge => "edge",
-            Family::VertexFace => "vertex-face",
-            Family::Volume => "volume",
-        }
-    }
-}
+use crate::body::families::Family;
 
 /// Max and RMS of `|C|` over a family's constraints (in the family's units: m or m³).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -8,14 +8,19 @@
 use hecs::World;
 use nalgebra::Vector3;
 
+use crate::body::families::Family;
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::body::mesh::Tetrahedra;
 use crate::body::particles::{ExternalAcceleration, Particles};
 use crate::constraints::{self, VERTEX_FACE_ORDER};
 use crate::kernels::class_runs::{edge_run, vertex_face_run, volume_run};
+pub use crate::kernels::compensated::add_compensated;
 pub use crate::kernels::count::{Kernel, ProjectionCount};
-use crate::kernels::working_copy::{self, CopyMode, WorkAccess};
-use crate::solver::stats::{ErrorAccumulator, ErrorStats, Family};
+pub use crate::kernels::particle_runs::VelocityUpdate;
+use crate::kernels::particle_runs::{PredictRun, VelocityRun};
+use crate::kernels::slots::WorkAccess;
+use crate::kernels::working_copy::{self, CopyMode};
+use crate::solver::stats::{ErrorAccumulator, ErrorStats};
 
 /// Saves `x` as the substep start, applies gravity plus each body's
 /// [`ExternalAcceleration`] and the linear damping `v ← v · max(0, 1 − damping·h)` to free
@@ -49,51 +54,6 @@ pub fn predict(world: &mut World, h: f32, gravity: Vector3<f32>, damping: f32) {
         }
         run.predict(a, h, keep);
     }
-}
-
-/// The particle arrays [`predict`] writes, for a run of particles.
-pub(crate) struct PredictRun<'a> {
-    pub positions: &'a mut [Vector3<f32>],
-    pub prev_positions: &'a mut [Vector3<f32>],
-    pub velocities: &'a mut [Vector3<f32>],
-    pub inv_masses: &'a [f32],
-    pub residuals: &'a mut [Vector3<f32>],
-}
-
-impl PredictRun<'_> {
-    /// [`predict`] on these particles, with acceleration `a` and damping factor `keep`.
-    pub fn predict(self, a: Vector3<f32>, h: f32, keep: f32) {
-        let PredictRun {
-            positions,
-            prev_positions,
-            velocities,
-            inv_masses,
-            residuals,
-        } = self;
-        for i in 0..positions.len() {
-            prev_positions[i] = positions[i];
-            residuals[i] = Vector3::zeros();
-            if inv_masses[i] > 0.0 {
-                velocities[i] = (velocities[i] + a * h) * keep;
-            }
-            add_compensated(&mut positions[i], &mut residuals[i], velocities[i] * h);
-        }
-    }
-}
-
-/// `x += d`, keeping the rounding error of the sum in `r` (Fast2Sum: exact while
-/// `|x| ≥ |d|`, which holds for the small corrections of a substep).
-///
-/// Why: a substep's corrections are often a few ulps of the position (10+ substeps, stiff
-/// constraints), and round-to-nearest then biases them. The velocity update adds the residual
-/// back, `v = (x − x_prev + r)/h`, so velocities, and with them momentum, see the exact sum
-/// of the corrections. Positions themselves stay rounded.
-#[inline(always)]
-pub fn add_compensated(x: &mut Vector3<f32>, r: &mut Vector3<f32>, d: Vector3<f32>) {
-    let old = *x;
-    let new = old + d;
-    *r += d - (new - old);
-    *x = new;
 }
 
 /// Sets every multiplier λ to zero (start of a substep).
@@ -276,15 +236,6 @@ fn volumes_of(
     count
 }
 
-/// What [`update_velocities`] did besides the plain update.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct VelocityUpdate {
-    /// Particles whose position became non-finite, reset to their substep start.
-    pub non_finite_resets: u64,
-    /// Particles whose correction speed was clamped.
-    pub clamped: u64,
-}
-
 /// Sets `v = (x − x_prev + r) / h`, with `r` the rounding residual of the substep's
 /// position updates (see [`add_compensated`]).
 ///
@@ -353,55 +304,6 @@ pub fn update_velocities(
         out += u;
     }
     out
-}
-
-impl std::ops::AddAssign for VelocityUpdate {
-    fn add_assign(&mut self, o: VelocityUpdate) {
-        self.non_finite_resets += o.non_finite_resets;
-        self.clamped += o.clamped;
-    }
-}
-
-/// The particle arrays [`update_velocities`] uses, for a run of particles.
-pub(crate) struct VelocityRun<'a> {
-    pub positions: &'a mut [Vector3<f32>],
-    pub prev_positions: &'a [Vector3<f32>],
-    pub velocities: &'a mut [Vector3<f32>],
-    pub residuals: &'a [Vector3<f32>],
-}
-
-impl VelocityRun<'_> {
-    /// [`update_velocities`] on these particles.
-    pub fn update(self, h: f32, max_correction_speed: Option<f32>) -> VelocityUpdate {
-        let VelocityRun {
-            positions,
-            prev_positions,
-            velocities,
-            residuals,
-        } = self;
-        let mut out = VelocityUpdate::default();
-        for i in 0..positions.len() {
-            // Divide, not multiply by 1/h: h · (1/h) ≠ 1 in f32, a bias every substep.
-            // `momentum_restoration::restore` recomputes this expression; keep the two the same.
-            let mut v = ((positions[i] - prev_positions[i]) + residuals[i]) / h;
-            if let Some(limit) = max_correction_speed {
-                let dv = v - velocities[i];
-                let n2 = dv.norm_squared();
-                if n2 > limit * limit {
-                    v = velocities[i] + dv * (limit / n2.sqrt());
-                    out.clamped += 1;
-                }
-            }
-            if v.iter().all(|c| c.is_finite()) {
-                velocities[i] = v;
-            } else {
-                positions[i] = prev_positions[i];
-                velocities[i] = Vector3::zeros();
-                out.non_finite_resets += 1;
-            }
-        }
-        out
-    }
 }
 
 /// `|C|` of every constraint at the current positions, per family, over all bodies.

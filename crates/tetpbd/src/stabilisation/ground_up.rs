@@ -56,6 +56,7 @@
 //! (the rapier coupling runs it for a soft body on an immovable support that carries a much
 //! heavier rigid body).
 
+use crate::body::families::Family;
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::body::mesh::Tetrahedra;
 use crate::body::particles::Particles;
@@ -63,7 +64,6 @@ use crate::constraints::VERTEX_FACE_ORDER;
 use crate::kernels::class_runs;
 use crate::kernels::count::{Kernel, ProjectionCount};
 use crate::kernels::working_copy;
-use crate::solver::stats::Family;
 use crate::stabilisation::ground_up_levels::{shift_starts, Gathered, LevelOrder};
 
 /// Level of a particle that no root reaches.

@@ -87,9 +87,8 @@ pub(crate) fn restore(run: RestoreRun<'_>, h: f32) {
         return;
     }
     let u = -dp / total;
-    let (c, omega) =
-        crate::stabilisation::angular_momentum::rigid_fit(total, first, second, -dl, -dp)
-            .unwrap_or((first / total, Vector3::zeros()));
+    let (c, omega) = crate::stabilisation::rigid_fit::rigid_fit(total, first, second, -dl, -dp)
+        .unwrap_or((first / total, Vector3::zeros()));
     if !u.iter().all(|x| x.is_finite()) {
         return;
     }
