@@ -15,7 +15,13 @@ use crate::error::StateError;
 /// ([`crate::SoftBodyBuilder::spatial_order`]): then [`Particles::source`] and
 /// [`Particles::particle_of`] map between particles and input vertices. A particle with inverse mass 0 is pinned: the solver never moves it (it can still be
 /// moved by writing its position, e.g. to drive it kinematically).
-#[derive(Clone, Debug, PartialEq)]
+///
+/// Equality (`==`) and serialization cover the state: positions, substep starts,
+/// velocities, masses and inverse masses, rest positions, rounding residuals and the
+/// particle–vertex maps. The projections' working copy is scratch memory, rebuilt by every
+/// sweep: it is neither compared nor serialized, so a body restored from a snapshot equals
+/// the one it was taken from.
+#[derive(Clone, Debug)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Particles {
     pub(crate) positions: Vec<Vector3<f32>>,
@@ -34,6 +40,33 @@ pub struct Particles {
     /// The projections' working copy (scratch, see [`crate::kernels::working_copy`]).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) work: crate::kernels::slots::WorkCopy,
+}
+
+impl PartialEq for Particles {
+    fn eq(&self, o: &Particles) -> bool {
+        // Every field but the working copy (`work`), which is scratch.
+        let Particles {
+            positions,
+            prev_positions,
+            velocities,
+            inv_masses,
+            masses,
+            rest_positions,
+            residuals,
+            source,
+            vertex_to_particle,
+            work: _,
+        } = self;
+        *positions == o.positions
+            && *prev_positions == o.prev_positions
+            && *velocities == o.velocities
+            && *inv_masses == o.inv_masses
+            && *masses == o.masses
+            && *rest_positions == o.rest_positions
+            && *residuals == o.residuals
+            && *source == o.source
+            && *vertex_to_particle == o.vertex_to_particle
+    }
 }
 
 impl Particles {
@@ -237,5 +270,29 @@ impl ExternalAcceleration {
     /// The acceleration, m/s².
     pub fn get(&self) -> Vector3<f32> {
         self.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector3;
+
+    use crate::generators::{box_grid, CellSplit};
+    use crate::kernels::slots::Slot;
+    use crate::SoftBodyBuilder;
+
+    #[test]
+    fn equality_compares_the_state_not_the_scratch() {
+        let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [2, 2, 2], CellSplit::Six).unwrap();
+        let a = SoftBodyBuilder::new(mesh).build().unwrap().particles;
+        let mut b = a.clone();
+        b.work.0.clear();
+        b.work.0.push(Slot::default());
+        assert_eq!(a, b, "the working copy is scratch");
+        b.positions[3].y += 1e-3;
+        assert_ne!(a, b, "a moved particle is a different state");
+        let mut c = a.clone();
+        c.residuals[0].x = 1e-9;
+        assert_ne!(a, c, "the rounding residual is state");
     }
 }

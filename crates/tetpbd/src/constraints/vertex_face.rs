@@ -93,9 +93,8 @@ pub fn signed_height<T: RealField + Copy>(
 /// height (its largest rest value, smaller than that height on faces thin at rest).
 /// Corrections of a healthy scene are far below it and unchanged; it acts where a
 /// near-singular gradient would take a step of many body sizes (the hard sliver plate of the
-/// stability matrix). 1 bounded the plate tighter but, together with the safety net's
-/// momentum restoration, left a scrambled vertex–face-only body tangled for good
-/// (`tests/recovery.rs`); measured in `docs/stability.md` against 0.5, 1 and 4.
+/// stability matrix). A bound of 1 holds such a plate tighter but, together with the safety
+/// net's momentum restoration, leaves a scrambled vertex–face-only body tangled for good.
 pub const VERTEX_FACE_MAX_STEP: f32 = 2.0;
 
 /// The move bound of one tetrahedron's vertex–face projections, m:

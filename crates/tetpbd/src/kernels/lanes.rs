@@ -8,8 +8,7 @@
 //! rows and added with the compensated update. The kernels are written over a [`Lane`] type:
 //! a chunk of four (`f32x4`) or two chunks side by side ([`crate::kernels::lane_types::X2`]), which gives
 //! the same bits as the two chunks one after the other (see [`crate::kernels::lane_types`]). The scalar
-//! kernels in [`crate::kernels::scalar`] are the reference these are tested against
-//! (`tests/lanes.rs`).
+//! kernels in [`crate::kernels::scalar`] are the reference these are tested against.
 //!
 //! A chunk whose lanes hit a degenerate configuration (a zero-length edge, a face too close
 //! to collinear) or, for vertex–face, a thin face (the thin branch of

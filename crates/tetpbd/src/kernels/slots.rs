@@ -31,16 +31,10 @@ impl Slot {
     }
 }
 
-/// The working copy of one body's particles (scratch, not state: always equal, never
+/// The working copy of one body's particles (scratch, not state: never compared, never
 /// serialized, rebuilt by every sweep).
 #[derive(Clone, Default)]
 pub(crate) struct WorkCopy(pub(crate) Vec<Slot>);
-
-impl PartialEq for WorkCopy {
-    fn eq(&self, _: &WorkCopy) -> bool {
-        true
-    }
-}
 
 impl fmt::Debug for WorkCopy {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -10,9 +10,8 @@
 //! update of a particle is a handful of 4-wide operations on its two rows. A public family
 //! system copies in and out around its own sweep ([`CopyMode::PerSweep`]); the solver copies
 //! once per iteration around all the families of a body ([`CopyMode::Resident`]). The
-//! copies are two streaming passes over the particles, about 3 ns per particle for both on
-//! one thread (0.55 ms per frame of 10 substeps for 19,683 particles, docs/performance.md,
-//! "Scaling"), run in parallel on large bodies with the `parallel` feature.
+//! copies are two streaming passes over the particles, a few nanoseconds per particle for
+//! both on one thread, run in parallel on large bodies with the `parallel` feature.
 
 use hecs::World;
 

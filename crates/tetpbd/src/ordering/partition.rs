@@ -4,7 +4,7 @@
 //! phase per class, and between two phases every thread waits for the others: a
 //! 100k-tetrahedron body has 30 classes of tetrahedra and 14 of edges, each a few hundred
 //! microseconds of work or less, so the waits and the imbalance at each boundary cost a
-//! good part of a second thread's gain (docs/performance.md, "Domain decomposition").
+//! good part of a second thread's gain.
 //!
 //! Here the particles are cut into `P` slabs of about equal work along the longest axis of
 //! the body ([`slab_parts`]), and each constraint goes to the group of the slabs it touches:

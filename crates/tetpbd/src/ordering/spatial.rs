@@ -8,9 +8,8 @@
 //! grid generator writes (a grid of cubic cells keeps its numbering) — puts a tetrahedron's particles within one or two rows and planes
 //! of each other. The tetrahedra are then sorted by their smallest particle index, so a
 //! sweep over a colour class walks memory forward in a few streams the hardware prefetcher
-//! follows. (A Morton / Z-order curve was measured too: it has fewer cache misses in a
-//! simulated L1 but its jumps defeat the prefetcher, and on a 1M-tetrahedron body it was
-//! 2–3× slower than rows; see `docs/performance.md`.)
+//! follows. (A Morton / Z-order curve has fewer cache misses in a simulated L1 but its jumps
+//! defeat the prefetcher: on a 1M-tetrahedron body it is 2–3× slower than rows.)
 //!
 //! The renumbering is a permutation `source`: particle `k` of the built body is vertex
 //! `source[k]` of the input mesh (see [`crate::Particles::source`] and

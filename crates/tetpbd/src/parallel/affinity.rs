@@ -1,11 +1,9 @@
 //! Keeping a team's helper off the core of the thread it helps (feature `parallel`, Linux).
 //!
 //! Why: the helper of [`crate::parallel::team`] is a rayon thread woken by the step's thread, and the
-//! kernel often wakes it on the waker's core. Two threads spinning on one core of this 2-core
-//! virtual machine share it: measured at 100k tetrahedra (docs/performance.md, "Why 2-thread
-//! frames at 100k are bimodal"), frames where up to 68 % of the chunks ran with both threads
-//! on one core took 15–16 ms against 10 ms for frames on two cores, and the idle core took
-//! them over only after some milliseconds. A helper that finds itself on the step thread's
+//! kernel often wakes it on the waker's core. Two threads spinning on one core share it, and
+//! an idle core takes one of them over only after some milliseconds: frames where most
+//! chunks run with both threads on one core are about 1.5 times as slow. A helper that finds itself on the step thread's
 //! core narrows its own CPU mask to the other cores it may use, which migrates it at once, and
 //! restores the mask it had when it leaves the team ([`Moved`]'s drop).
 //!

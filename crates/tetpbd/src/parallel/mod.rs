@@ -3,6 +3,8 @@
 //!
 //! * [`sweeps`] — the parallel family sweeps and particle passes;
 //! * [`schedule`] — one parallel region per sweep, its phases split into chunks;
+//! * [`shared`] — memory the threads of a region share, each writing its own part (the
+//!   parallel sweeps' `unsafe` lives here);
 //! * [`team`] — the pool's threads kept awake for one step;
 //! * [`backoff`] — how a waiting thread spins, yields and sleeps;
 //! * [`affinity`] — moving a team helper off the stepping thread's core (Linux).
@@ -10,6 +12,7 @@
 pub(crate) mod affinity;
 pub(crate) mod backoff;
 pub(crate) mod schedule;
+pub(crate) mod shared;
 pub(crate) mod sweeps;
 #[cfg(feature = "sync-stats")]
 pub mod sync_stats;

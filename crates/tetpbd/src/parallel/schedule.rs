@@ -6,8 +6,7 @@
 //! plain layout has 30 classes of tetrahedra (14 of edges), each a few hundred microseconds
 //! of work or less (a partitioned body has 3 phases per family, see [`crate::ordering::partition`]).
 //! Between two parallel iterators rayon's idle thread goes to sleep and has to be woken, which
-//! on this virtual machine costs tens of microseconds each time (measured in
-//! docs/performance.md, "Scaling"). Here every thread of the pool enters once per sweep and
+//! can cost tens of microseconds each time. Here every thread of the pool enters once per sweep and
 //! waits at a phase boundary by spinning on a counter.
 //!
 //! **Layout.** Each phase is cut into `R` contiguous *regions*, one per thread (`R` = the
@@ -45,8 +44,8 @@ use crate::parallel::backoff::Backoff;
 
 /// Constraints per chunk of a colour class: small enough to balance the threads at a class
 /// boundary (a 100k-tetrahedron body has 7–9 chunks per thread in most classes), large
-/// enough that a claim costs little beside it (256 volume projections take about 3 µs; 64
-/// measured 2–4 % slower per frame on 2 threads).
+/// enough that a claim costs little beside it (256 volume projections take a few µs; 64
+/// are a few per cent slower per frame on 2 threads).
 pub(crate) const CLASS_CHUNK: usize = 256;
 
 /// Particles per chunk of a pass over the particles (a copy, the prediction, the velocity
@@ -134,38 +133,6 @@ pub(crate) struct Nothing;
 
 impl AddAssign for Nothing {
     fn add_assign(&mut self, _: Nothing) {}
-}
-
-/// A mutable slice shared by the threads of one parallel region, each taking disjoint runs.
-pub(crate) struct Shared<T> {
-    ptr: *mut T,
-    len: usize,
-}
-
-// SAFETY: the threads of a region take the runs of [`Shared::run`] as [`run_phases`] hands
-// them out, every item of a phase to exactly one call; the slice is borrowed mutably for the
-// whole region (`Shared::new`), so no other access exists meanwhile.
-unsafe impl<T: Send> Sync for Shared<T> {}
-
-impl<T> Shared<T> {
-    /// Shares `items` (borrowed mutably for as long as the `Shared` lives).
-    pub fn new(items: &mut [T]) -> Shared<T> {
-        Shared {
-            ptr: items.as_mut_ptr(),
-            len: items.len(),
-        }
-    }
-
-    /// The items `range`.
-    ///
-    /// # Safety
-    /// No other live reference may overlap `range`.
-    #[allow(clippy::mut_from_ref)]
-    pub unsafe fn run(&self, range: Range<usize>) -> &mut [T] {
-        assert!(range.start <= range.end && range.end <= self.len);
-        // SAFETY: in bounds (checked); exclusive by the caller's guarantee.
-        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(range.start), range.len()) }
-    }
 }
 
 /// Claims the next chunk of `region` below `end` (its count over all phases), if any.

@@ -15,17 +15,16 @@
 use std::ops::Range;
 
 use nalgebra::Vector3;
-use wide::f32x4;
 
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::body::mesh::Tetrahedra;
 use crate::kernels::class_runs::{edge_run, vertex_face_run, volume_run};
 use crate::kernels::count::{Kernel, ProjectionCount};
 use crate::kernels::particle_runs::{PredictRun, VelocityRun, VelocityUpdate};
-use crate::kernels::scalar::ParticleAccess;
 use crate::kernels::slots::{self, Slot, WorkAccess};
 use crate::ordering::colouring::{ColourClasses, Phase};
-use crate::parallel::schedule::{run_phases, Nothing, Shared, Split, PARTICLE_CHUNK};
+use crate::parallel::schedule::{run_phases, Nothing, Split, PARTICLE_CHUNK};
+use crate::parallel::shared::{for_runs, Shared, SharedAccess};
 use crate::stabilisation::rigid_fit::{self, Moments, StoreRun, BLOCK};
 
 /// Bodies with fewer constraints in a family than this take the serial path.
@@ -58,42 +57,30 @@ pub(crate) fn particles_worth_it(len: usize) -> bool {
     len >= MIN_PARALLEL_PARTICLES && rayon::current_num_threads() > 1
 }
 
-/// Runs `f` over runs of [`PARTICLE_CHUNK`] of `len` particles on the pool, summing what it
-/// returns.
-fn particle_pass<C: Default + std::ops::AddAssign + Send>(
-    len: usize,
-    f: impl Fn(std::ops::Range<usize>) -> C + Sync,
-) -> C {
-    run_phases(1, PARTICLE_CHUNK, |_| (len, Split::Lanes), |_, r| f(r))
-}
-
-/// [`crate::solver::systems::predict`] of one body, in runs of particles.
+/// [`crate::systems::predict`] of one body, in runs of particles.
 pub(crate) fn predict(run: PredictRun<'_>, a: Vector3<f32>, h: f32, keep: f32) {
     let n = run.positions.len();
-    let (x, xp, v, r) = (
+    let w = run.inv_masses;
+    let shared = (
         Shared::new(run.positions),
         Shared::new(run.prev_positions),
         Shared::new(run.velocities),
         Shared::new(run.residuals),
     );
-    let w = run.inv_masses;
-    particle_pass(n, |i| {
-        // SAFETY: `particle_pass` hands each particle to one call only.
-        let run = unsafe {
-            PredictRun {
-                positions: x.run(i.clone()),
-                prev_positions: xp.run(i.clone()),
-                velocities: v.run(i.clone()),
-                inv_masses: &w[i.clone()],
-                residuals: r.run(i),
-            }
+    for_runs(n, PARTICLE_CHUNK, &shared, |i, (x, xp, v, r)| {
+        let run = PredictRun {
+            positions: x,
+            prev_positions: xp,
+            velocities: v,
+            inv_masses: &w[i],
+            residuals: r,
         };
         run.predict(a, h, keep);
         Nothing
     });
 }
 
-/// [`crate::solver::systems::update_velocities`] of one body, in runs of particles (the counts are
+/// [`crate::systems::update_velocities`] of one body, in runs of particles (the counts are
 /// sums, whatever the split). The safety net's momentum restoration that may follow runs on
 /// one thread, after this pass (its sums in particle order, so the result does not depend on
 /// the thread count).
@@ -103,17 +90,14 @@ pub(crate) fn update_velocities(
     max_correction_speed: Option<f32>,
 ) -> VelocityUpdate {
     let n = run.positions.len();
-    let (x, v) = (Shared::new(run.positions), Shared::new(run.velocities));
     let (xp, r) = (run.prev_positions, run.residuals);
-    particle_pass(n, |i| {
-        // SAFETY: `particle_pass` hands each particle to one call only.
-        let run = unsafe {
-            VelocityRun {
-                positions: x.run(i.clone()),
-                prev_positions: &xp[i.clone()],
-                velocities: v.run(i.clone()),
-                residuals: &r[i],
-            }
+    let shared = (Shared::new(run.positions), Shared::new(run.velocities));
+    for_runs(n, PARTICLE_CHUNK, &shared, |i, (x, v)| {
+        let run = VelocityRun {
+            positions: x,
+            prev_positions: &xp[i.clone()],
+            velocities: v,
+            residuals: &r[i],
         };
         run.update(h, max_correction_speed)
     })
@@ -122,10 +106,8 @@ pub(crate) fn update_velocities(
 /// Fills `items` with `value`, in runs of [`PARTICLE_CHUNK`] items.
 pub(crate) fn fill<T: Copy + Send + Sync>(items: &mut [T], value: T) {
     let n = items.len();
-    let shared = Shared::new(items);
-    particle_pass(n, |i| {
-        // SAFETY: `particle_pass` hands each item to one call only.
-        unsafe { shared.run(i) }.fill(value);
+    for_runs(n, PARTICLE_CHUNK, &Shared::new(items), |_, run| {
+        run.fill(value);
         Nothing
     });
 }
@@ -133,11 +115,8 @@ pub(crate) fn fill<T: Copy + Send + Sync>(items: &mut [T], value: T) {
 /// [`crate::kernels::working_copy::load`] in runs of particles.
 pub(crate) fn load(slots: &mut [Slot], x: &[Vector3<f32>], w: &[f32], r: &[Vector3<f32>]) {
     let n = slots.len().min(x.len()).min(w.len()).min(r.len());
-    let s = Shared::new(slots);
-    particle_pass(n, |i| {
-        // SAFETY: `particle_pass` hands each particle to one call only.
-        let slots = unsafe { s.run(i.clone()) };
-        slots::load_run(slots, &x[i.clone()], &w[i.clone()], &r[i]);
+    for_runs(n, PARTICLE_CHUNK, &Shared::new(slots), |i, run| {
+        slots::load_run(run, &x[i.clone()], &w[i.clone()], &r[i]);
         Nothing
     });
 }
@@ -145,78 +124,11 @@ pub(crate) fn load(slots: &mut [Slot], x: &[Vector3<f32>], w: &[f32], r: &[Vecto
 /// [`crate::kernels::working_copy::store`] in runs of particles.
 pub(crate) fn store(slots: &[Slot], x: &mut [Vector3<f32>], r: &mut [Vector3<f32>]) {
     let n = slots.len().min(x.len()).min(r.len());
-    let (xs, rs) = (Shared::new(x), Shared::new(r));
-    particle_pass(n, |i| {
-        // SAFETY: `particle_pass` hands each particle to one call only.
-        let (x, r) = unsafe { (xs.run(i.clone()), rs.run(i.clone())) };
+    let shared = (Shared::new(x), Shared::new(r));
+    for_runs(n, PARTICLE_CHUNK, &shared, |i, (x, r)| {
         slots::store_run(&slots[i], x, r);
         Nothing
     });
-}
-
-/// Shared access to a body's working copy for the projections of one colour class.
-#[derive(Clone, Copy)]
-struct SharedAccess {
-    slots: *mut Slot,
-    rest: *const Vector3<f32>,
-    len: usize,
-}
-
-// SAFETY: a `SharedAccess` is only handed to the projections of one colour class, which
-// touch pairwise disjoint particles (greedy colouring; the overflow class, whose items may
-// overlap, never runs in parallel), or to the tasks of one phase of a partitioned sweep,
-// which touch disjoint slabs of particles (crate::ordering::partition). The slices it points into outlive the parallel loop and
-// are borrowed mutably by it, so no other access exists meanwhile.
-unsafe impl Send for SharedAccess {}
-// SAFETY: as above.
-unsafe impl Sync for SharedAccess {}
-
-impl SharedAccess {
-    fn new(acc: &mut WorkAccess<'_>) -> SharedAccess {
-        SharedAccess {
-            slots: acc.slots.as_mut_ptr(),
-            rest: acc.rest.as_ptr(),
-            len: acc.slots.len().min(acc.rest.len()),
-        }
-    }
-}
-
-impl ParticleAccess for SharedAccess {
-    #[inline(always)]
-    fn row(&self, i: usize) -> f32x4 {
-        assert!(i < self.len);
-        // SAFETY: in bounds (checked); no other thread writes particle `i` (colour class).
-        unsafe { (*self.slots.add(i)).xw }
-    }
-    #[inline(always)]
-    fn rest(&self, i: usize) -> Vector3<f32> {
-        assert!(i < self.len);
-        // SAFETY: in bounds (checked, `rest` has `len` items); never written during a sweep.
-        unsafe { *self.rest.add(i) }
-    }
-    #[inline(always)]
-    fn add_row(&mut self, i: usize, d: f32x4) {
-        assert!(i < self.len);
-        // SAFETY: in bounds (checked); particle `i` belongs to this item alone within the
-        // running colour class, so this is the only reference to it.
-        unsafe { (*self.slots.add(i)).add(d) }
-    }
-    #[inline(always)]
-    fn len(&self) -> usize {
-        self.len
-    }
-    #[inline(always)]
-    unsafe fn row_unchecked(&self, i: usize) -> f32x4 {
-        // SAFETY: `i < self.len` (the caller's contract); no other thread writes particle
-        // `i` (colour class, as in `row`).
-        unsafe { (*self.slots.add(i)).xw }
-    }
-    #[inline(always)]
-    unsafe fn add_row_unchecked(&mut self, i: usize, d: f32x4) {
-        // SAFETY: `i < self.len` (the caller's contract); particle `i` is this item's alone
-        // within the running colour class, as in `add_row`.
-        unsafe { (*self.slots.add(i)).add(d) }
-    }
 }
 
 /// Runs `f` over every class, in one parallel region ([`crate::parallel::schedule::run_phases`]: the
@@ -376,10 +288,8 @@ pub(crate) fn rotate_back(
         .len()
         .min(residuals.len())
         .min(prev_positions.len());
-    let (x, r) = (Shared::new(positions), Shared::new(residuals));
-    particle_pass(n, |i| {
-        // SAFETY: `particle_pass` hands each particle to one call only.
-        let (x, r) = unsafe { (x.run(i.clone()), r.run(i.clone())) };
+    let shared = (Shared::new(positions), Shared::new(residuals));
+    for_runs(n, PARTICLE_CHUNK, &shared, |i, (x, r)| {
         rigid_fit::rotate_back(x, r, &prev_positions[i], origin_centre, theta);
         Nothing
     });

@@ -1,9 +1,8 @@
 //! The pool's other threads kept awake for one solver step (feature `parallel`).
 //!
 //! Why: a parallel region entered through rayon (`join`, a parallel iterator) has to wake
-//! the other threads, which go to sleep a few microseconds after they run out of work. On
-//! this 2-core virtual machine a wake-up costs about 18 µs after a gap of 10–100 µs and
-//! 50 µs after 1 ms (docs/performance.md, "Scaling"), while a substep of a 100k-tetrahedron
+//! the other threads, which go to sleep a few microseconds after they run out of work. A
+//! wake-up can cost tens of microseconds, while a substep of a 100k-tetrahedron
 //! body has six parallel passes (prediction, the copies in and out, two families, the
 //! velocity update) of 30–700 µs each.
 //!

@@ -44,9 +44,8 @@ pub struct SolverSettings {
     /// torque: undamped, such a body spins itself up from rest. Bodies with pinned
     /// particles are left alone, as are a hook's contacts. Cost: the copy back from the
     /// working copy also measures the corrections, plus one more pass over a free body's
-    /// particles per iteration (+2–13 % per frame, docs/performance.md); both counted in
-    /// [`crate::StepStats::spin_time`] instead of [`crate::StepStats::copy_time`] (see the `spin` module
-    /// docs).
+    /// particles per iteration (a few per cent of a frame); both counted in
+    /// [`crate::StepStats::spin_time`] instead of [`crate::StepStats::copy_time`].
     pub conserve_angular_momentum: bool,
     /// Scalar or SIMD projection kernels (default SIMD; they agree to rounding).
     pub kernel: systems::Kernel,

@@ -251,7 +251,7 @@ fn volumes_of(
 /// snap-back would push and turn the body). So when at least one particle of a body was
 /// clamped and the body has no pinned particle, the momentum the clamp removed is given back
 /// as a rigid velocity change of the whole body, a uniform velocity plus a rotation about its
-/// centre of mass (see the `momentum` module): the net never changes a free body's linear or
+/// centre of mass (the momentum restoration of the `stabilisation` folder): the net never changes a free body's linear or
 /// angular momentum. That costs two more serial passes over the body's particles, only in
 /// substeps where the net clamped one of them; bodies it leaves alone are bit-identical to
 /// running without it. A body with pinned particles (inverse mass 0) gets the per-particle

@@ -17,8 +17,7 @@
 //! and every other particle at its own mass: each level is corrected against the levels
 //! below it, which were corrected just before, so a support's reaction reaches the top of
 //! the body within one sweep, if not all of it (a 3-cell column whose top was pushed 5 cm
-//! down comes back 54–82 % of the way in one sweep, all of it in 50:
-//! `tests/stacking.rs`). Of the vertex–face constraints only those holding a vertex of
+//! down comes back 54–82 % of the way in one sweep, all of it in 50). Of the vertex–face constraints only those holding a vertex of
 //! level `L` above its face are projected (holding a root by moving the face alone is
 //! ill-conditioned). Constraints among roots only (level 0) and constraints with a particle
 //! no root reaches are left alone. Each constraint is projected at most once per sweep, so
@@ -34,21 +33,15 @@
 //! after every sweep. Of a tetrahedron's four vertex–face constraints only those holding a
 //! vertex of the tetrahedron's level run: a mask per constraint, built with the levels, that
 //! the kernel applies lane by lane. The roots are held by an inverse mass of 0 in the working copy for the length of the
-//! sweep. The scalar kernel in the same order is the reference (`tests/stacking.rs`).
+//! sweep. The scalar kernel in the same order is the reference the SIMD one is tested against.
 //!
 //! Why the levels above the roots are not frozen too, as shock propagation freezes the
 //! lower bodies of a rigid stack: fixing each level against a frozen one below is a march
 //! from the ground up, and marching an elastic body's shape in one direction amplifies a
-//! lateral error at every level. With the lower levels frozen, a 1000 kg box dropped on a
-//! 1 kg slab (0.6 m wide, 0.1 m cells) gave slab peak speeds of 0.09, 0.14, 0.16, 0.17,
-//! 0.28 and 0.71 m/s at 1 to 6 cells of depth and 26–30 m/s at 8 (the box driven 24 m
-//! through the ground); a 100 kg box on a 1 m cube of 8³ or 12³ cells exploded likewise.
-//! Lowering the lower levels' inverse mass to 10, 30 or 50 % of theirs instead of 0 moved
-//! the explosion deeper (8, 12, 12 levels), not away. At their own mass the sweep is an
-//! ordinary Gauss–Seidel sweep with the roots as its only fixed particles, stable at any
-//! depth: the same slabs peak at 0.14–0.17 m/s from 2 to 8 cells and 0.43–0.55 m/s at 16
-//! (over 3 and 10 s), the cubes at 0.16–0.24 m/s (`tests/issue_6_stacking_deep_bodies.rs`
-//! at the workspace root).
+//! lateral error at every level. A heavy box on a light slab more than a few cells deep then
+//! explodes, and a partly frozen lower level (a reduced inverse mass instead of 0) only moves
+//! the explosion deeper. At their own mass the sweep is an ordinary Gauss–Seidel sweep with
+//! the roots as its only fixed particles, stable at any depth.
 //!
 //! Holding the roots does not conserve the body's momentum: the impulses it leaves out are
 //! the ones the roots' supports would have taken, which is right for a body resting on

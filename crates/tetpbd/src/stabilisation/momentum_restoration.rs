@@ -4,9 +4,9 @@
 //! The per-particle clamp of [`crate::solver::systems::update_velocities`] removes a velocity
 //! `δvᵢ = v_clampedᵢ − v_unclampedᵢ` from each clamped particle, and with it the linear
 //! momentum `ΔP = Σ mᵢδvᵢ` and the angular momentum `ΔL = Σ mᵢ rᵢ × δvᵢ` about the centre of
-//! mass `c` (`rᵢ = xᵢ − c`): an asymmetric snap-back clamped particle by particle used to
-//! throw the whole body (2150 kg·m/s, 2.15 m/s of drift, three frames after a tangled
-//! release) and set it turning. [`restore`] gives both back as a rigid velocity field,
+//! mass `c` (`rᵢ = xᵢ − c`): clamped particle by particle, an asymmetric snap-back would
+//! throw the whole body and set it turning. [`restore`] gives both back as a rigid velocity
+//! field,
 //!
 //! ```text
 //! vᵢ += −ΔP / M + ω × rᵢ,   I ω = −ΔL,
@@ -14,16 +14,15 @@
 //!
 //! `M` the body's mass, `I = Σ mᵢ(|rᵢ|²𝟙 − rᵢrᵢᵀ)` its inertia tensor at the end of the
 //! substep (inverted through its eigenvalues, those below 10⁻⁹ of the largest taken as zero,
-//! as in the `spin` module): the net never changes a free body's linear or angular momentum.
+//! by the same [`rigid_fit`](crate::stabilisation::rigid_fit::rigid_fit) the
+//! angular-momentum conservation uses): the net never changes a free body's linear or
+//! angular momentum.
 //!
-//! The angular part is given back since the projections stopped creating spin of their own
-//! ([`crate::SolverSettings::conserve_angular_momentum`]). Before that, a snap-back violent
-//! enough to be clamped spun the body up through the projections themselves (a mirrored 1 m
-//! cube: 8e3 kg·m²/s after one frame without the net), what the clamp removed was mostly that
-//! spurious spin, and giving it back took the stability matrix with the net from 95 to 90 of
-//! 108 cells. With the spin removal it takes the matrix with the net from 92 to 93 of 108
-//! (hard vertex–face dragged 100 cells now recovers), the rest unchanged
-//! (crates/tetpbd-stability/src/bin/findings.md).
+//! Limit: giving the angular part back assumes the projections create no spin of their own
+//! ([`crate::SolverSettings::conserve_angular_momentum`], on by default). With that switched
+//! off, a snap-back violent enough to be clamped spins the body up through the projections
+//! themselves, what the clamp removes is mostly that spurious spin, and giving it back makes
+//! recovery from tangled states worse.
 //!
 //! The sums run over the particles in index order, in f64, on one thread: the result does
 //! not depend on the thread count.
@@ -45,7 +44,7 @@ pub(crate) struct RestoreRun<'a> {
 }
 
 /// Gives back the linear and angular momentum the clamp removed from one body whose
-/// velocities were just set by [`crate::solver::systems::VelocityRun::update`] with step `h` (s).
+/// velocities were just set by [`crate::kernels::particle_runs::VelocityRun::update`] with step `h` (s).
 ///
 /// The unclamped velocity of each particle is recomputed with the same expression the
 /// update used, so a particle the clamp left alone contributes exactly zero. A particle the

@@ -80,6 +80,11 @@ fn snapshot_restored_into_a_fresh_world_continues_bit_identically() {
 
     let mut fresh = World::new();
     let (e2, settings2) = restore(serde_json::from_str(&json).unwrap(), &mut fresh);
+    assert_eq!(
+        *fresh.get::<&Particles>(e2).unwrap(),
+        *world.get::<&Particles>(e).unwrap(),
+        "the restored state equals the original (the working copy is scratch, not compared)"
+    );
     let mut solver2 = Solver::new(settings2).unwrap();
     for _ in 0..60 {
         solver.step(&mut world).unwrap();

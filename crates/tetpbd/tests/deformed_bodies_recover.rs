@@ -1,10 +1,10 @@
 //! Inverted, flattened and scrambled bodies recover; edges alone do not un-invert (the
 //! seed's motivation for the vertex–face and signed volume constraints).
 //!
-//! Finding recorded here: the four vertex–face constraints alone fix only four of a
-//! tetrahedron's six shape degrees of freedom. Released from a mirrored or scrambled start,
-//! the snap-back turns into velocity along the two free directions and the body expands
-//! (see `docs/stability.md`, "without safety net"). With the solver's correction-speed
+//! A limit: the four vertex–face constraints alone fix only four of a tetrahedron's six
+//! shape degrees of freedom. Released from a mirrored or scrambled start without the safety
+//! net, the snap-back turns into velocity along the two free directions and the body
+//! expands. With the solver's correction-speed
 //! safety net (`max_correction_speed`, which every test here uses) they recover fully; with
 //! edges added, or edges + volume, the shape comes back either way.
 

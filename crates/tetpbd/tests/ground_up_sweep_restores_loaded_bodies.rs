@@ -168,10 +168,9 @@ fn a_squashed_column_is_restored_from_the_ground_up() {
 }
 
 /// A column 16 cells tall with every particle above the roots moved sideways by up to
-/// 1 mm: ground-up sweeps only shrink the error. (The explosion of deep bodies under the
-/// earlier sweep, which froze every level below the current one, needs the substeps'
-/// velocities and shows only through the coupling: `tests/issue_6_stacking_deep_bodies.rs`
-/// at the workspace root.)
+/// 1 mm: ground-up sweeps only shrink the error. (A sweep that froze every level below the
+/// current one would explode deep bodies, but only with the substeps' velocities: that is
+/// guarded through the coupling, by the deep-body stacking test at the workspace root.)
 #[test]
 fn a_tall_column_shaken_sideways_settles() {
     let mut world = World::new();

@@ -75,7 +75,7 @@ fn simd_matches_scalar_vertex_face_and_edges() {
 
 /// Large corrections (a body sheared and squashed to 60 %). An inverted start is not
 /// compared: a vertex–face flip passes near degenerate faces, where `1/|b × c|` amplifies
-/// rounding differences (measured: 1.6 cm apart after one sweep of a mirrored 5³ grid,
+/// rounding differences (1.6 cm apart after one sweep of a mirrored 5³ grid,
 /// 2.4e-7 m for this deformation); edges and volume are bit-identical even there.
 #[test]
 fn simd_matches_scalar_under_large_corrections() {

@@ -76,10 +76,11 @@ fn released(start: Start, net: f32) -> (f64, f64, u64) {
     (dp, dl, clamps)
 }
 
-/// A mirrored or scrambled body snapping back with the net at 10 m/s. Measured: linear
+/// A mirrored or scrambled body snapping back with the net at 10 m/s. Typical: linear
 /// 1.0–1.4e-6 relative; with the per-particle clamp alone 0.54 (mirrored) and 0.3
-/// (scrambled). Angular 1.0–1.5e-6 (since the solver removes the projections' own spin and
-/// the net gives back the angular momentum it removed); before, 0.6 of the scale in frame 1.
+/// (scrambled). Angular 1.0–1.5e-6 (the solver removes the projections' own spin and the
+/// net gives back the angular momentum it removed); without either, 0.6 of the scale in
+/// frame 1.
 #[test]
 fn released_tangled_body_keeps_zero_momentum() {
     for start in [Start::Mirrored, Start::Scrambled] {
@@ -91,8 +92,8 @@ fn released_tangled_body_keeps_zero_momentum() {
 }
 
 /// A one-sided strain snapping back with the net at 1 m/s: the clamp acts on the top only,
-/// which used to push the body and set it turning. Measured: linear 0.9e-7 relative,
-/// angular 1.5e-7; with the per-particle clamp alone 0.45 and 0.34.
+/// which clamped particle by particle would push the body and set it turning. Typical: linear
+/// 0.9e-7 relative, angular 1.5e-7; with the per-particle clamp alone 0.45 and 0.34.
 #[test]
 fn released_strained_body_keeps_zero_momentum() {
     let (dp, dl, clamps) = released(Start::Strained, 1.0);

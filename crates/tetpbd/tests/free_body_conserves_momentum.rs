@@ -14,7 +14,7 @@ use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings};
 /// each projection only to second order (PBD evaluates the gradients at predicted positions,
 /// unlike SHAKE, and Gauss–Seidel applies corrections one after another): without
 /// `conserve_angular_momentum` the first frame, which projects away the random internal
-/// velocity field, loses about 1e-4 of it (measured 0.8–1.3e-4). With it (the default) the
+/// velocity field, loses about 1e-4 of it (0.8–1.3e-4). With it (the default) the
 /// solver removes the rigid rotation of the families' corrections and the first frame loses
 /// 1–4e-8; over the next 1000 frames at the 20 substeps this test runs the drift is 1–20e-6
 /// (f32 positions).
