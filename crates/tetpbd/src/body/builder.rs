@@ -184,6 +184,7 @@ impl SoftBodyBuilder {
 
     /// Validates the input and builds the components.
     pub fn build(self) -> Result<SoftBody, BuildError> {
+        self.check_parameters()?;
         let SoftBodyBuilder {
             mesh,
             density,
@@ -198,130 +199,35 @@ impl SoftBodyBuilder {
             parts,
         } = self;
         let n = mesh.vertices.len();
-        if n == 0 {
-            return Err(BuildError::NoVertices);
-        }
-        if !(density.is_finite() && density > 0.0) {
-            return Err(BuildError::BadDensity { value: density });
-        }
-        if !(epsilon.is_finite() && epsilon >= 0.0) {
-            return Err(BuildError::BadEpsilon { value: epsilon });
-        }
-        for (family, a) in [
-            ("edge", edge),
-            ("vertex-face", vertex_face),
-            ("volume", volume),
-        ] {
-            if let Some(a) = a {
-                if !(a.is_finite() && a >= 0.0) {
-                    return Err(BuildError::BadCompliance { family, value: a });
-                }
-            }
-        }
-        if !velocity.iter().all(|c| c.is_finite()) {
-            return Err(BuildError::NonFiniteVelocity);
-        }
         let positions: Vec<Vector3<f32>> = mesh.vertices.iter().map(|v| v + translation).collect();
         for (i, (v, p)) in mesh.vertices.iter().zip(&positions).enumerate() {
             if !v.iter().chain(p.iter()).all(|c| c.is_finite()) {
                 return Err(BuildError::NonFiniteVertex { vertex: i });
             }
         }
-        let mut rest_volumes = Vec::with_capacity(mesh.tets.len());
-        let mut masses = vec![0.0f32; n];
-        for (t, tet) in mesh.tets.iter().enumerate() {
-            for (k, &i) in tet.iter().enumerate() {
-                if i as usize >= n {
-                    return Err(BuildError::IndexOutOfRange {
-                        tet: t,
-                        index: i,
-                        vertex_count: n,
-                    });
-                }
-                if tet[..k].contains(&i) {
-                    return Err(BuildError::RepeatedVertex { tet: t, index: i });
-                }
-            }
-            let p = tet.map(|i| mesh.vertices[i as usize]);
-            let vol = signed_volume(&p[0], &p[1], &p[2], &p[3]);
-            let mut longest = 0.0f32;
-            for a in 0..4 {
-                for b in a + 1..4 {
-                    longest = longest.max((p[a] - p[b]).norm());
-                }
-            }
-            let threshold = epsilon * longest * longest * longest;
-            // NaN-safe: anything not strictly above the threshold (overflow included) is rejected.
-            if vol.abs().partial_cmp(&threshold) != Some(std::cmp::Ordering::Greater) || vol == 0.0
-            {
-                return Err(BuildError::DegenerateTetrahedron {
-                    tet: t,
-                    volume: vol,
-                    threshold,
-                });
-            }
-            rest_volumes.push(vol);
-            for &i in tet {
-                masses[i as usize] += density * vol.abs() / 4.0;
-            }
-        }
-        if let Some(vertex) = masses.iter().position(|m| *m <= 0.0) {
-            return Err(BuildError::UnreferencedVertex { vertex });
-        }
-        let mut inv_masses: Vec<f32> = masses.iter().map(|m| 1.0 / m).collect();
-        for &i in &pinned {
-            match inv_masses.get_mut(i as usize) {
-                Some(w) => *w = 0.0,
-                None => {
-                    return Err(BuildError::PinnedOutOfRange {
-                        index: i,
-                        vertex_count: n,
-                    })
-                }
-            }
-        }
+        let (rest_volumes, masses) = rest_volumes_and_masses(&mesh, density, epsilon)?;
+        let inv_masses = pinned_inverse_masses(&masses, &pinned)?;
         let velocities: Vec<Vector3<f32>> = inv_masses
             .iter()
             .map(|w| if *w > 0.0 { velocity } else { Vector3::zeros() })
             .collect();
-        // Particle order (see `locality`): particle `k` is input vertex `particle_source[k]`.
-        let (particle_source, local_tets, local_source) = if spatial_order {
-            // Rows half an edge thick: each layer of a box grid gets its own row, so a grid
-            // generator's numbering is kept.
-            let cell = 0.5 * mean_edge_length(&mesh.vertices, &mesh.tets);
-            let order = row_order(&mesh.vertices, cell);
-            let (tets, tet_source) = relabel_tets(&mesh.tets, &inverse(&order));
-            (order, tets, tet_source)
-        } else {
-            let identity = |len: usize| (0..len as u32).collect::<Vec<u32>>();
-            (identity(n), mesh.tets, identity(rest_volumes.len()))
-        };
+        // Particle order (see `ordering::spatial`): particle `k` is input vertex
+        // `particle_source[k]`.
+        let (particle_source, local_tets, local_source) =
+            particle_order(&mesh.vertices, mesh.tets, spatial_order);
         let permute = |v: Vec<Vector3<f32>>| -> Vec<Vector3<f32>> {
             particle_source.iter().map(|&i| v[i as usize]).collect()
         };
         let positions = permute(positions);
         let velocities = permute(velocities);
         let vertices = permute(mesh.vertices);
-        let masses: Vec<f32> = particle_source
-            .iter()
-            .map(|&i| masses[i as usize])
-            .collect();
-        let inv_masses: Vec<f32> = particle_source
-            .iter()
-            .map(|&i| inv_masses[i as usize])
-            .collect();
+        let pick =
+            |v: &[f32]| -> Vec<f32> { particle_source.iter().map(|&i| v[i as usize]).collect() };
+        let (masses, inv_masses) = (pick(&masses), pick(&inv_masses));
         let surface = Surface::from_tetrahedra(&local_tets, &vertices);
-        // Solver order for tetrahedra and edges (see `ordering` and `partition`); `source`
-        // maps back.
-        let (axis, extent) = longest_axis(&vertices);
-        let parts = match parts {
-            0 => auto_parts(
-                local_tets.len(),
-                extent / mean_edge_length(&vertices, &local_tets),
-            ),
-            p => p,
-        };
-        let part_of = slab_parts(&vertices, &local_tets, axis, parts);
+        // Solver order for tetrahedra and edges (see `ordering::colouring` and
+        // `ordering::partition`); `source` maps back.
+        let (parts, part_of) = body_parts(&vertices, &local_tets, parts);
         let (order, tet_classes) = part_order(&local_tets, &part_of, parts, n);
         let tets: Vec<[u32; 4]> = order.iter().map(|&t| local_tets[t]).collect();
         let rest_volumes: Vec<f32> = order
@@ -330,37 +236,8 @@ impl SoftBodyBuilder {
             .collect();
         let source: Vec<u32> = order.iter().map(|&t| local_source[t]).collect();
         let mesh = TetMesh { vertices, tets };
-        let edges = edge.map(|alpha| {
-            let sorted = unique_edges(&mesh.tets);
-            let (edge_order, classes) = part_order(&sorted, &part_of, parts, n);
-            let list: Vec<[u32; 2]> = edge_order.iter().map(|&k| sorted[k]).collect();
-            let rest_lengths = list
-                .iter()
-                .map(|[a, b]| (mesh.vertices[*a as usize] - mesh.vertices[*b as usize]).norm())
-                .collect();
-            EdgeConstraints {
-                lambdas: vec![0.0; list.len()],
-                edges: list,
-                rest_lengths,
-                compliance: alpha,
-                classes,
-            }
-        });
-        let vertex_face = vertex_face.map(|alpha| VertexFaceConstraints {
-            rest_heights: mesh
-                .tets
-                .iter()
-                .map(|tet| {
-                    VERTEX_FACE_ORDER.map(|o| {
-                        let [a, b, c, d] = o.map(|k| mesh.vertices[tet[k] as usize]);
-                        // The volume check above guarantees a non-degenerate tetrahedron.
-                        bounded_height(&a, &b, &c, &d, VERTEX_FACE_KAPPA, 0.0).unwrap_or(0.0)
-                    })
-                })
-                .collect(),
-            lambdas: vec![[0.0; 4]; mesh.tets.len()],
-            compliance: alpha,
-        });
+        let edges = edge.map(|alpha| edge_constraints(&mesh, &part_of, parts, alpha));
+        let vertex_face = vertex_face.map(|alpha| vertex_face_constraints(&mesh, alpha));
         let volume = volume.map(|alpha| VolumeConstraints {
             lambdas: vec![0.0; mesh.tets.len()],
             compliance: alpha,
@@ -389,6 +266,174 @@ impl SoftBodyBuilder {
             vertex_face,
             volume,
         })
+    }
+
+    /// Checks the parameters that do not depend on the mesh's geometry.
+    fn check_parameters(&self) -> Result<(), BuildError> {
+        if self.mesh.vertices.is_empty() {
+            return Err(BuildError::NoVertices);
+        }
+        let (density, epsilon) = (self.density, self.epsilon);
+        if !(density.is_finite() && density > 0.0) {
+            return Err(BuildError::BadDensity { value: density });
+        }
+        if !(epsilon.is_finite() && epsilon >= 0.0) {
+            return Err(BuildError::BadEpsilon { value: epsilon });
+        }
+        for (family, a) in [
+            ("edge", self.edge),
+            ("vertex-face", self.vertex_face),
+            ("volume", self.volume),
+        ] {
+            if let Some(a) = a {
+                if !(a.is_finite() && a >= 0.0) {
+                    return Err(BuildError::BadCompliance { family, value: a });
+                }
+            }
+        }
+        if !self.velocity.iter().all(|c| c.is_finite()) {
+            return Err(BuildError::NonFiniteVelocity);
+        }
+        Ok(())
+    }
+}
+
+/// The particle order (`source[k]`: the input vertex of particle `k`), the tetrahedra
+/// relabelled for it and, for each, its input index: rows in space with `spatial_order`, the
+/// input order without.
+fn particle_order(
+    vertices: &[Vector3<f32>],
+    tets: Vec<[u32; 4]>,
+    spatial_order: bool,
+) -> (Vec<u32>, Vec<[u32; 4]>, Vec<u32>) {
+    if spatial_order {
+        // Rows half an edge thick: each layer of a box grid gets its own row, so a grid
+        // generator's numbering is kept.
+        let cell = 0.5 * mean_edge_length(vertices, &tets);
+        let order = row_order(vertices, cell);
+        let (tets, tet_source) = relabel_tets(&tets, &inverse(&order));
+        (order, tets, tet_source)
+    } else {
+        let identity = |len: usize| (0..len as u32).collect::<Vec<u32>>();
+        let tet_count = tets.len();
+        (identity(vertices.len()), tets, identity(tet_count))
+    }
+}
+
+/// The part count (`parts`, or chosen by size when 0) and the slab of each particle.
+fn body_parts(vertices: &[Vector3<f32>], tets: &[[u32; 4]], parts: usize) -> (usize, Vec<u32>) {
+    let (axis, extent) = longest_axis(vertices);
+    let parts = match parts {
+        0 => auto_parts(tets.len(), extent / mean_edge_length(vertices, tets)),
+        p => p,
+    };
+    (parts, slab_parts(vertices, tets, axis, parts))
+}
+
+/// The signed rest volume of every tetrahedron (in input order) and the lumped mass of every
+/// vertex (a quarter of each incident tetrahedron's mass), checking indices and degeneracy.
+fn rest_volumes_and_masses(
+    mesh: &TetMesh,
+    density: f32,
+    epsilon: f32,
+) -> Result<(Vec<f32>, Vec<f32>), BuildError> {
+    let n = mesh.vertices.len();
+    let mut rest_volumes = Vec::with_capacity(mesh.tets.len());
+    let mut masses = vec![0.0f32; n];
+    for (t, tet) in mesh.tets.iter().enumerate() {
+        for (k, &i) in tet.iter().enumerate() {
+            if i as usize >= n {
+                return Err(BuildError::IndexOutOfRange {
+                    tet: t,
+                    index: i,
+                    vertex_count: n,
+                });
+            }
+            if tet[..k].contains(&i) {
+                return Err(BuildError::RepeatedVertex { tet: t, index: i });
+            }
+        }
+        let p = tet.map(|i| mesh.vertices[i as usize]);
+        let vol = signed_volume(&p[0], &p[1], &p[2], &p[3]);
+        let mut longest = 0.0f32;
+        for a in 0..4 {
+            for b in a + 1..4 {
+                longest = longest.max((p[a] - p[b]).norm());
+            }
+        }
+        let threshold = epsilon * longest * longest * longest;
+        // NaN-safe: anything not strictly above the threshold (overflow included) is rejected.
+        if vol.abs().partial_cmp(&threshold) != Some(std::cmp::Ordering::Greater) || vol == 0.0 {
+            return Err(BuildError::DegenerateTetrahedron {
+                tet: t,
+                volume: vol,
+                threshold,
+            });
+        }
+        rest_volumes.push(vol);
+        for &i in tet {
+            masses[i as usize] += density * vol.abs() / 4.0;
+        }
+    }
+    if let Some(vertex) = masses.iter().position(|m| *m <= 0.0) {
+        return Err(BuildError::UnreferencedVertex { vertex });
+    }
+    Ok((rest_volumes, masses))
+}
+
+/// Inverse masses, 0 for the pinned vertices.
+fn pinned_inverse_masses(masses: &[f32], pinned: &[u32]) -> Result<Vec<f32>, BuildError> {
+    let mut inv_masses: Vec<f32> = masses.iter().map(|m| 1.0 / m).collect();
+    for &i in pinned {
+        match inv_masses.get_mut(i as usize) {
+            Some(w) => *w = 0.0,
+            None => {
+                return Err(BuildError::PinnedOutOfRange {
+                    index: i,
+                    vertex_count: masses.len(),
+                })
+            }
+        }
+    }
+    Ok(inv_masses)
+}
+
+/// The edge family of a built mesh (particles and tetrahedra in solver order), its edges in
+/// the solver's order for the body's parts.
+fn edge_constraints(mesh: &TetMesh, part_of: &[u32], parts: usize, alpha: f32) -> EdgeConstraints {
+    let sorted = unique_edges(&mesh.tets);
+    let (edge_order, classes) = part_order(&sorted, part_of, parts, mesh.vertices.len());
+    let list: Vec<[u32; 2]> = edge_order.iter().map(|&k| sorted[k]).collect();
+    let rest_lengths = list
+        .iter()
+        .map(|[a, b]| (mesh.vertices[*a as usize] - mesh.vertices[*b as usize]).norm())
+        .collect();
+    EdgeConstraints {
+        lambdas: vec![0.0; list.len()],
+        edges: list,
+        rest_lengths,
+        compliance: alpha,
+        classes,
+    }
+}
+
+/// The vertex–face family of a built mesh: the rest values of each tetrahedron's four
+/// constraints.
+fn vertex_face_constraints(mesh: &TetMesh, alpha: f32) -> VertexFaceConstraints {
+    VertexFaceConstraints {
+        rest_heights: mesh
+            .tets
+            .iter()
+            .map(|tet| {
+                VERTEX_FACE_ORDER.map(|o| {
+                    let [a, b, c, d] = o.map(|k| mesh.vertices[tet[k] as usize]);
+                    // The volume check guarantees a non-degenerate tetrahedron.
+                    bounded_height(&a, &b, &c, &d, VERTEX_FACE_KAPPA, 0.0).unwrap_or(0.0)
+                })
+            })
+            .collect(),
+        lambdas: vec![[0.0; 4]; mesh.tets.len()],
+        compliance: alpha,
     }
 }
 

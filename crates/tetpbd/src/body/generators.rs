@@ -25,23 +25,7 @@ pub fn box_grid(
     cells: [u32; 3],
     split: CellSplit,
 ) -> Result<TetMesh, BuildError> {
-    for (name, v) in [("size.x", size.x), ("size.y", size.y), ("size.z", size.z)] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(BuildError::BadGeneratorParameter { name, value: v });
-        }
-    }
-    for (name, c) in [
-        ("cells[0]", cells[0]),
-        ("cells[1]", cells[1]),
-        ("cells[2]", cells[2]),
-    ] {
-        if c == 0 || c > 1024 {
-            return Err(BuildError::BadGeneratorParameter {
-                name,
-                value: c as f32,
-            });
-        }
-    }
+    check_grid(size, cells)?;
     let [nx, ny, nz] = cells;
     let (vx, vy) = (nx + 1, ny + 1);
     let id = |i: u32, j: u32, k: u32| i + vx * (j + vy * k);
@@ -109,6 +93,28 @@ pub fn box_grid(
         }
     }
     Ok(TetMesh { vertices, tets })
+}
+
+/// Checks the size (finite, positive) and cell counts (1 to 1024) of a box grid.
+fn check_grid(size: Vector3<f32>, cells: [u32; 3]) -> Result<(), BuildError> {
+    for (name, v) in [("size.x", size.x), ("size.y", size.y), ("size.z", size.z)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(BuildError::BadGeneratorParameter { name, value: v });
+        }
+    }
+    for (name, c) in [
+        ("cells[0]", cells[0]),
+        ("cells[1]", cells[1]),
+        ("cells[2]", cells[2]),
+    ] {
+        if c == 0 || c > 1024 {
+            return Err(BuildError::BadGeneratorParameter {
+                name,
+                value: c as f32,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// A ball of `radius` (m) centred at the origin: a `cells³` box grid mapped onto the ball

@@ -361,40 +361,8 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
 ) -> ProjectionCount {
     let (p0, w) = bd.gather_corners::<L>(at);
     let kappa = L::splat(VERTEX_FACE_KAPPA);
-    // Pre-check every face at the start of the chunk: healthy with a margin of 2.
-    for order in VERTEX_FACE_ORDER {
-        let (b, c) = (
-            p0[order[2]].sub(p0[order[0]]),
-            p0[order[3]].sub(p0[order[0]]),
-        );
-        let m = b.cross(c);
-        let twice_k = kappa * (b.dot(b) + c.dot(c));
-        let ok = m.dot(m).vgt(twice_k * twice_k);
-        if !ok.vall() {
-            let mut count = ProjectionCount::default();
-            if L::WIDTH > LANES {
-                for c in (0..L::WIDTH).step_by(LANES) {
-                    count +=
-                        vertex_faces::<f32x4, A>(bd, at + c, heights, held, lambdas, alpha_tilde);
-                }
-                return count;
-            }
-            let tets = chunk(bd.items(), at);
-            for (l, &t) in tets.iter().enumerate() {
-                let k = at + l;
-                let (a, d) = scalar::vertex_face_held(
-                    bd.acc(),
-                    t,
-                    &heights[k],
-                    &mut lambdas[k],
-                    alpha_tilde,
-                    scalar::held_mask(held, k),
-                );
-                count.applied += u64::from(a);
-                count.degenerate += u64::from(d);
-            }
-            return count;
-        }
+    if !faces_healthy(&p0, kappa) {
+        return vertex_faces_elsewhere::<L, A>(bd, at, heights, held, lambdas, alpha_tilde);
     }
     let alpha = L::splat(alpha_tilde);
     // Per constraint k, the tetrahedra's heights and multipliers as lanes.
@@ -424,19 +392,7 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
             p0[order[2]].add(dp[order[2]]),
             p0[order[3]].add(dp[order[3]]),
         ];
-        let (a, b, c) = (q[1].sub(q[0]), q[2].sub(q[0]), q[3].sub(q[0]));
-        let m = b.cross(c);
-        let m_len = m.dot(m).vsqrt();
-        // Healthy (`s ≥ κQ`, Q = (|b|² + |c|²)/2): the seed's height.
-        let valid = m_len.vge((b.dot(b) + c.dot(c)) * kappa * L::splat(0.5));
-        let inv = valid.vsel(L::ONE / m_len, L::ZERO);
-        let n = m.scale(inv);
-        let na = n.dot(a);
-        let g1 = n;
-        let g2 = c.cross(a).add(n.cross(c).scale(na)).scale(inv);
-        let g3 = b.cross(a).add(n.cross(b).scale(na)).scale(inv).neg();
-        let g0 = g1.add(g2).add(g3).neg();
-        let g = [g0, g1, g2, g3];
+        let (na, valid, g) = height_and_gradients(q, kappa);
         let wo = [w[order[0]], w[order[1]], w[order[2]], w[order[3]]];
         let w_grad_sq = (0..4).fold(L::ZERO, |s, s_| s + wo[s_] * g[s_].dot(g[s_]));
         let (dl, ok) = delta_lambda(na - h[k], lam[k], alpha, w_grad_sq);
@@ -465,4 +421,77 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
         bd.scatter(at, k, d);
     }
     count
+}
+
+/// Whether every face of the chunk's tetrahedra is healthy with a margin of 2
+/// (`|b × c| > 2κQ` on every lane) at the start of the chunk.
+#[inline(always)]
+fn faces_healthy<L: Lane>(p0: &[V3<L>; 4], kappa: L) -> bool {
+    for order in VERTEX_FACE_ORDER {
+        let (b, c) = (
+            p0[order[2]].sub(p0[order[0]]),
+            p0[order[3]].sub(p0[order[0]]),
+        );
+        let m = b.cross(c);
+        let twice_k = kappa * (b.dot(b) + c.dot(c));
+        let ok = m.dot(m).vgt(twice_k * twice_k);
+        if !ok.vall() {
+            return false;
+        }
+    }
+    true
+}
+
+/// [`vertex_faces`] of a chunk with a face not healthy by the margin: a pair of chunks goes
+/// back to chunks of four, a chunk of four to the scalar kernel.
+#[inline(always)]
+fn vertex_faces_elsewhere<L: Lane, A: ParticleAccess>(
+    bd: &mut Bounded<'_, A, 4>,
+    at: usize,
+    heights: &[[f32; 4]],
+    held: &[[f32; 4]],
+    lambdas: &mut [[f32; 4]],
+    alpha_tilde: f32,
+) -> ProjectionCount {
+    let mut count = ProjectionCount::default();
+    if L::WIDTH > LANES {
+        for c in (0..L::WIDTH).step_by(LANES) {
+            count += vertex_faces::<f32x4, A>(bd, at + c, heights, held, lambdas, alpha_tilde);
+        }
+        return count;
+    }
+    let tets = chunk(bd.items(), at);
+    for (l, &t) in tets.iter().enumerate() {
+        let k = at + l;
+        let (a, d) = scalar::vertex_face_held(
+            bd.acc(),
+            t,
+            &heights[k],
+            &mut lambdas[k],
+            alpha_tilde,
+            scalar::held_mask(held, k),
+        );
+        count.applied += u64::from(a);
+        count.degenerate += u64::from(d);
+    }
+    count
+}
+
+/// The seed's height `n·a` of corner `q[1]` above the face `q[0], q[2], q[3]`, whether the
+/// face is healthy (`s ≥ κQ`, Q = (|b|² + |c|²)/2) and the four gradients (zero on a lane
+/// whose face is not).
+#[inline(always)]
+fn height_and_gradients<L: Lane>(q: [V3<L>; 4], kappa: L) -> (L, L, [V3<L>; 4]) {
+    let (a, b, c) = (q[1].sub(q[0]), q[2].sub(q[0]), q[3].sub(q[0]));
+    let m = b.cross(c);
+    let m_len = m.dot(m).vsqrt();
+    let valid = m_len.vge((b.dot(b) + c.dot(c)) * kappa * L::splat(0.5));
+    let inv = valid.vsel(L::ONE / m_len, L::ZERO);
+    let n = m.scale(inv);
+    let na = n.dot(a);
+    let g1 = n;
+    let g2 = c.cross(a).add(n.cross(c).scale(na)).scale(inv);
+    let g3 = b.cross(a).add(n.cross(b).scale(na)).scale(inv).neg();
+    let g0 = g1.add(g2).add(g3).neg();
+    (na, valid, [g0, g1, g2, g3])
 }

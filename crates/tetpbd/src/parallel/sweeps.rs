@@ -243,7 +243,7 @@ pub(crate) fn vertex_face(
 }
 
 /// The spin removal's measuring copy back ([`crate::stabilisation::angular_momentum`]) of one body: one unit per
-/// block of [`crate::stabilisation::angular_momentum::BLOCK`] particles, each block's f32 sums written to its entry of
+/// block of [`crate::stabilisation::rigid_fit::BLOCK`] particles, each block's f32 sums written to its entry of
 /// `blocks` (the caller folds them in block order, as the serial path does, so the result
 /// does not depend on the thread count).
 pub(crate) fn store_measuring(run: StoreRun<'_>, o: Vector3<f32>, blocks: &mut [Moments<f32>]) {

@@ -54,10 +54,12 @@ use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstr
 use crate::body::mesh::Tetrahedra;
 use crate::body::particles::Particles;
 use crate::constraints::VERTEX_FACE_ORDER;
-use crate::kernels::class_runs;
 use crate::kernels::count::{Kernel, ProjectionCount};
+use crate::kernels::slots::WorkAccess;
 use crate::kernels::working_copy;
-use crate::stabilisation::ground_up_levels::{shift_starts, Gathered, LevelOrder};
+use crate::stabilisation::ground_up_levels::{
+    edge_level, shift_starts, vertex_face_level, volume_level, Gathered, LevelOrder,
+};
 
 /// Level of a particle that no root reaches.
 const UNREACHED: u32 = u32::MAX;
@@ -238,6 +240,50 @@ impl StackingLayers {
         }
         shift_starts(&mut self.first);
     }
+
+    /// Copies the families' items, rest values and multipliers into level order (the items
+    /// and rest values only when the order changed since the last sweep).
+    fn gather(&mut self, tets: &Tetrahedra, families: &BodyConstraints<'_>) {
+        let gathered = self.gathered;
+        if let Some(e) = families.edges.as_deref() {
+            let o = &self.edges.order;
+            self.edge_data
+                .gather(o, &e.edges, &e.rest_lengths, &e.lambdas, gathered);
+        }
+        if let Some(v) = families.vertex_face.as_deref() {
+            let o = &self.tets.order;
+            let data = &mut self.vertex_face_data;
+            if data.gather(o, &tets.indices, &v.rest_heights, &v.lambdas, gathered) {
+                held_masks(
+                    &mut self.vf_held,
+                    &self.tets,
+                    &tets.indices,
+                    &self.level,
+                    self.top,
+                );
+            }
+        }
+        if let Some(v) = families.volume.as_deref() {
+            let o = &self.tets.order;
+            self.volume_data
+                .gather(o, &tets.indices, &tets.rest_volumes, &v.lambdas, gathered);
+        }
+        self.gathered = true;
+    }
+
+    /// Copies the multipliers back from level order.
+    fn scatter(&self, families: BodyConstraints<'_>) {
+        if let Some(e) = families.edges {
+            self.edge_data.scatter(&self.edges.order, &mut e.lambdas);
+        }
+        if let Some(v) = families.vertex_face {
+            self.vertex_face_data
+                .scatter(&self.tets.order, &mut v.lambdas);
+        }
+        if let Some(v) = families.volume {
+            self.volume_data.scatter(&self.tets.order, &mut v.lambdas);
+        }
+    }
 }
 
 /// The held masks of the vertex–face constraints in sweep order (`StackingLayers::vf_held`):
@@ -303,13 +349,13 @@ pub fn project_stacked(
     if layers.top == 0 || !layers.fits(p.len(), tets) {
         return count;
     }
+    layers.gather(tets, &families);
     let BodyConstraints {
         edges,
         vertex_face,
         volume,
     } = families;
     let StackingLayers {
-        level,
         roots,
         edges: edge_order,
         tets: tet_order,
@@ -318,112 +364,72 @@ pub fn project_stacked(
         volume_data,
         vf_held,
         held,
-        gathered,
         top,
         ..
     } = layers;
-    if let Some(e) = edges.as_deref() {
-        let o = &edge_order.order;
-        edge_data.gather(o, &e.edges, &e.rest_lengths, &e.lambdas, *gathered);
-    }
-    if let Some(v) = vertex_face.as_deref() {
-        let o = &tet_order.order;
-        if vertex_face_data.gather(o, &tets.indices, &v.rest_heights, &v.lambdas, *gathered) {
-            held_masks(vf_held, tet_order, &tets.indices, level, *top);
-        }
-    }
-    if let Some(v) = volume.as_deref() {
-        let o = &tet_order.order;
-        volume_data.gather(o, &tets.indices, &tets.rest_volumes, &v.lambdas, *gathered);
-    }
-    *gathered = true;
     working_copy::with_access(p, working_copy::CopyMode::PerSweep, |acc| {
-        // Hold the roots: inverse mass 0 for the sweep, restored after it.
-        held.clear();
-        for &r in roots.iter() {
-            let slot = &mut acc.slots[r as usize];
-            let [x, y, z, w] = slot.xw.to_array();
-            held.push(w);
-            slot.xw = wide::f32x4::new([x, y, z, 0.0]);
-        }
+        hold_roots(acc, roots, held);
         for l in 1..=*top {
             for family in order {
-                match family {
-                    Family::Edge => {
-                        let Some(e) = edges.as_deref() else {
-                            continue;
-                        };
-                        let alpha_tilde = e.compliance / (h * h);
-                        for (r, independent) in edge_order.level(l) {
-                            count += class_runs::edge_run(
-                                acc,
-                                &edge_data.items[r.clone()],
-                                &edge_data.rest[r.clone()],
-                                &mut edge_data.lambdas[r],
-                                alpha_tilde,
-                                kernel,
-                                independent,
-                            );
+                count += match family {
+                    Family::Edge => match edges.as_deref() {
+                        Some(e) => {
+                            let alpha_tilde = e.compliance / (h * h);
+                            edge_level(acc, edge_order, edge_data, l, alpha_tilde, kernel)
                         }
-                    }
-                    Family::VertexFace => {
-                        let Some(vf) = vertex_face.as_deref() else {
-                            continue;
-                        };
-                        let alpha_tilde = vf.compliance / (h * h);
-                        // Only a vertex of this level is held above its face (`vf_held`):
-                        // moving a face alone to hold a root is ill-conditioned (the height
-                        // barely depends on a face point whose opposite edge passes under
-                        // the vertex) and blew the slab up.
-                        for (r, independent) in tet_order.level(l) {
-                            count += class_runs::vertex_face_run(
-                                acc,
-                                &vertex_face_data.items[r.clone()],
-                                &vertex_face_data.rest[r.clone()],
-                                &vf_held[r.clone()],
-                                &mut vertex_face_data.lambdas[r],
-                                alpha_tilde,
-                                kernel,
-                                independent,
-                            );
+                        None => continue,
+                    },
+                    // Only a vertex of this level is held above its face (`vf_held`): moving
+                    // a face alone to hold a root is ill-conditioned (the height barely
+                    // depends on a face point whose opposite edge passes under the vertex)
+                    // and blows the slab up.
+                    Family::VertexFace => match vertex_face.as_deref() {
+                        Some(vf) => {
+                            let alpha_tilde = vf.compliance / (h * h);
+                            let data = (&mut *vertex_face_data, &vf_held[..]);
+                            vertex_face_level(acc, tet_order, data, l, alpha_tilde, kernel)
                         }
-                    }
-                    Family::Volume => {
-                        let Some(vol) = volume.as_deref() else {
-                            continue;
-                        };
-                        let alpha_tilde = vol.compliance / (h * h);
-                        for (r, independent) in tet_order.level(l) {
-                            count += class_runs::volume_run(
-                                acc,
-                                &volume_data.items[r.clone()],
-                                &volume_data.rest[r.clone()],
-                                &mut volume_data.lambdas[r],
-                                alpha_tilde,
-                                kernel,
-                                independent,
-                            );
+                        None => continue,
+                    },
+                    Family::Volume => match volume.as_deref() {
+                        Some(vol) => {
+                            let alpha_tilde = vol.compliance / (h * h);
+                            volume_level(acc, tet_order, volume_data, l, alpha_tilde, kernel)
                         }
-                    }
-                }
+                        None => continue,
+                    },
+                };
             }
         }
-        for (&r, &w) in roots.iter().zip(held.iter()) {
-            let slot = &mut acc.slots[r as usize];
-            let [x, y, z, _] = slot.xw.to_array();
-            slot.xw = wide::f32x4::new([x, y, z, w]);
-        }
+        release_roots(acc, roots, held);
     });
-    if let Some(e) = edges {
-        edge_data.scatter(&edge_order.order, &mut e.lambdas);
-    }
-    if let Some(v) = vertex_face {
-        vertex_face_data.scatter(&tet_order.order, &mut v.lambdas);
-    }
-    if let Some(v) = volume {
-        volume_data.scatter(&tet_order.order, &mut v.lambdas);
-    }
+    layers.scatter(BodyConstraints {
+        edges,
+        vertex_face,
+        volume,
+    });
     count
+}
+
+/// Holds the roots: inverse mass 0 in the working copy for the sweep, the old values kept
+/// in `held`.
+fn hold_roots(acc: &mut WorkAccess<'_>, roots: &[u32], held: &mut Vec<f32>) {
+    held.clear();
+    for &r in roots {
+        let slot = &mut acc.slots[r as usize];
+        let [x, y, z, w] = slot.xw.to_array();
+        held.push(w);
+        slot.xw = wide::f32x4::new([x, y, z, 0.0]);
+    }
+}
+
+/// Gives the roots their inverse masses back after the sweep.
+fn release_roots(acc: &mut WorkAccess<'_>, roots: &[u32], held: &[f32]) {
+    for (&r, &w) in roots.iter().zip(held.iter()) {
+        let slot = &mut acc.slots[r as usize];
+        let [x, y, z, _] = slot.xw.to_array();
+        slot.xw = wide::f32x4::new([x, y, z, w]);
+    }
 }
 
 #[cfg(test)]

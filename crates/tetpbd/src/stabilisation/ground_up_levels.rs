@@ -1,7 +1,11 @@
 //! The order of a ground-up sweep ([`crate::project_stacked`]) within one family: items
 //! (edges or tetrahedra) by level, each level in greedy colour classes so that the SIMD
-//! kernels run a class in lanes, and the per-sweep copies of the items' data in that order.
+//! kernels run a class in lanes, the per-sweep copies of the items' data in that order, and
+//! the projections of one level.
 
+use crate::kernels::class_runs;
+use crate::kernels::count::{Kernel, ProjectionCount};
+use crate::kernels::slots::WorkAccess;
 use crate::ordering::colouring::{greedy_colour, OVERFLOW_COLOUR};
 
 /// Colour of the overflow class of a greedy colouring (its items may share particles).
@@ -207,4 +211,81 @@ pub(crate) fn shift_starts(starts: &mut [u32]) {
     if let Some(s) = starts.first_mut() {
         *s = 0;
     }
+}
+
+/// The vertex–face constraints of a sweep in level order.
+pub(crate) type VertexFaceData = Gathered<[u32; 4], [f32; 4]>;
+
+/// The edges of level `l`, class by class (`alpha_tilde = α/h²`).
+pub(crate) fn edge_level(
+    acc: &mut WorkAccess<'_>,
+    order: &LevelOrder,
+    data: &mut Gathered<[u32; 2], f32>,
+    l: u32,
+    alpha_tilde: f32,
+    kernel: Kernel,
+) -> ProjectionCount {
+    let mut count = ProjectionCount::default();
+    for (r, independent) in order.level(l) {
+        count += class_runs::edge_run(
+            acc,
+            &data.items[r.clone()],
+            &data.rest[r.clone()],
+            &mut data.lambdas[r],
+            alpha_tilde,
+            kernel,
+            independent,
+        );
+    }
+    count
+}
+
+/// The vertex–face constraints of the tetrahedra of level `l` that hold a vertex of that
+/// level (`data`: the gathered constraints and their held masks).
+pub(crate) fn vertex_face_level(
+    acc: &mut WorkAccess<'_>,
+    order: &LevelOrder,
+    (data, held): (&mut VertexFaceData, &[[f32; 4]]),
+    l: u32,
+    alpha_tilde: f32,
+    kernel: Kernel,
+) -> ProjectionCount {
+    let mut count = ProjectionCount::default();
+    for (r, independent) in order.level(l) {
+        count += class_runs::vertex_face_run(
+            acc,
+            &data.items[r.clone()],
+            &data.rest[r.clone()],
+            &held[r.clone()],
+            &mut data.lambdas[r],
+            alpha_tilde,
+            kernel,
+            independent,
+        );
+    }
+    count
+}
+
+/// The volume constraints of the tetrahedra of level `l`.
+pub(crate) fn volume_level(
+    acc: &mut WorkAccess<'_>,
+    order: &LevelOrder,
+    data: &mut Gathered<[u32; 4], f32>,
+    l: u32,
+    alpha_tilde: f32,
+    kernel: Kernel,
+) -> ProjectionCount {
+    let mut count = ProjectionCount::default();
+    for (r, independent) in order.level(l) {
+        count += class_runs::volume_run(
+            acc,
+            &data.items[r.clone()],
+            &data.rest[r.clone()],
+            &mut data.lambdas[r],
+            alpha_tilde,
+            kernel,
+            independent,
+        );
+    }
+    count
 }

@@ -11,7 +11,7 @@ use crate::kernels::slots::Slot;
 /// Eigenvalues of the inertia tensor below this fraction of the largest count as zero.
 const INERTIA_CUTOFF: f64 = 1e-9;
 
-/// Particles per f32 block of [`store_without_spin`]'s sums.
+/// Particles per f32 block of the angular-momentum conservation's sums.
 pub(crate) const BLOCK: usize = 256;
 
 /// Mass-weighted moments of the substep starts `x̄` and corrections `Δ` of some particles.
