@@ -4,7 +4,7 @@ mod common;
 
 use common::Rng;
 use nalgebra::Vector3;
-use tetpbd::constraint::{
+use tetpbd::constraints::{
     edge, signed_volume, vertex_face, vertex_face_bounded, volume, Evaluated,
 };
 
@@ -175,7 +175,7 @@ fn collapsed_tetrahedron_volume_is_finite() {
     let p = Vector3::new(0.3f32, -0.2, 0.1);
     let e = volume(&p, &p, &p, &p, 0.1);
     assert!(e.c.is_finite() && e.grad.iter().all(|g| g.norm() == 0.0));
-    assert!(tetpbd::constraint::xpbd_delta_lambda(e.c, 0.0, 0.0, 0.0f32).is_none());
+    assert!(tetpbd::constraints::xpbd_delta_lambda(e.c, 0.0, 0.0, 0.0f32).is_none());
 }
 
 #[test]

@@ -5,7 +5,7 @@ mod common;
 use common::{unit_tet, Rng};
 use hecs::World;
 use nalgebra::Vector3;
-use tetpbd::constraint::{apply, edge, vertex_face, volume};
+use tetpbd::constraints::{apply, edge, vertex_face, volume};
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, TetMesh};
 
 fn perturbed(rng: &mut Rng, p: [Vector3<f32>; 4], amount: f64) -> [Vector3<f32>; 4] {

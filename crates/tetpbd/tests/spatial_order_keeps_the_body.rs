@@ -3,7 +3,7 @@
 //! the body behaves like the one built in input order.
 
 use nalgebra::Vector3;
-use tetpbd::constraint::signed_volume;
+use tetpbd::constraints::signed_volume;
 use tetpbd::generators::{box_grid, shuffled, CellSplit};
 use tetpbd::{BuildError, Particles, SoftBodyBuilder, Solver, SolverSettings, Surface, TetMesh};
 

@@ -5,7 +5,7 @@
 //! reference).
 
 use nalgebra::Vector3;
-use tetpbd::constraint::{bounded_step, vertex_face_step_bound, VERTEX_FACE_MAX_STEP};
+use tetpbd::constraints::{bounded_step, vertex_face_step_bound, VERTEX_FACE_MAX_STEP};
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings};
 

@@ -12,7 +12,7 @@
 
 /// Greedy colour of each item (an edge or a tetrahedron given by its particle indices).
 /// Colours above 63 share the last class; the order stays valid, only less independent.
-pub fn greedy_colours<const N: usize>(items: &[[u32; N]], particles: usize) -> Vec<u8> {
+pub(crate) fn greedy_colours<const N: usize>(items: &[[u32; N]], particles: usize) -> Vec<u8> {
     let mut used = vec![0u64; particles];
     items
         .iter()
@@ -139,7 +139,7 @@ impl ColourClasses {
 
 /// The permutation that sorts `items` by greedy colour (stable within a colour), and the
 /// resulting classes.
-pub fn colour_order<const N: usize>(
+pub(crate) fn colour_order<const N: usize>(
     items: &[[u32; N]],
     particles: usize,
 ) -> (Vec<usize>, ColourClasses) {

@@ -28,10 +28,10 @@ use nalgebra::Vector3;
 use crate::ordering::colouring::{colour_order, greedy_colours, ColourClasses};
 
 /// Tetrahedra per part of [`auto_parts`] at least (below it a body keeps the plain layout).
-pub const TETS_PER_PART: usize = 25_000;
+pub(crate) const TETS_PER_PART: usize = 25_000;
 
 /// Parts of [`auto_parts`] at most.
-pub const MAX_PARTS: usize = 8;
+pub(crate) const MAX_PARTS: usize = 8;
 
 /// Slabs at least this many mean edge lengths thick (thinner slabs leave more constraints
 /// spanning three slabs, which fall back to plain classes).
@@ -40,7 +40,7 @@ const MIN_SLAB_EDGES: f32 = 3.0;
 /// The part count chosen for a body of `tets` tetrahedra whose longest extent is `extent`
 /// mean edge lengths: one per [`TETS_PER_PART`] tetrahedra, at most [`MAX_PARTS`], slabs at
 /// least three edges thick; 1 (the plain layout) for small bodies.
-pub fn auto_parts(tets: usize, extent: f32) -> usize {
+pub(crate) fn auto_parts(tets: usize, extent: f32) -> usize {
     let by_size = tets / TETS_PER_PART;
     let by_thickness = if extent.is_finite() && extent > 0.0 {
         (extent / MIN_SLAB_EDGES) as usize
@@ -52,7 +52,7 @@ pub fn auto_parts(tets: usize, extent: f32) -> usize {
 
 /// The axis (0, 1, 2) of the longest extent of `positions`, preferring z, then y, on ties
 /// (row order numbers particles by z first, see [`crate::ordering::spatial`]), and that extent.
-pub fn longest_axis(positions: &[Vector3<f32>]) -> (usize, f32) {
+pub(crate) fn longest_axis(positions: &[Vector3<f32>]) -> (usize, f32) {
     let mut lo = Vector3::repeat(f32::INFINITY);
     let mut hi = Vector3::repeat(f32::NEG_INFINITY);
     for p in positions.iter().filter(|p| p.iter().all(|c| c.is_finite())) {
@@ -73,7 +73,7 @@ pub fn longest_axis(positions: &[Vector3<f32>]) -> (usize, f32) {
 /// corners (each particle weighted by the tetrahedra it belongs to) passes each multiple of
 /// `1 / parts` of the total. Ties in the coordinate keep the index order, so the result is
 /// deterministic.
-pub fn slab_parts(
+pub(crate) fn slab_parts(
     positions: &[Vector3<f32>],
     tets: &[[u32; 4]],
     axis: usize,
@@ -117,7 +117,7 @@ fn group(lo: u32, hi: u32, parts: usize) -> usize {
 /// The permutation that sorts `items` into the layout of the module docs for the part of
 /// each particle `part_of` (values below `parts`), and the resulting classes. With
 /// `parts ≤ 1` this is [`colour_order`].
-pub fn part_order<const N: usize>(
+pub(crate) fn part_order<const N: usize>(
     items: &[[u32; N]],
     part_of: &[u32],
     parts: usize,

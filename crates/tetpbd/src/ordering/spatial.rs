@@ -19,7 +19,7 @@ use nalgebra::Vector3;
 
 /// Mean length of the six edges of every tetrahedron, m (0 when there are none). Indices
 /// must be in range.
-pub fn mean_edge_length(vertices: &[Vector3<f32>], tets: &[[u32; 4]]) -> f32 {
+pub(crate) fn mean_edge_length(vertices: &[Vector3<f32>], tets: &[[u32; 4]]) -> f32 {
     let mut sum = 0.0f64;
     for t in tets {
         for a in 0..4 {
@@ -40,7 +40,7 @@ pub fn mean_edge_length(vertices: &[Vector3<f32>], tets: &[[u32; 4]]) -> f32 {
 /// sorted by (z cell, y cell, x). Element `k` is the input index of the `k`-th particle.
 /// Ties (and non-finite input, and a `cell` that is not positive) keep the input order, so
 /// the result is deterministic.
-pub fn row_order(positions: &[Vector3<f32>], cell: f32) -> Vec<u32> {
+pub(crate) fn row_order(positions: &[Vector3<f32>], cell: f32) -> Vec<u32> {
     let mut lo = Vector3::repeat(f32::INFINITY);
     for p in positions.iter().filter(|p| p.iter().all(|c| c.is_finite())) {
         lo = lo.inf(p);
@@ -73,7 +73,7 @@ pub fn row_order(positions: &[Vector3<f32>], cell: f32) -> Vec<u32> {
 }
 
 /// The inverse of a permutation: `inverse[order[k]] = k`.
-pub fn inverse(order: &[u32]) -> Vec<u32> {
+pub(crate) fn inverse(order: &[u32]) -> Vec<u32> {
     let mut inv = vec![0u32; order.len()];
     for (k, &i) in order.iter().enumerate() {
         inv[i as usize] = k as u32;
@@ -83,7 +83,7 @@ pub fn inverse(order: &[u32]) -> Vec<u32> {
 
 /// Tetrahedra renumbered by `index` (input vertex → particle) and sorted by their smallest
 /// particle index (stable); returns the tetrahedra and, for each, its input index.
-pub fn relabel_tets(tets: &[[u32; 4]], index: &[u32]) -> (Vec<[u32; 4]>, Vec<u32>) {
+pub(crate) fn relabel_tets(tets: &[[u32; 4]], index: &[u32]) -> (Vec<[u32; 4]>, Vec<u32>) {
     let relabelled: Vec<[u32; 4]> = tets.iter().map(|t| t.map(|i| index[i as usize])).collect();
     let mut order: Vec<u32> = (0..tets.len() as u32).collect();
     order.sort_by_key(|&t| relabelled[t as usize].iter().copied().min());
