@@ -1,23 +1,31 @@
 //! Tetrahedral soft bodies solved with (extended) position-based dynamics, stored as
 //! [`hecs`] components.
 //!
-//! The crate, folder by folder:
+//! What a user touches: [`SoftBodyBuilder`] turns a [`TetMesh`] (from a file or a
+//! [`generators`] function) into components — [`Particles`] (flat arrays per quantity),
+//! [`Tetrahedra`], [`Surface`] and one optional component per constraint family
+//! ([`EdgeConstraints`], [`VertexFaceConstraints`], [`VolumeConstraints`]): a body pays only
+//! for the families it has. A [`Solver`] steps every body of a `hecs::World` with
+//! [`SolverSettings`], runs a [`SubstepHook`] (contacts, attachments of a coupling crate)
+//! inside its substep loop and returns [`StepStats`]. [`constraints`] holds the constraint
+//! math as pure functions and [`systems`] the solver's steps as plain functions over
+//! `&mut hecs::World`, for an integrator who builds a different schedule.
 //!
-//! * [`constraints`] — the math of the three constraints Müller et al. (2006) use for
-//!   tetrahedra (edge distance, vertex–face, signed volume) as pure functions, with the XPBD
-//!   update written once in its module docs;
-//! * components — [`Particles`] (flat arrays per quantity), [`Tetrahedra`], [`Surface`] and
-//!   one optional component per constraint family ([`EdgeConstraints`],
-//!   [`VertexFaceConstraints`], [`VolumeConstraints`]): a body pays only for the families it has;
-//! * [`systems`] — plain functions over `&mut hecs::World`, run in order by [`Solver`]
-//!   (the `solver` folder: [`Solver`], [`SolverSettings`], [`SubstepHook`], [`StepStats`]).
+//! The source, folder by folder:
 //!
-//! Inside the crate, `body/` builds bodies and holds their components, `stabilisation/` the
-//! optional passes that keep a body well-behaved (the correction-speed safety net's momentum
-//! restoration, the angular-momentum conservation, the ground-up sweep), `kernels/` the
-//! scalar and SIMD projections over the working copy of the particles, `parallel/` the
-//! parallel sweeps (feature `parallel`) and `ordering/` the build-time orders (colour
-//! classes, spatial renumbering, domain decomposition).
+//! | folder | holds |
+//! |---|---|
+//! | `body/` | the builder, the mesh generators and the components |
+//! | `constraints/` | one file per constraint (`edge.rs`, `vertex_face.rs`, `vertex_face_bounded.rs`, `volume.rs`) and the XPBD update (`xpbd.rs`) |
+//! | `solver/` | settings, the hook, the statistics, the systems, and `step.rs`, where a frame and each substep start |
+//! | `stabilisation/` | the angular-momentum conservation, the safety net's momentum restoration, the ground-up sweep for heavy loads |
+//! | `kernels/` | the scalar and SIMD projections and the working copy of the particles they run on |
+//! | `parallel/` | the parallel sweeps (feature `parallel`), bit-identical to the serial ones |
+//! | `ordering/` | orders fixed at build time: colour classes, spatial renumbering, domain decomposition |
+//!
+//! `unsafe` is confined to `kernels/` (bounds checked once per run of a colour class, AVX2
+//! chosen at run time) and `parallel/` (disjoint writes of one region's threads, the step's
+//! helper threads, the helper's CPU mask), each use with its `SAFETY` argument.
 //!
 //! ```
 //! use nalgebra::Vector3;

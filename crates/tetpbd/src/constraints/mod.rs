@@ -20,7 +20,7 @@
 //! the hard PBD projection of Müller et al. 2006, which removes `C` to first order in one
 //! step. The potential energy behind a compliant constraint is `U = C² / (2α)`, so `α` has the
 //! units of `C² / J`: m/N for the two length constraints, m⁵/N for the volume constraint.
-
+//!
 //! # Where each constraint lives
 //!
 //! * [`edge()`] — edge distance (`edge.rs`);
