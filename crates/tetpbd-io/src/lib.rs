@@ -39,6 +39,7 @@
 //! assert_eq!(err.to_string(), ".ele line 2: vertex 9 does not exist (4 vertices)");
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+#![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 mod compact;

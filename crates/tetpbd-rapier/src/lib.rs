@@ -48,6 +48,7 @@
 //! Bad input is rejected with a [`CouplingError`] naming what is wrong; conditions that can
 //! only be seen during a step (an attachment whose body was removed, a point parry gives no
 //! normal for) are skipped and counted in [`CouplingStats`].
+#![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 mod attachment;

@@ -5,6 +5,7 @@
 //! stayed finite, the peak kinetic energy relative to the case's reference energy, the frames
 //! until recovered (no inverted tetrahedron and total volume within 1 %), and the final
 //! max |C| per family. [`Outcome::pass`] applies the case's criteria.
+#![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 mod cases;

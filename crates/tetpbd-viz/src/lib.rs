@@ -30,6 +30,7 @@
 //! assert_eq!(picture.pixel(0, 0), Some(settings.background));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+#![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 mod camera;

@@ -1,15 +1,31 @@
 //! Tetrahedral soft bodies solved with (extended) position-based dynamics, stored as
 //! [`hecs`] components.
 //!
-//! Three layers:
+//! What a user touches: [`SoftBodyBuilder`] turns a [`TetMesh`] (from a file or a
+//! [`generators`] function) into components — [`Particles`] (flat arrays per quantity),
+//! [`Tetrahedra`], [`Surface`] and one optional component per constraint family
+//! ([`EdgeConstraints`], [`VertexFaceConstraints`], [`VolumeConstraints`]): a body pays only
+//! for the families it has. A [`Solver`] steps every body of a `hecs::World` with
+//! [`SolverSettings`], runs a [`SubstepHook`] (contacts, attachments of a coupling crate)
+//! inside its substep loop and returns [`StepStats`]. [`constraints`] holds the constraint
+//! math as pure functions and [`systems`] the solver's steps as plain functions over
+//! `&mut hecs::World`, for an integrator who builds a different schedule.
 //!
-//! * [`constraint`] — the math of the three constraints Müller et al. (2006) use for
-//!   tetrahedra (edge distance, vertex–face, signed volume) as pure functions, with the XPBD
-//!   update written once in its module docs;
-//! * components — [`Particles`] (flat arrays per quantity), [`Tetrahedra`], [`Surface`] and
-//!   one optional component per constraint family ([`EdgeConstraints`],
-//!   [`VertexFaceConstraints`], [`VolumeConstraints`]): a body pays only for the families it has;
-//! * [`systems`] — plain functions over `&mut hecs::World`, run in order by [`Solver`].
+//! The source, folder by folder:
+//!
+//! | folder | holds |
+//! |---|---|
+//! | `body/` | the builder, the mesh generators and the components |
+//! | `constraints/` | one file per constraint (`edge.rs`, `vertex_face.rs`, `vertex_face_bounded.rs`, `volume.rs`) and the XPBD update (`xpbd.rs`) |
+//! | `solver/` | settings, the hook, the statistics, the systems, and `step.rs`, where a frame and each substep start |
+//! | `stabilisation/` | the angular-momentum conservation, the safety net's momentum restoration, the ground-up sweep for heavy loads |
+//! | `kernels/` | the scalar and SIMD projections and the working copy of the particles they run on |
+//! | `parallel/` | the parallel sweeps (feature `parallel`), bit-identical to the serial ones |
+//! | `ordering/` | orders fixed at build time: colour classes, spatial renumbering, domain decomposition |
+//!
+//! `unsafe` is confined to `kernels/` (bounds checked once per run of a colour class, AVX2
+//! chosen at run time) and `parallel/` (disjoint writes of one region's threads, the step's
+//! helper threads, the helper's CPU mask), each use with its `SAFETY` argument.
 //!
 //! ```
 //! use nalgebra::Vector3;
@@ -25,47 +41,35 @@
 //! ```
 #![warn(missing_docs)]
 
-#[cfg(feature = "parallel")]
-mod affinity;
-mod builder;
-pub mod constraint;
+mod body;
+pub mod constraints;
 mod error;
-mod families;
-pub mod generators;
-mod lanes;
-mod level_order;
-pub mod locality;
-mod mesh;
-mod momentum;
-pub mod ordering;
+mod kernels;
+mod ordering;
 #[cfg(feature = "parallel")]
 mod parallel;
-mod particles;
-pub mod partition;
-mod projection;
-mod runs;
-#[cfg(feature = "parallel")]
-mod schedule;
-mod simd;
 mod solver;
-mod spin;
-mod stacking;
-mod stats;
-#[cfg(feature = "sync-stats")]
-pub mod sync_stats;
-pub mod systems;
-#[cfg(feature = "parallel")]
-mod team;
-mod work;
+mod stabilisation;
 
-pub use builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
+pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
+pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};
+pub use body::generators;
+pub use body::mesh::{Surface, Tetrahedra};
+pub use body::particles::{ExternalAcceleration, Particles};
 pub use error::{BuildError, SettingsError, StateError};
-pub use families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-pub use mesh::{Surface, Tetrahedra};
-pub use particles::{ExternalAcceleration, Particles};
-pub use solver::{Solver, SolverSettings, SubstepHook};
-pub use stacking::{project_stacked, BodyConstraints, StackingLayers};
-pub use stats::{ErrorAccumulator, ErrorStats, Family, FamilyStats, StepStats};
+pub use ordering::ColourClasses;
+pub use solver::hook::SubstepHook;
+pub use solver::settings::SolverSettings;
+pub use solver::stats::{ErrorAccumulator, ErrorStats, FamilyStats, StepStats};
+pub use solver::step::Solver;
+pub use solver::systems;
+pub use stabilisation::ground_up::{project_stacked, BodyConstraints, StackingLayers};
+
+/// The constraint math under its former name; the same module as [`constraints`].
+#[doc(hidden)]
+pub use constraints as constraint;
+#[cfg(feature = "sync-stats")]
+pub use parallel::sync_stats;
 
 pub use hecs;
 pub use nalgebra;

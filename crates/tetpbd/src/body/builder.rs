@@ -1,0 +1,453 @@
+//! Building soft bodies from vertices and tetrahedra.
+
+use hecs::{Entity, World};
+use nalgebra::Vector3;
+
+use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::body::mesh::{Surface, Tetrahedra};
+use crate::body::particles::Particles;
+use crate::constraints::{bounded_height, signed_volume, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
+use crate::error::BuildError;
+use crate::kernels::slots::{Slot, WorkCopy};
+use crate::ordering::partition::{auto_parts, longest_axis, part_order, slab_parts};
+use crate::ordering::spatial::{inverse, mean_edge_length, relabel_tets, row_order};
+
+/// A tetrahedral mesh: vertex positions (m) and tetrahedra as vertex indices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TetMesh {
+    /// Vertex positions, m.
+    pub vertices: Vec<Vector3<f32>>,
+    /// Tetrahedra, four vertex indices each, either orientation.
+    pub tets: Vec<[u32; 4]>,
+}
+
+/// A built soft body: its components, ready to be spawned as one entity.
+///
+/// Fields are the components; `None` families are simply not added.
+#[derive(Clone, Debug)]
+pub struct SoftBody {
+    /// Particle state.
+    pub particles: Particles,
+    /// Tetrahedra with rest volumes.
+    pub tetrahedra: Tetrahedra,
+    /// Boundary triangles.
+    pub surface: Surface,
+    /// Edge family, if chosen.
+    pub edges: Option<EdgeConstraints>,
+    /// Vertex–face family, if chosen.
+    pub vertex_face: Option<VertexFaceConstraints>,
+    /// Volume family, if chosen.
+    pub volume: Option<VolumeConstraints>,
+}
+
+impl SoftBody {
+    /// Spawns the body as one entity holding its components.
+    pub fn spawn(self, world: &mut World) -> Entity {
+        let mut b = hecs::EntityBuilder::new();
+        b.add(self.particles).add(self.tetrahedra).add(self.surface);
+        if let Some(e) = self.edges {
+            b.add(e);
+        }
+        if let Some(v) = self.vertex_face {
+            b.add(v);
+        }
+        if let Some(v) = self.volume {
+            b.add(v);
+        }
+        world.spawn(b.build())
+    }
+}
+
+/// Builds a [`SoftBody`] from raw vertices and tetrahedra, choosing its constraint families.
+///
+/// ```
+/// use tetpbd::{generators, SoftBodyBuilder};
+/// let mesh = generators::box_grid(nalgebra::Vector3::new(1.0, 1.0, 1.0), [2, 2, 2], generators::CellSplit::Six)?;
+/// let body = SoftBodyBuilder::new(mesh).density(1000.0).edges(0.0).volume(0.0).build()?;
+/// assert!(body.vertex_face.is_none());
+/// # Ok::<(), tetpbd::BuildError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct SoftBodyBuilder {
+    mesh: TetMesh,
+    density: f32,
+    edge: Option<f32>,
+    vertex_face: Option<f32>,
+    volume: Option<f32>,
+    pinned: Vec<u32>,
+    velocity: Vector3<f32>,
+    translation: Vector3<f32>,
+    epsilon: f32,
+    spatial_order: bool,
+    parts: usize,
+}
+
+impl SoftBodyBuilder {
+    /// Default relative volume epsilon: a tetrahedron with `|V| < 1e-6 · (longest edge)³`
+    /// is rejected as degenerate.
+    pub const DEFAULT_EPSILON: f32 = 1e-6;
+
+    /// Whether [`Self::spatial_order`] is on by default. Off: the generators already number
+    /// their vertices in rows; turn it on for meshes read from files.
+    pub const DEFAULT_SPATIAL_ORDER: bool = false;
+
+    /// Starts from a mesh. Defaults: density 1000 kg/m³, no constraint family, nothing pinned.
+    pub fn new(mesh: TetMesh) -> Self {
+        SoftBodyBuilder {
+            mesh,
+            density: 1000.0,
+            edge: None,
+            vertex_face: None,
+            volume: None,
+            pinned: Vec::new(),
+            velocity: Vector3::zeros(),
+            translation: Vector3::zeros(),
+            epsilon: Self::DEFAULT_EPSILON,
+            spatial_order: Self::DEFAULT_SPATIAL_ORDER,
+            parts: 0,
+        }
+    }
+
+    /// Starts from raw arrays.
+    pub fn from_arrays(vertices: Vec<Vector3<f32>>, tets: Vec<[u32; 4]>) -> Self {
+        Self::new(TetMesh { vertices, tets })
+    }
+
+    /// Density, kg/m³; masses are lumped as `density · |V| / 4` per tetrahedron corner.
+    pub fn density(mut self, density: f32) -> Self {
+        self.density = density;
+        self
+    }
+
+    /// Adds the edge family with compliance `alpha` (m/N; 0 = rigid).
+    pub fn edges(mut self, alpha: f32) -> Self {
+        self.edge = Some(alpha);
+        self
+    }
+
+    /// Adds the vertex–face family with compliance `alpha` (m/N).
+    pub fn vertex_face(mut self, alpha: f32) -> Self {
+        self.vertex_face = Some(alpha);
+        self
+    }
+
+    /// Adds the volume family with compliance `alpha` (m⁵/N).
+    pub fn volume(mut self, alpha: f32) -> Self {
+        self.volume = Some(alpha);
+        self
+    }
+
+    /// Pins these vertices (inverse mass 0), given as indices into the input mesh's
+    /// vertices (whatever [`Self::spatial_order`] does to the particle numbering).
+    pub fn pinned(mut self, vertices: impl IntoIterator<Item = u32>) -> Self {
+        self.pinned.extend(vertices);
+        self
+    }
+
+    /// Initial velocity of every free particle, m/s.
+    pub fn velocity(mut self, v: Vector3<f32>) -> Self {
+        self.velocity = v;
+        self
+    }
+
+    /// Moves the mesh by `t` (m) before building; rest data is translation-free.
+    pub fn translation(mut self, t: Vector3<f32>) -> Self {
+        self.translation = t;
+        self
+    }
+
+    /// Relative volume epsilon (see [`Self::DEFAULT_EPSILON`]).
+    pub fn volume_epsilon(mut self, eps: f32) -> Self {
+        self.epsilon = eps;
+        self
+    }
+
+    /// Renumbers the particles in rows of about one edge length so that particles close in space are close in memory, which speeds up the projections of
+    /// meshes whose vertex numbering is unrelated to space (mesh files). When on, particle `k`
+    /// of the built body is input vertex [`Particles::source`]`()[k]`, and
+    /// [`Particles::particle_of`] maps a vertex index to its particle. Default
+    /// [`Self::DEFAULT_SPATIAL_ORDER`].
+    pub fn spatial_order(mut self, on: bool) -> Self {
+        self.spatial_order = on;
+        self
+    }
+
+    /// Cuts the body into `parts` slabs along its longest axis for the solver's sweep order
+    /// (fewer phases per parallel sweep); 0 (the default) chooses by size (1, the plain
+    /// colour classes, below 50,000 tetrahedra). The order changes which
+    /// constraint is projected after which (so the rounding and, slightly, the convergence),
+    /// never what a step does on a given number of threads versus another.
+    pub fn parts(mut self, parts: usize) -> Self {
+        self.parts = parts;
+        self
+    }
+
+    /// Validates the input and builds the components.
+    pub fn build(self) -> Result<SoftBody, BuildError> {
+        self.check_parameters()?;
+        let SoftBodyBuilder {
+            mesh,
+            density,
+            edge,
+            vertex_face,
+            volume,
+            pinned,
+            velocity,
+            translation,
+            epsilon,
+            spatial_order,
+            parts,
+        } = self;
+        let n = mesh.vertices.len();
+        let positions: Vec<Vector3<f32>> = mesh.vertices.iter().map(|v| v + translation).collect();
+        for (i, (v, p)) in mesh.vertices.iter().zip(&positions).enumerate() {
+            if !v.iter().chain(p.iter()).all(|c| c.is_finite()) {
+                return Err(BuildError::NonFiniteVertex { vertex: i });
+            }
+        }
+        let (rest_volumes, masses) = rest_volumes_and_masses(&mesh, density, epsilon)?;
+        let inv_masses = pinned_inverse_masses(&masses, &pinned)?;
+        let velocities: Vec<Vector3<f32>> = inv_masses
+            .iter()
+            .map(|w| if *w > 0.0 { velocity } else { Vector3::zeros() })
+            .collect();
+        // Particle order (see `ordering::spatial`): particle `k` is input vertex
+        // `particle_source[k]`.
+        let (particle_source, local_tets, local_source) =
+            particle_order(&mesh.vertices, mesh.tets, spatial_order);
+        let permute = |v: Vec<Vector3<f32>>| -> Vec<Vector3<f32>> {
+            particle_source.iter().map(|&i| v[i as usize]).collect()
+        };
+        let positions = permute(positions);
+        let velocities = permute(velocities);
+        let vertices = permute(mesh.vertices);
+        let pick =
+            |v: &[f32]| -> Vec<f32> { particle_source.iter().map(|&i| v[i as usize]).collect() };
+        let (masses, inv_masses) = (pick(&masses), pick(&inv_masses));
+        let surface = Surface::from_tetrahedra(&local_tets, &vertices);
+        // Solver order for tetrahedra and edges (see `ordering::colouring` and
+        // `ordering::partition`); `source` maps back.
+        let (parts, part_of) = body_parts(&vertices, &local_tets, parts);
+        let (order, tet_classes) = part_order(&local_tets, &part_of, parts, n);
+        let tets: Vec<[u32; 4]> = order.iter().map(|&t| local_tets[t]).collect();
+        let rest_volumes: Vec<f32> = order
+            .iter()
+            .map(|&t| rest_volumes[local_source[t] as usize])
+            .collect();
+        let source: Vec<u32> = order.iter().map(|&t| local_source[t]).collect();
+        let mesh = TetMesh { vertices, tets };
+        let edges = edge.map(|alpha| edge_constraints(&mesh, &part_of, parts, alpha));
+        let vertex_face = vertex_face.map(|alpha| vertex_face_constraints(&mesh, alpha));
+        let volume = volume.map(|alpha| VolumeConstraints {
+            lambdas: vec![0.0; mesh.tets.len()],
+            compliance: alpha,
+        });
+        Ok(SoftBody {
+            particles: Particles {
+                prev_positions: positions.clone(),
+                positions,
+                velocities,
+                inv_masses,
+                masses,
+                rest_positions: mesh.vertices,
+                residuals: vec![Vector3::zeros(); n],
+                vertex_to_particle: inverse(&particle_source),
+                source: particle_source,
+                work: WorkCopy(vec![Slot::default(); n]),
+            },
+            tetrahedra: Tetrahedra {
+                indices: mesh.tets,
+                rest_volumes,
+                source,
+                classes: tet_classes,
+            },
+            surface,
+            edges,
+            vertex_face,
+            volume,
+        })
+    }
+
+    /// Checks the parameters that do not depend on the mesh's geometry.
+    fn check_parameters(&self) -> Result<(), BuildError> {
+        if self.mesh.vertices.is_empty() {
+            return Err(BuildError::NoVertices);
+        }
+        let (density, epsilon) = (self.density, self.epsilon);
+        if !(density.is_finite() && density > 0.0) {
+            return Err(BuildError::BadDensity { value: density });
+        }
+        if !(epsilon.is_finite() && epsilon >= 0.0) {
+            return Err(BuildError::BadEpsilon { value: epsilon });
+        }
+        for (family, a) in [
+            ("edge", self.edge),
+            ("vertex-face", self.vertex_face),
+            ("volume", self.volume),
+        ] {
+            if let Some(a) = a {
+                if !(a.is_finite() && a >= 0.0) {
+                    return Err(BuildError::BadCompliance { family, value: a });
+                }
+            }
+        }
+        if !self.velocity.iter().all(|c| c.is_finite()) {
+            return Err(BuildError::NonFiniteVelocity);
+        }
+        Ok(())
+    }
+}
+
+/// The particle order (`source[k]`: the input vertex of particle `k`), the tetrahedra
+/// relabelled for it and, for each, its input index: rows in space with `spatial_order`, the
+/// input order without.
+fn particle_order(
+    vertices: &[Vector3<f32>],
+    tets: Vec<[u32; 4]>,
+    spatial_order: bool,
+) -> (Vec<u32>, Vec<[u32; 4]>, Vec<u32>) {
+    if spatial_order {
+        // Rows half an edge thick: each layer of a box grid gets its own row, so a grid
+        // generator's numbering is kept.
+        let cell = 0.5 * mean_edge_length(vertices, &tets);
+        let order = row_order(vertices, cell);
+        let (tets, tet_source) = relabel_tets(&tets, &inverse(&order));
+        (order, tets, tet_source)
+    } else {
+        let identity = |len: usize| (0..len as u32).collect::<Vec<u32>>();
+        let tet_count = tets.len();
+        (identity(vertices.len()), tets, identity(tet_count))
+    }
+}
+
+/// The part count (`parts`, or chosen by size when 0) and the slab of each particle.
+fn body_parts(vertices: &[Vector3<f32>], tets: &[[u32; 4]], parts: usize) -> (usize, Vec<u32>) {
+    let (axis, extent) = longest_axis(vertices);
+    let parts = match parts {
+        0 => auto_parts(tets.len(), extent / mean_edge_length(vertices, tets)),
+        p => p,
+    };
+    (parts, slab_parts(vertices, tets, axis, parts))
+}
+
+/// The signed rest volume of every tetrahedron (in input order) and the lumped mass of every
+/// vertex (a quarter of each incident tetrahedron's mass), checking indices and degeneracy.
+fn rest_volumes_and_masses(
+    mesh: &TetMesh,
+    density: f32,
+    epsilon: f32,
+) -> Result<(Vec<f32>, Vec<f32>), BuildError> {
+    let n = mesh.vertices.len();
+    let mut rest_volumes = Vec::with_capacity(mesh.tets.len());
+    let mut masses = vec![0.0f32; n];
+    for (t, tet) in mesh.tets.iter().enumerate() {
+        for (k, &i) in tet.iter().enumerate() {
+            if i as usize >= n {
+                return Err(BuildError::IndexOutOfRange {
+                    tet: t,
+                    index: i,
+                    vertex_count: n,
+                });
+            }
+            if tet[..k].contains(&i) {
+                return Err(BuildError::RepeatedVertex { tet: t, index: i });
+            }
+        }
+        let p = tet.map(|i| mesh.vertices[i as usize]);
+        let vol = signed_volume(&p[0], &p[1], &p[2], &p[3]);
+        let mut longest = 0.0f32;
+        for a in 0..4 {
+            for b in a + 1..4 {
+                longest = longest.max((p[a] - p[b]).norm());
+            }
+        }
+        let threshold = epsilon * longest * longest * longest;
+        // NaN-safe: anything not strictly above the threshold (overflow included) is rejected.
+        if vol.abs().partial_cmp(&threshold) != Some(std::cmp::Ordering::Greater) || vol == 0.0 {
+            return Err(BuildError::DegenerateTetrahedron {
+                tet: t,
+                volume: vol,
+                threshold,
+            });
+        }
+        rest_volumes.push(vol);
+        for &i in tet {
+            masses[i as usize] += density * vol.abs() / 4.0;
+        }
+    }
+    if let Some(vertex) = masses.iter().position(|m| *m <= 0.0) {
+        return Err(BuildError::UnreferencedVertex { vertex });
+    }
+    Ok((rest_volumes, masses))
+}
+
+/// Inverse masses, 0 for the pinned vertices.
+fn pinned_inverse_masses(masses: &[f32], pinned: &[u32]) -> Result<Vec<f32>, BuildError> {
+    let mut inv_masses: Vec<f32> = masses.iter().map(|m| 1.0 / m).collect();
+    for &i in pinned {
+        match inv_masses.get_mut(i as usize) {
+            Some(w) => *w = 0.0,
+            None => {
+                return Err(BuildError::PinnedOutOfRange {
+                    index: i,
+                    vertex_count: masses.len(),
+                })
+            }
+        }
+    }
+    Ok(inv_masses)
+}
+
+/// The edge family of a built mesh (particles and tetrahedra in solver order), its edges in
+/// the solver's order for the body's parts.
+fn edge_constraints(mesh: &TetMesh, part_of: &[u32], parts: usize, alpha: f32) -> EdgeConstraints {
+    let sorted = unique_edges(&mesh.tets);
+    let (edge_order, classes) = part_order(&sorted, part_of, parts, mesh.vertices.len());
+    let list: Vec<[u32; 2]> = edge_order.iter().map(|&k| sorted[k]).collect();
+    let rest_lengths = list
+        .iter()
+        .map(|[a, b]| (mesh.vertices[*a as usize] - mesh.vertices[*b as usize]).norm())
+        .collect();
+    EdgeConstraints {
+        lambdas: vec![0.0; list.len()],
+        edges: list,
+        rest_lengths,
+        compliance: alpha,
+        classes,
+    }
+}
+
+/// The vertex–face family of a built mesh: the rest values of each tetrahedron's four
+/// constraints.
+fn vertex_face_constraints(mesh: &TetMesh, alpha: f32) -> VertexFaceConstraints {
+    VertexFaceConstraints {
+        rest_heights: mesh
+            .tets
+            .iter()
+            .map(|tet| {
+                VERTEX_FACE_ORDER.map(|o| {
+                    let [a, b, c, d] = o.map(|k| mesh.vertices[tet[k] as usize]);
+                    // The volume check guarantees a non-degenerate tetrahedron.
+                    bounded_height(&a, &b, &c, &d, VERTEX_FACE_KAPPA, 0.0).unwrap_or(0.0)
+                })
+            })
+            .collect(),
+        lambdas: vec![[0.0; 4]; mesh.tets.len()],
+        compliance: alpha,
+    }
+}
+
+/// The unique edges of `tets`, each `[low, high]`, sorted.
+pub fn unique_edges(tets: &[[u32; 4]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(tets.len() * 6);
+    for t in tets {
+        for a in 0..4 {
+            for b in a + 1..4 {
+                edges.push([t[a].min(t[b]), t[a].max(t[b])]);
+            }
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}

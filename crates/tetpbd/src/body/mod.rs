@@ -1,0 +1,13 @@
+//! Building soft bodies and the components they are made of.
+//!
+//! [`SoftBodyBuilder`](builder::SoftBodyBuilder) turns a [`TetMesh`](builder::TetMesh)
+//! (vertices and tetrahedra, from a file or a [`generators`] function) into the components of
+//! one body: [`Particles`](particles::Particles) (one flat array per quantity),
+//! [`Tetrahedra`](mesh::Tetrahedra), [`Surface`](mesh::Surface) and one optional component per
+//! constraint family ([`families`]): a body pays only for the families it has.
+
+pub(crate) mod builder;
+pub(crate) mod families;
+pub mod generators;
+pub(crate) mod mesh;
+pub(crate) mod particles;

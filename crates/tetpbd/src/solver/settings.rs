@@ -1,0 +1,117 @@
+//! Settings of the solver: time step, substeps, iterations, gravity, damping, family order
+//! and the safety options, with their units and defaults.
+
+use nalgebra::Vector3;
+
+use crate::body::families::Family;
+use crate::error::SettingsError;
+use crate::solver::systems;
+
+/// Settings of a [`Solver`](crate::Solver). Fields are public; [`SolverSettings::validate`] (called by every
+/// step) rejects bad values with a typed error before they reach the state.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct SolverSettings {
+    /// Frame time step, s (> 0).
+    pub dt: f32,
+    /// Substeps per frame (≥ 1); each has length `h = dt / substeps`.
+    pub substeps: u32,
+    /// Constraint iterations per substep (≥ 1). Macklin et al. 2019 ("Small Steps in
+    /// Physics Simulation") show that spending a budget on substeps beats iterations, so the
+    /// default is many substeps of one iteration.
+    pub iterations: u32,
+    /// Gravity, m/s².
+    pub gravity: Vector3<f32>,
+    /// Linear velocity damping, 1/s (0 = none).
+    pub damping: f32,
+    /// The order in which the families are projected in an iteration. Default: volume,
+    /// vertex–face, edge — edges last, so lengths are closest to rest at the end.
+    pub order: [Family; 3],
+    /// Safety net: the velocity a substep's projections add to a particle is clamped to this
+    /// length, m/s (positions keep their full correction). `None` = no clamp. On a body
+    /// without pinned particles, the linear and angular momentum the clamps removed are
+    /// given back as a rigid velocity change of the whole body, so the net never changes the
+    /// body's momentum; a body with pinned particles gets the per-particle clamp alone.
+    /// Cost: a compare per particle per substep, plus two serial passes over a body's
+    /// particles in substeps where it clamped one of them. See
+    /// [`systems::update_velocities`]; clamps are counted in
+    /// [`crate::StepStats::velocity_clamps`].
+    pub max_correction_speed: Option<f32>,
+    /// Remove the rigid rotation the families' corrections carry, once per iteration, so
+    /// that a free body's internal constraints conserve its angular momentum (default on).
+    /// Gauss–Seidel projections conserve it only to second order, which in a body that
+    /// cannot meet all its constraints (a tangled, self-intersecting state) is a steady
+    /// torque: undamped, such a body spins itself up from rest. Bodies with pinned
+    /// particles are left alone, as are a hook's contacts. Cost: the copy back from the
+    /// working copy also measures the corrections, plus one more pass over a free body's
+    /// particles per iteration (a few per cent of a frame); both counted in
+    /// [`crate::StepStats::spin_time`] instead of [`crate::StepStats::copy_time`].
+    pub conserve_angular_momentum: bool,
+    /// Scalar or SIMD projection kernels (default SIMD; they agree to rounding).
+    pub kernel: systems::Kernel,
+    /// Evaluate every constraint after the step to fill [`crate::FamilyStats::after`] and
+    /// [`crate::StepStats::inverted`]. Costs about one extra sweep; off by default.
+    pub measure_error: bool,
+    /// Also evaluate every constraint before the step ([`crate::FamilyStats::before`]).
+    pub measure_before: bool,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings {
+            dt: 1.0 / 60.0,
+            substeps: 10,
+            iterations: 1,
+            gravity: Vector3::new(0.0, -9.81, 0.0),
+            damping: 0.0,
+            order: Family::ALL,
+            max_correction_speed: None,
+            conserve_angular_momentum: true,
+            kernel: systems::Kernel::Simd,
+            measure_error: false,
+            measure_before: false,
+        }
+    }
+}
+
+impl SolverSettings {
+    /// Checks every field; the first bad one is returned.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(SettingsError::BadDt { value: self.dt });
+        }
+        if self.substeps == 0 {
+            return Err(SettingsError::ZeroCount { what: "substeps" });
+        }
+        if self.iterations == 0 {
+            return Err(SettingsError::ZeroCount { what: "iterations" });
+        }
+        if !self.gravity.iter().all(|g| g.is_finite()) {
+            return Err(SettingsError::NonFiniteGravity);
+        }
+        if !(self.damping.is_finite() && self.damping >= 0.0) {
+            return Err(SettingsError::BadDamping {
+                value: self.damping,
+            });
+        }
+        if let Some(v) = self.max_correction_speed {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(SettingsError::BadCorrectionSpeed { value: v });
+            }
+        }
+        let mut seen = [false; 3];
+        for f in self.order {
+            let i = f as usize;
+            if seen[i] {
+                return Err(SettingsError::BadOrder);
+            }
+            seen[i] = true;
+        }
+        Ok(())
+    }
+
+    /// Substep length `dt / substeps`, s.
+    pub fn substep_dt(&self) -> f32 {
+        self.dt / self.substeps as f32
+    }
+}

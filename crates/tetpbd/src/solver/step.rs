@@ -1,0 +1,183 @@
+//! [`Solver`]: a frame as `substeps × iterations` of the systems; [`Solver::run_step`] is
+//! where a frame and each of its substeps start.
+
+use std::time::{Duration, Instant};
+
+use hecs::World;
+
+use crate::error::SettingsError;
+use crate::kernels::working_copy::{self, CopyMode};
+use crate::solver::hook::SubstepHook;
+use crate::solver::settings::SolverSettings;
+use crate::solver::stats::StepStats;
+use crate::solver::systems;
+use crate::stabilisation::angular_momentum;
+
+/// Runs frames of the soft-body systems on a [`hecs::World`].
+///
+/// ```text
+/// for each of `substeps` substeps (h = dt / substeps):
+///     predict            x_prev ← x; v ← (v + h(g + a))·damping; x ← x + h v
+///     reset λ
+///     repeat `iterations` times:
+///         copy the particles into the projections' working copy (crate::kernels::working_copy)
+///         project families in `order` on it, remove the rigid rotation of their
+///         corrections (conserve_angular_momentum), copy back, then hook.project
+///     update velocities  v ← (x − x_prev) / h
+///     hook.end_substep
+/// ```
+#[derive(Clone, Debug, Default)]
+pub struct Solver {
+    /// The settings used by the next step.
+    pub settings: SolverSettings,
+}
+
+impl Solver {
+    /// A solver with validated settings.
+    pub fn new(settings: SolverSettings) -> Result<Solver, SettingsError> {
+        settings.validate()?;
+        Ok(Solver { settings })
+    }
+
+    /// Advances every soft body in `world` by one frame.
+    pub fn step(&mut self, world: &mut World) -> Result<StepStats, SettingsError> {
+        self.step_with(world, &mut ())
+    }
+
+    /// Advances every soft body by one frame, running `hook` inside the substep loop.
+    pub fn step_with(
+        &mut self,
+        world: &mut World,
+        hook: &mut dyn SubstepHook,
+    ) -> Result<StepStats, SettingsError> {
+        self.settings.validate()?;
+        // With the `parallel` feature and a body large enough for a parallel pass, the pool's
+        // other threads stay awake for the step (crate::parallel::team), so the passes need not wake
+        // them.
+        #[cfg(feature = "parallel")]
+        if crate::parallel::sweeps::any_parallel(world) {
+            return crate::parallel::team::with_team(|| self.run_step(world, hook));
+        }
+        self.run_step(world, hook)
+    }
+
+    /// One frame with validated settings: the frame starts here, each substep in
+    /// [`Solver::substep`].
+    fn run_step(
+        &self,
+        world: &mut World,
+        hook: &mut dyn SubstepHook,
+    ) -> Result<StepStats, SettingsError> {
+        let s = &self.settings;
+        let start = Instant::now();
+        let mut stats = StepStats {
+            substeps: s.substeps,
+            iterations: s.iterations,
+            ..StepStats::default()
+        };
+        count_constraints(world, &mut stats);
+        if s.measure_before {
+            let m = systems::measure(world);
+            stats.edge.before = Some(m.edge);
+            stats.vertex_face.before = Some(m.vertex_face);
+            stats.volume.before = Some(m.volume);
+        }
+        let h = s.substep_dt();
+        let t = Instant::now();
+        hook.begin_frame(world, s.dt);
+        let mut hook_time = t.elapsed();
+        for _ in 0..s.substeps {
+            self.substep(world, hook, h, &mut stats, &mut hook_time);
+        }
+        let t = Instant::now();
+        hook.end_frame(world, s.dt);
+        hook_time += t.elapsed();
+        stats.hook_time = hook_time;
+        if s.measure_error {
+            let t = Instant::now();
+            let m = systems::measure(world);
+            stats.edge.after = Some(m.edge);
+            stats.vertex_face.after = Some(m.vertex_face);
+            stats.volume.after = Some(m.volume);
+            stats.inverted = Some(m.inverted);
+            stats.measure_time = t.elapsed();
+        }
+        stats.total_time = start.elapsed();
+        Ok(stats)
+    }
+
+    /// One substep of length `h`: prediction, `iterations` iterations, the velocity update.
+    fn substep(
+        &self,
+        world: &mut World,
+        hook: &mut dyn SubstepHook,
+        h: f32,
+        stats: &mut StepStats,
+        hook_time: &mut Duration,
+    ) {
+        let s = &self.settings;
+        let t = Instant::now();
+        systems::predict(world, h, s.gravity, s.damping);
+        systems::reset_lambdas(world);
+        stats.predict_time += t.elapsed();
+        let t = Instant::now();
+        hook.begin_substep(world, h);
+        *hook_time += t.elapsed();
+        for _ in 0..s.iterations {
+            self.iteration(world, h, stats);
+            let t = Instant::now();
+            hook.project(world, h);
+            *hook_time += t.elapsed();
+        }
+        let t = Instant::now();
+        let u = systems::update_velocities(world, h, s.max_correction_speed);
+        stats.non_finite_resets += u.non_finite_resets;
+        stats.velocity_clamps += u.clamped;
+        stats.velocity_time += t.elapsed();
+        let t = Instant::now();
+        hook.end_substep(world, h);
+        *hook_time += t.elapsed();
+    }
+
+    /// One iteration: copy the particles into the working copy, project the families in
+    /// order, copy back (removing the corrections' rigid rotation if asked).
+    fn iteration(&self, world: &mut World, h: f32, stats: &mut StepStats) {
+        let s = &self.settings;
+        let t = Instant::now();
+        working_copy::load_bodies(world);
+        stats.copy_time += t.elapsed();
+        for family in s.order {
+            let t = Instant::now();
+            let c = systems::project_family(world, family, h, s.kernel, CopyMode::Resident);
+            let f = stats.family_mut(family);
+            f.time += t.elapsed();
+            f.projections += c.applied;
+            f.degenerate += c.degenerate;
+        }
+        let t = Instant::now();
+        if s.conserve_angular_momentum {
+            angular_momentum::store_bodies_without_spin(world);
+            stats.spin_time += t.elapsed();
+        } else {
+            working_copy::store_bodies(world);
+            stats.copy_time += t.elapsed();
+        }
+    }
+}
+
+fn count_constraints(world: &mut World, stats: &mut StepStats) {
+    use crate::{EdgeConstraints, Particles, VertexFaceConstraints, VolumeConstraints};
+    for p in world.query_mut::<&Particles>() {
+        stats.bodies += 1;
+        stats.particles += p.len();
+    }
+    for e in world.query_mut::<&EdgeConstraints>() {
+        stats.edge.count += e.len();
+    }
+    for v in world.query_mut::<&VertexFaceConstraints>() {
+        stats.vertex_face.count += v.len();
+    }
+    for v in world.query_mut::<&VolumeConstraints>() {
+        stats.volume.count += v.len();
+    }
+}

@@ -1,0 +1,155 @@
+//! The rigid fit of a field on a body's particles (centre of mass, inertia tensor,
+//! pseudo-inverse), the moments it is computed from, and the runs of particles that sum
+//! them: shared by the angular-momentum conservation and the safety net's momentum
+//! restoration, serial and parallel.
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::kernels::compensated::add_compensated;
+use crate::kernels::slots::Slot;
+
+/// Eigenvalues of the inertia tensor below this fraction of the largest count as zero.
+const INERTIA_CUTOFF: f64 = 1e-9;
+
+/// Particles per f32 block of the angular-momentum conservation's sums.
+pub(crate) const BLOCK: usize = 256;
+
+/// Mass-weighted moments of the substep starts `x̄` and corrections `Δ` of some particles.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Moments<T: nalgebra::Scalar + Copy> {
+    /// Σ m.
+    mass: T,
+    /// Σ m x̄.
+    first: Vector3<T>,
+    /// Σ m x̄ x̄ᵀ as `[xx, yy, zz, xy, xz, yz]`.
+    second: [T; 6],
+    /// Σ m x̄ × Δ.
+    torque: Vector3<T>,
+    /// Σ m Δ.
+    push: Vector3<T>,
+}
+
+impl Moments<f32> {
+    #[inline(always)]
+    fn add(&mut self, m: f32, x: Vector3<f32>, d: Vector3<f32>) {
+        let mx = x * m;
+        self.mass += m;
+        self.first += mx;
+        self.second[0] += mx.x * x.x;
+        self.second[1] += mx.y * x.y;
+        self.second[2] += mx.z * x.z;
+        self.second[3] += mx.x * x.y;
+        self.second[4] += mx.x * x.z;
+        self.second[5] += mx.y * x.z;
+        self.torque += mx.cross(&d);
+        self.push += d * m;
+    }
+}
+
+impl Moments<f64> {
+    /// Adds one block's f32 sums.
+    pub(crate) fn fold(&mut self, b: &Moments<f32>) {
+        self.mass += f64::from(b.mass);
+        self.first += b.first.cast::<f64>();
+        for k in 0..6 {
+            self.second[k] += f64::from(b.second[k]);
+        }
+        self.torque += b.torque.cast::<f64>();
+        self.push += b.push.cast::<f64>();
+    }
+
+    /// [`rigid_fit`] of the corrections these sums measured: the centre of mass and `θ`.
+    pub(crate) fn fit(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let [xx, yy, zz, xy, xz, yz] = self.second;
+        let second = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+        rigid_fit(self.mass, self.first, second, self.torque, self.push)
+    }
+}
+
+/// The rigid rotation that best fits a field `wᵢ` on particles of masses `mᵢ` at `xᵢ`,
+/// from sums about any origin: `mass = Σ mᵢ`, `first = Σ mᵢ xᵢ`, `second = Σ mᵢ xᵢ xᵢᵀ`,
+/// `moment = Σ mᵢ xᵢ × wᵢ`, `total = Σ mᵢ wᵢ`. Returns the centre of mass `c` and
+/// `θ = I⁺ Σ mᵢ rᵢ × wᵢ` with `rᵢ = xᵢ − c` and `I = Σ mᵢ(|rᵢ|²𝟙 − rᵢrᵢᵀ)` (eigenvalues
+/// below [`INERTIA_CUTOFF`] of the largest taken as zero): the least-squares `θ` of
+/// `Σ mᵢ |wᵢ − θ × rᵢ|²` for the part of `w` without its mean. `None` without mass or when
+/// not finite. Used by the spin removal (`w` the corrections) and the safety net's momentum
+/// restoration (`crate::stabilisation::momentum_restoration`, `w` the velocity the clamp removed).
+pub(crate) fn rigid_fit(
+    mass: f64,
+    first: Vector3<f64>,
+    second: Matrix3<f64>,
+    moment: Vector3<f64>,
+    total: Vector3<f64>,
+) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    if !(mass.is_finite() && mass > 0.0) {
+        return None;
+    }
+    let c = first / mass;
+    let spread = second - c * c.transpose() * mass;
+    let inertia = Matrix3::identity() * spread.trace() - spread;
+    let b = moment - c.cross(&total);
+    if !inertia.iter().chain(b.iter()).all(|x| x.is_finite()) {
+        return None;
+    }
+    let eig = inertia.symmetric_eigen();
+    let largest = eig.eigenvalues.max();
+    if !(largest.is_finite() && largest > 0.0) {
+        return None;
+    }
+    let mut theta = Vector3::zeros();
+    for k in 0..3 {
+        let l = eig.eigenvalues[k];
+        if l > largest * INERTIA_CUTOFF {
+            let u = eig.eigenvectors.column(k);
+            theta += u * (u.dot(&b) / l);
+        }
+    }
+    theta.iter().all(|v| v.is_finite()).then_some((c, theta))
+}
+/// `xᵢ += (x̄ᵢ − o − c) × θ` (compensated) for a run of particles, `[o, c]` the sums'
+/// origin and the centre of mass relative to it.
+pub(crate) fn rotate_back(
+    positions: &mut [Vector3<f32>],
+    residuals: &mut [Vector3<f32>],
+    prev_positions: &[Vector3<f32>],
+    [o, c]: [Vector3<f32>; 2],
+    theta: Vector3<f32>,
+) {
+    for ((x, r), xb) in positions.iter_mut().zip(residuals).zip(prev_positions) {
+        add_compensated(x, r, (xb - o - c).cross(&theta));
+    }
+}
+
+/// The arrays of a run of particles the measuring copy back reads and writes.
+pub(crate) struct StoreRun<'a> {
+    /// The working copy (after the families).
+    pub slots: &'a [Slot],
+    /// Positions: before the families on entry, the slots' on return, m.
+    pub positions: &'a mut [Vector3<f32>],
+    /// Rounding residuals, likewise, m.
+    pub residuals: &'a mut [Vector3<f32>],
+    /// Substep starts, m.
+    pub prev_positions: &'a [Vector3<f32>],
+    /// Lumped masses, kg.
+    pub masses: &'a [f32],
+}
+
+impl StoreRun<'_> {
+    /// Copies the slots back and returns the moments of the corrections (one block: f32,
+    /// in particle order), `x̄` taken about `o`.
+    pub(crate) fn store_measuring(self, o: Vector3<f32>) -> Moments<f32> {
+        let mut m = Moments::<f32>::default();
+        for (i, slot) in self.slots.iter().enumerate() {
+            let [a, b, c, _] = slot.xw.to_array();
+            let [ra, rb, rc, _] = slot.r.to_array();
+            let (x, r) = (Vector3::new(a, b, c), Vector3::new(ra, rb, rc));
+            // The correction as the velocity update will see it: position plus rounding
+            // residual (see `systems::add_compensated`); at rest most of it is residual.
+            let d = (x - self.positions[i]) + (r - self.residuals[i]);
+            m.add(self.masses[i], self.prev_positions[i] - o, d);
+            self.positions[i] = x;
+            self.residuals[i] = r;
+        }
+        m
+    }
+}
