@@ -218,12 +218,24 @@ fn particle_position(particles: &Particles, particle: u32) -> Result<Vector3<f32
         })
 }
 
+/// An attachment in the frame.
+#[derive(Clone, Debug)]
+pub(crate) struct AttachRun {
+    pub particle: u32,
+    pub body: Option<usize>,
+    pub local: Vector3<f32>,
+    pub start: Vector3<f32>,
+    pub end: Vector3<f32>,
+    pub compliance: f32,
+    pub lambda: f32,
+}
+
 /// One sweep over a soft body's attachments (see the module docs for the constraint).
 /// `frac` is the current substep's end time as a fraction of the frame.
 pub(crate) fn project_attachments(
-    runs: &mut [crate::frame::AttachRun],
+    runs: &mut [AttachRun],
     p: &mut Particles,
-    bodies: &mut [crate::bodies::BodyProxy],
+    bodies: &mut [crate::rigid::body::BodyProxy],
     frac: f32,
     h: f32,
 ) {
@@ -258,8 +270,8 @@ pub(crate) fn project_attachments(
 
 /// World anchor of an attachment at the current substep, m.
 pub(crate) fn anchor_of(
-    a: &crate::frame::AttachRun,
-    bodies: &[crate::bodies::BodyProxy],
+    a: &AttachRun,
+    bodies: &[crate::rigid::body::BodyProxy],
     frac: f32,
 ) -> Vector3<f32> {
     match a.body {

@@ -36,8 +36,8 @@ use rapier3d::parry::query::Ray;
 use rapier3d::parry::shape::Shape;
 
 use crate::convert::{pose_to_glam, pose_to_na, to_glam, to_na};
-use crate::frame::StartState;
-use crate::shape_query::SurfacePoint;
+use crate::rigid::body::StartState;
+use crate::rigid::shape_query::SurfacePoint;
 
 /// Lists the colliders of awake non-fixed bodies whose swept AABB over the frame reaches
 /// more than `margin` (m) beyond their AABB at the end pose, with that swept AABB.

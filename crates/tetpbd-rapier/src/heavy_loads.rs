@@ -62,10 +62,11 @@ use tetpbd::{
     Tetrahedra, VertexFaceConstraints, VolumeConstraints,
 };
 
-use crate::bodies::{BodyKind, BodyProxy};
-use crate::contact::project_contacts;
-use crate::corner::{project_corners, CornerContact, CornerPass};
-use crate::frame::{ColliderProxy, ParticleContact};
+use crate::contacts::corner::{project_corners, CornerContact, CornerPass};
+use crate::contacts::particle::project_contacts;
+use crate::contacts::particle::ParticleContact;
+use crate::rigid::body::{BodyKind, BodyProxy};
+use crate::rigid::collider::ColliderProxy;
 use nalgebra::Vector3;
 use tetpbd::systems::Kernel;
 

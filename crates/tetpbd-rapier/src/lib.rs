@@ -50,41 +50,33 @@
 //! normal for) are skipped and counted in [`CouplingStats`].
 #![warn(missing_docs)]
 
-mod attachment;
-mod bodies;
-mod contact;
-pub mod convert;
-mod corner;
-mod corner_points;
+mod attachments;
+mod ccd;
+mod contacts;
+mod convert;
 mod coupling;
-mod damping;
 mod error;
-mod frame;
-mod hook;
-mod material;
+mod gather;
+mod heavy_loads;
 mod report;
-mod restitution;
-mod rolling;
+mod response;
+mod rigid;
 mod scene;
-mod shape_query;
-mod soft_bvh;
-mod soft_contact;
-mod soft_gather;
-mod soft_project;
-mod soft_restitution;
-mod soft_separation;
-mod stacking;
-mod support;
-mod sweep;
+mod settings;
+mod soft_collider;
+mod soft_soft;
+mod substep;
 
-pub use attachment::{AttachTarget, Attachment, Attachments};
-pub use coupling::{Coupling, CouplingSettings, RapierContext};
-pub use damping::DeformationDamping;
+pub use attachments::{AttachTarget, Attachment, Attachments};
+pub use coupling::{Coupling, RapierContext};
 pub use error::CouplingError;
-pub use material::{SoftCollider, SoftColliderBuilder};
 pub use report::{ContactReport, CouplingStats, SoftFeature};
+pub use response::deformation_damping::DeformationDamping;
 pub use scene::CoupledWorld;
-pub use soft_contact::{SelfCollision, SoftContactSettings, SoftContactStats, SoftContacts};
+pub use settings::CouplingSettings;
+pub use soft_collider::{SoftCollider, SoftColliderBuilder};
+pub use soft_soft::settings::{SelfCollision, SoftContactSettings, SoftContactStats};
+pub use soft_soft::SoftContacts;
 
 pub use rapier3d;
 pub use tetpbd;

@@ -5,18 +5,20 @@ use rapier3d::geometry::NarrowPhase;
 use rapier3d::pipeline::QueryPipeline;
 use tetpbd::{Particles, SubstepHook, Surface};
 
-use crate::attachment::{anchor_of, project_attachments, Attachments};
-use crate::contact::{finish_substep, project_contacts, velocity_pass};
-use crate::corner::{project_corners, CornerPass};
-use crate::damping::{damp, DeformationDamping};
-use crate::frame::{Frame, GatherInput};
-use crate::material::SoftCollider;
+use crate::attachments::{anchor_of, project_attachments, Attachments};
+use crate::contacts::corner::{project_corners, CornerPass};
+use crate::contacts::particle::{finish_substep, project_contacts, velocity_pass};
+use crate::contacts::support::{
+    end_substep_supports, hold_supported, measure_clearance, project_supports,
+};
+use crate::gather::{Frame, GatherInput};
+use crate::heavy_loads::{stacked_velocity_pass, stacking_pass, Stacking};
 use crate::report::{ContactReport, SoftFeature};
-use crate::restitution::{com_velocity, end_episodes, restitution_pass};
-use crate::rolling::rolling_pass;
-use crate::shape_query::surface_point;
-use crate::stacking::{stacked_velocity_pass, stacking_pass, Stacking};
-use crate::support::{end_substep_supports, hold_supported, measure_clearance, project_supports};
+use crate::response::deformation_damping::{damp, DeformationDamping};
+use crate::response::restitution::{com_velocity, end_episodes, restitution_pass};
+use crate::response::rolling::rolling_pass;
+use crate::rigid::shape_query::surface_point;
+use crate::soft_collider::SoftCollider;
 
 /// Borrows the frame state and rapier's query pipeline for one soft step.
 pub(crate) struct CouplingHook<'q, 'a> {

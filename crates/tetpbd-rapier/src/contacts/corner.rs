@@ -67,16 +67,15 @@
 //! thickness and half the triangle's longest edge, contain it: the far corners of a ground
 //! cuboid are not evaluated against every soft triangle beside the particles resting on it.
 
-use nalgebra::{Isometry3, Point3, Vector3};
-use rapier3d::geometry::{Aabb, ColliderSet};
-use rapier3d::parry::bounding_volume::BoundingVolume;
-use rapier3d::parry::shape::Shape;
+use nalgebra::{Point3, Vector3};
+use rapier3d::geometry::ColliderSet;
 use tetpbd::{Particles, Surface};
 
-use crate::bodies::{BodyKind, BodyProxy};
-use crate::convert::{pose_to_glam, to_glam, to_na};
-use crate::corner_points::Corners;
-use crate::frame::{ColliderProxy, ParticleContact};
+use crate::contacts::particle::ParticleContact;
+use crate::convert::{to_glam, to_na};
+use crate::response::friction::{positional_friction, ContactStencil, Coulomb};
+use crate::rigid::body::{BodyKind, BodyProxy};
+use crate::rigid::collider::ColliderProxy;
 
 /// Cosine of the largest angle between a vertex's particle contact normal and its triangle's
 /// normal at which the particle contact still holds the collider against the triangle, so
@@ -112,117 +111,6 @@ pub(crate) struct CornerContact {
     pub beta: [f32; 3],
     pub sub_impulse: Vector3<f32>,
     pub impulse: Vector3<f32>,
-}
-
-/// Adds the corner–triangle candidates of one collider against one soft body. `corners` is
-/// scratch space (its capacity is reused across calls). `still`: the collider stands at
-/// `pose` for the whole frame (fixed), so each of its corners is only paired with the
-/// triangles it can reach (see the module docs).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn gather_corners(
-    out: &mut Vec<CornerContact>,
-    shape: &dyn Shape,
-    collider: usize,
-    collider_aabb: &Aabb,
-    pose: &Isometry3<f32>,
-    still: bool,
-    p: &Particles,
-    surface: &Surface,
-    dt: f32,
-    thickness: f32,
-    (mu_d, mu_s, restitution): (f32, f32, f32),
-    vertex_contacts: &[(u32, usize)],
-    corners: &mut Corners,
-) {
-    // The soft body's surface over the frame, in the collider's frame (at its end pose).
-    let mut lo = Vector3::repeat(f32::INFINITY);
-    let mut hi = Vector3::repeat(f32::NEG_INFINITY);
-    for &i in surface.vertices() {
-        let x = p.positions()[i as usize];
-        let y = x + p.velocities()[i as usize] * dt;
-        lo = lo.inf(&x.inf(&y));
-        hi = hi.sup(&x.sup(&y));
-    }
-    let near = Aabb::new(to_glam(&lo), to_glam(&hi))
-        .loosened(thickness)
-        .transform_by(&pose_to_glam(&pose.inverse()));
-    corners.fill(shape, &near);
-    // No corners: the support point of a shape with a support map, as the single `None`.
-    let count = if !corners.points.is_empty() {
-        corners.points.len()
-    } else if shape.as_support_map().is_some() && !corners.from_mesh {
-        1
-    } else {
-        return;
-    };
-    let max_extra = corners.points.iter().map(|c| c.1).fold(0.0f32, f32::max);
-    let reach = thickness + max_extra;
-    let first = out.len();
-    for (t, tri) in surface.triangles().iter().enumerate() {
-        let mut lo = Vector3::repeat(f32::INFINITY);
-        let mut hi = Vector3::repeat(f32::NEG_INFINITY);
-        for &i in tri {
-            let x = p.positions()[i as usize];
-            let y = x + p.velocities()[i as usize] * dt;
-            lo = lo.inf(&x.inf(&y));
-            hi = hi.sup(&x.sup(&y));
-        }
-        let ta = Aabb::new(to_glam(&lo), to_glam(&hi)).loosened(reach);
-        if !ta.intersects(collider_aabb) {
-            continue;
-        }
-        // A still corner is caught only in front of the triangle or less than half its
-        // shortest edge behind it, with its projection inside it.
-        let [a, b, c] = tri.map(|i| p.positions()[i as usize]);
-        let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
-        let reachable = ta.loosened(0.5 * longest);
-        let vc = tri.map(|i| {
-            vertex_contacts
-                .binary_search_by_key(&i, |(p, _)| *p)
-                .ok()
-                .map(|k| vertex_contacts[k].1)
-        });
-        for j in 0..count {
-            let (corner, extra) = match corners.points.get(j) {
-                Some(&(c, r)) => (Some(c), r),
-                None => (None, 0.0),
-            };
-            // A mesh vertex only with the soft triangles near it, a still corner only with
-            // those it can reach.
-            let world = corner.map(|c| to_glam(&(pose * Point3::from(c)).coords));
-            if world.is_some_and(|w| {
-                (corners.from_mesh && !ta.contains_local_point(w))
-                    || (still && !reachable.contains_local_point(w))
-            }) {
-                continue;
-            }
-            out.push(CornerContact {
-                collider,
-                run: 0,
-                corner,
-                triangle: t as u32,
-                vertex_contacts: vc,
-                thickness: thickness + extra,
-                restitution,
-                active: false,
-                mu_d,
-                mu_s,
-                lambda_n: 0.0,
-                lambda_t: 0.0,
-                ever_active: false,
-                depth: 0.0,
-                normal: Vector3::zeros(),
-                point: Vector3::zeros(),
-                beta: [0.0; 3],
-                sub_impulse: Vector3::zeros(),
-                impulse: Vector3::zeros(),
-            });
-        }
-    }
-    let run = out.len() - first;
-    if let Some(k) = out.get_mut(first) {
-        k.run = u32::try_from(run).unwrap_or(u32::MAX);
-    }
 }
 
 /// Which rigid points a sweep over the corner contacts projects.
@@ -458,9 +346,56 @@ fn is_fast(
     })
 }
 
-/// Coulomb friction between the rigid point `v` and the triangle (as for particles, see
-/// [`crate::contact`]): the relative tangential motion over the substep is removed while
-/// the tangential multiplier stays under `μ_s λ_n`, else limited to `μ_d λ_n`.
+/// A rigid point `v` (first side) against a soft triangle's point with barycentric weights
+/// `beta` (second side), for friction.
+struct PointOnTriangle<'s> {
+    p: &'s mut Particles,
+    idx: [usize; 3],
+    beta: [f32; 3],
+    bodies: &'s mut [BodyProxy],
+    body: Option<usize>,
+    v: Vector3<f32>,
+}
+
+impl ContactStencil for PointOnTriangle<'_> {
+    fn relative_motion(&self) -> Vector3<f32> {
+        let (p, idx, beta) = (&*self.p, self.idx, self.beta);
+        let tri_motion: Vector3<f32> = (0..3)
+            .map(|j| (p.positions()[idx[j]] - p.prev_positions()[idx[j]]) * beta[j])
+            .sum();
+        let body_motion = self.body.map_or(Vector3::zeros(), |b| {
+            let rb = &self.bodies[b];
+            let local = rb.pose.inverse_transform_point(&Point3::from(self.v));
+            (rb.pose * local).coords - (rb.prev * local).coords
+        });
+        body_motion - tri_motion
+    }
+
+    fn inv_mass(&self, t: &Vector3<f32>) -> f32 {
+        let w = self.idx.map(|i| self.p.inv_masses()[i]);
+        let w_body = self
+            .body
+            .map_or(0.0, |b| self.bodies[b].inv_mass_at(&self.v, t));
+        (0..3)
+            .map(|j| w[j] * self.beta[j] * self.beta[j])
+            .sum::<f32>()
+            + w_body
+    }
+
+    fn apply(&mut self, t: &Vector3<f32>, dl: f32) {
+        let w = self.idx.map(|i| self.p.inv_masses()[i]);
+        let x = self.p.positions_mut();
+        for j in 0..3 {
+            x[self.idx[j]] += t * (w[j] * self.beta[j] * dl);
+        }
+        if let Some(b) = self.body {
+            self.bodies[b].apply_position_impulse(&(-t * dl), &self.v);
+        }
+    }
+}
+
+/// Coulomb friction between the rigid point `v` and the triangle
+/// ([`crate::response::friction`]).
 #[allow(clippy::too_many_arguments)]
 fn friction(
     k: &mut CornerContact,
@@ -472,43 +407,20 @@ fn friction(
     v: &Vector3<f32>,
     n: &Vector3<f32>,
 ) {
-    let tri_motion: Vector3<f32> = (0..3)
-        .map(|j| (p.positions()[idx[j]] - p.prev_positions()[idx[j]]) * beta[j])
-        .sum();
-    let body_motion = body.map_or(Vector3::zeros(), |b| {
-        let rb = &bodies[b];
-        let local = rb.pose.inverse_transform_point(&Point3::from(*v));
-        (rb.pose * local).coords - (rb.prev * local).coords
-    });
-    let d = body_motion - tri_motion;
-    let dt = d - n * n.dot(&d);
-    let len = dt.norm();
-    if len.is_nan() || len <= 1e-9 {
-        return;
-    }
-    let t = dt / len;
-    let w = idx.map(|i| p.inv_masses()[i]);
-    let w_body = body.map_or(0.0, |b| bodies[b].inv_mass_at(v, &t));
-    let denom: f32 = (0..3).map(|j| w[j] * beta[j] * beta[j]).sum::<f32>() + w_body;
-    if denom.is_nan() || denom <= 0.0 {
-        return;
-    }
-    let full = len / denom;
-    let applied = if k.lambda_t + full <= k.mu_s * k.lambda_n {
-        full
-    } else {
-        full.min((k.mu_d * k.lambda_n - k.lambda_t).max(0.0))
+    let mut stencil = PointOnTriangle {
+        p,
+        idx,
+        beta,
+        bodies,
+        body,
+        v: *v,
     };
-    if applied <= 0.0 {
-        return;
+    let coulomb = Coulomb {
+        lambda_n: k.lambda_n,
+        mu_s: k.mu_s,
+        mu_d: k.mu_d,
+    };
+    if let Some((t, dl)) = positional_friction(&mut stencil, n, coulomb, &mut k.lambda_t) {
+        k.sub_impulse += t * dl;
     }
-    let x = p.positions_mut();
-    for j in 0..3 {
-        x[idx[j]] += t * (w[j] * beta[j] * applied);
-    }
-    if let Some(b) = body {
-        bodies[b].apply_position_impulse(&(-t * applied), v);
-    }
-    k.lambda_t += applied;
-    k.sub_impulse += t * applied;
 }

@@ -28,18 +28,48 @@
 //! allowance.
 //!
 //! The velocity pass then removes the separating normal velocity the projection gave each
-//! contact particle; restitution is applied to the whole body by [`crate::restitution`],
-//! rolling resistance by [`crate::rolling`] (sticking friction alone lets a rounded body
+//! contact particle; restitution is applied to the whole body by [`crate::response::restitution`],
+//! rolling resistance by [`crate::response::rolling`] (sticking friction alone lets a rounded body
 //! roll and rock without loss).
 
 use nalgebra::{Point3, Vector3};
 use rapier3d::geometry::ColliderSet;
 use tetpbd::Particles;
 
-use crate::bodies::{BodyKind, BodyProxy};
-use crate::frame::{ColliderProxy, ParticleContact};
-use crate::shape_query::surface_point;
-use crate::sweep::swept_entry;
+use crate::ccd::swept_entry;
+use crate::response::friction::{positional_friction, ContactStencil, Coulomb};
+use crate::rigid::body::{BodyKind, BodyProxy};
+use crate::rigid::collider::ColliderProxy;
+use crate::rigid::shape_query::surface_point;
+
+/// A surface particle near a collider: an XPBD inequality contact re-evaluated every
+/// iteration of every substep.
+#[derive(Clone, Debug)]
+pub(crate) struct ParticleContact {
+    pub particle: u32,
+    pub collider: usize,
+    pub mu_d: f32,
+    pub mu_s: f32,
+    pub restitution: f32,
+    pub thickness: f32,
+    pub solve: bool,
+    pub lambda_n: f32,
+    pub lambda_t: f32,
+    pub active: bool,
+    pub ever_active: bool,
+    pub has_normal: bool,
+    pub normal: Vector3<f32>,
+    pub point: Vector3<f32>,
+    pub depth: f32,
+    /// Penetration tolerated in this substep (pre-existing overlap beyond one substep's
+    /// allowed push-out), m; see `CouplingSettings::max_depenetration_speed`.
+    pub allowance: f32,
+    /// Whether `allowance` was decided: at the contact's first evaluation in the frame, or
+    /// at gathering for a pair already touching in the previous frame (no allowance).
+    pub allowance_fresh: bool,
+    pub sub_impulse: Vector3<f32>,
+    pub impulse: Vector3<f32>,
+}
 
 /// One sweep over a soft body's particle contacts. Returns the number of degenerate
 /// evaluations (no usable normal).
@@ -122,6 +152,48 @@ pub(crate) fn project_contacts(
     degenerate
 }
 
+/// A particle against a collider's material point `q`, for friction.
+struct ParticleOnCollider<'s> {
+    p: &'s mut Particles,
+    i: usize,
+    bodies: &'s mut [BodyProxy],
+    body: Option<usize>,
+    q: Vector3<f32>,
+}
+
+impl ContactStencil for ParticleOnCollider<'_> {
+    fn relative_motion(&self) -> Vector3<f32> {
+        let x = self.p.positions()[self.i];
+        let x_prev = self.p.prev_positions()[self.i];
+        let body_motion = match self.body {
+            Some(b) => {
+                let body = &self.bodies[b];
+                let local = body.pose.inverse_transform_point(&Point3::from(self.q));
+                (body.pose * local).coords - (body.prev * local).coords
+            }
+            None => Vector3::zeros(),
+        };
+        (x - x_prev) - body_motion
+    }
+
+    fn inv_mass(&self, t: &Vector3<f32>) -> f32 {
+        let w_p = self.p.inv_masses()[self.i];
+        let w_b = self
+            .body
+            .map_or(0.0, |b| self.bodies[b].inv_mass_at(&self.q, t));
+        w_p + w_b
+    }
+
+    fn apply(&mut self, t: &Vector3<f32>, dl: f32) {
+        let w_p = self.p.inv_masses()[self.i];
+        self.p.positions_mut()[self.i] -= t * (w_p * dl);
+        if let Some(b) = self.body {
+            self.bodies[b].apply_position_impulse(&(t * dl), &self.q);
+        }
+    }
+}
+
+/// Coulomb friction of a particle contact just projected ([`crate::response::friction`]).
 fn friction(
     c: &mut ParticleContact,
     p: &mut Particles,
@@ -130,50 +202,27 @@ fn friction(
     q: &Vector3<f32>,
     n: &Vector3<f32>,
 ) {
-    let i = c.particle as usize;
-    let x = p.positions()[i];
-    let x_prev = p.prev_positions()[i];
-    let body_motion = match cp.body {
-        Some(b) => {
-            let body = &bodies[b];
-            let local = body.pose.inverse_transform_point(&Point3::from(*q));
-            (body.pose * local).coords - (body.prev * local).coords
-        }
-        None => Vector3::zeros(),
+    let mut stencil = ParticleOnCollider {
+        p,
+        i: c.particle as usize,
+        bodies,
+        body: cp.body,
+        q: *q,
     };
-    let dp = (x - x_prev) - body_motion;
-    let dpt = dp - n * n.dot(&dp);
-    let len = dpt.norm();
-    if len.is_nan() || len <= 1e-9 {
-        return;
-    }
-    let t = dpt / len;
-    let w_p = p.inv_masses()[i];
-    let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_at(q, &t));
-    if (w_p + w_b).is_nan() || w_p + w_b <= 0.0 {
-        return;
-    }
-    let full = len / (w_p + w_b);
-    let applied = if c.lambda_t + full <= c.mu_s * c.lambda_n {
-        full
-    } else {
-        full.min((c.mu_d * c.lambda_n - c.lambda_t).max(0.0))
+    let coulomb = Coulomb {
+        lambda_n: c.lambda_n,
+        mu_s: c.mu_s,
+        mu_d: c.mu_d,
     };
-    if applied <= 0.0 {
-        return;
+    if let Some((t, dl)) = positional_friction(&mut stencil, n, coulomb, &mut c.lambda_t) {
+        c.sub_impulse -= t * dl;
     }
-    p.positions_mut()[i] -= t * (w_p * applied);
-    if let Some(b) = cp.body {
-        bodies[b].apply_position_impulse(&(t * applied), q);
-    }
-    c.lambda_t += applied;
-    c.sub_impulse -= t * applied;
 }
 
 /// Velocity pass after a substep, per particle: the relative normal velocity of every
 /// contact active in the substep is set to zero (Müller et al. 2020 with `e = 0`), which
 /// removes the separating velocity the position projection created. Restitution itself
-/// acts on the whole body (see [`crate::restitution`]).
+/// acts on the whole body (see [`crate::response::restitution`]).
 pub(crate) fn velocity_pass(
     contacts: &mut [ParticleContact],
     p: &mut Particles,

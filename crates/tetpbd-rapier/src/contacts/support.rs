@@ -77,8 +77,8 @@ use nalgebra::{Point3, Vector3};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{ColliderSet, NarrowPhase};
 
-use crate::bodies::BodyProxy;
 use crate::convert::{pose_to_na, to_glam, to_na};
+use crate::rigid::body::BodyProxy;
 
 /// One contact point of an anchored body with a rigid support.
 #[derive(Clone, Debug)]

@@ -28,9 +28,10 @@ use nalgebra::Vector3;
 use rapier3d::geometry::ColliderHandle;
 use tetpbd::Particles;
 
-use crate::bodies::BodyProxy;
-use crate::corner::CornerContact;
-use crate::frame::{ColliderProxy, ParticleContact};
+use crate::contacts::corner::CornerContact;
+use crate::contacts::particle::ParticleContact;
+use crate::rigid::body::BodyProxy;
+use crate::rigid::collider::ColliderProxy;
 
 /// One impact episode of a (soft body, collider) pair.
 #[derive(Clone, Copy, Debug, PartialEq)]

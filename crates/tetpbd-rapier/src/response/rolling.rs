@@ -48,11 +48,12 @@
 use nalgebra::Vector3;
 use tetpbd::Particles;
 
-use crate::bodies::BodyProxy;
-use crate::corner::CornerContact;
-use crate::damping::RigidFit;
-use crate::frame::{ColliderProxy, ParticleContact};
-use crate::restitution::active_colliders;
+use crate::contacts::corner::CornerContact;
+use crate::contacts::particle::ParticleContact;
+use crate::response::deformation_damping::RigidFit;
+use crate::response::restitution::active_colliders;
+use crate::rigid::body::BodyProxy;
+use crate::rigid::collider::ColliderProxy;
 
 /// Applies the rolling resistance of one soft body for a substep of length `h`. `active` is
 /// scratch space (its capacity is reused).

@@ -28,6 +28,9 @@ use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
 
 use crate::convert::{inertia_to_na, pose_to_glam, to_glam, to_na};
 
+/// A body's pose (m, rad) and linear velocity (m/s) before rapier's step.
+pub(crate) type StartState = (Isometry3<f32>, Vector3<f32>);
+
 /// Clearance (m) up to which an anchored body stands on its supports.
 const TOUCH: f32 = 1e-6;
 

@@ -8,28 +8,10 @@ use rapier3d::parry::bounding_volume::Aabb;
 use tetpbd::{Particles, Surface, Tetrahedra};
 
 use crate::convert::{finite3, to_glam};
-use crate::soft_bvh::{triangle_normal, BodyCache};
-use crate::soft_contact::{SelfCollision, SoftContactSettings, SoftContactStats};
-use crate::soft_separation::{Separation, Side};
-
-/// A soft body taking part in the frame; its surface particles occupy the slots
-/// `offset..offset + len` of the [`ContactFrame`] arrays.
-#[derive(Clone, Debug)]
-pub(crate) struct FrameBody {
-    pub entity: Entity,
-    pub cache: usize,
-    pub offset: usize,
-    pub len: usize,
-    /// Surface AABB at the frame start grown by each particle's motion bound, m.
-    pub lo: Vector3<f32>,
-    pub hi: Vector3<f32>,
-    pub self_collide: bool,
-    /// Inverse of the body's mass, 1/kg; 0 when a particle is pinned (the body is not
-    /// shifted by deep-overlap separation).
-    pub inv_mass: f32,
-    /// `true` when some candidate refers to the body's slots.
-    pub involved: bool,
-}
+use crate::soft_soft::body::FrameBody;
+use crate::soft_soft::bvh::{triangle_normal, BodyCache};
+use crate::soft_soft::separation::{Separation, Side};
+use crate::soft_soft::settings::{SelfCollision, SoftContactSettings, SoftContactStats};
 
 /// A particle–triangle contact candidate (slot indices).
 #[derive(Clone, Debug)]
@@ -37,7 +19,7 @@ pub(crate) struct Candidate {
     pub p: u32,
     pub tri: [u32; 3],
     /// Deep particle (inside the other body at the frame start): not projected, resolved by
-    /// [`crate::soft_separation`].
+    /// [`crate::soft_soft::separation`].
     pub recovery: bool,
     /// Largest depth behind the triangle at which a regular candidate is active, m.
     pub depth_limit: f32,

@@ -8,9 +8,10 @@ use nalgebra::Vector3;
 use tetpbd::Particles;
 
 use crate::convert::finite3;
-use crate::soft_bvh::{closest_barycentric, plane_barycentric, triangle_normal};
-use crate::soft_contact::{SoftContactSettings, SoftContactStats};
-use crate::soft_gather::{Candidate, ContactFrame, Gather};
+use crate::response::friction::{positional_friction, ContactStencil, Coulomb};
+use crate::soft_soft::bvh::{closest_barycentric, plane_barycentric, triangle_normal};
+use crate::soft_soft::gather::{Candidate, ContactFrame, Gather};
+use crate::soft_soft::settings::{SoftContactSettings, SoftContactStats};
 
 /// How far (in barycentric units) a particle's projection may lie outside a triangle and
 /// still count as inside its prism: rounding only. A wider band lets a face catch particles
@@ -354,9 +355,39 @@ fn contact_target(d_prev: f32, thickness: f32, step: f32, skin_step: f32) -> f32
     out_of_depth.max(through_skin)
 }
 
-/// Positional Coulomb friction of one contact just projected (Müller et al. 2020): the
-/// relative tangential displacement of the particle against its triangle point over the
-/// substep is removed while `λ_t` stays under `μ_s λ_n`, else by at most `μ_d λ_n − λ_t`.
+/// A particle (first side) against its triangle's point at barycentrics `bary` (second
+/// side), for friction; `wsum` is the contact's `w_p + Σ β² w` from its projection.
+struct ParticleOnTriangle<'s> {
+    x: &'s mut [Vector3<f32>],
+    x_prev: &'s [Vector3<f32>],
+    w: &'s [f32],
+    p: usize,
+    tri: [usize; 3],
+    bary: [f32; 3],
+    wsum: f32,
+}
+
+impl ContactStencil for ParticleOnTriangle<'_> {
+    fn relative_motion(&self) -> Vector3<f32> {
+        let (x, x_prev, tri, bary) = (&*self.x, self.x_prev, self.tri, self.bary);
+        let dq: Vector3<f32> = (0..3).map(|k| (x[tri[k]] - x_prev[tri[k]]) * bary[k]).sum();
+        (x[self.p] - x_prev[self.p]) - dq
+    }
+
+    fn inv_mass(&self, _t: &Vector3<f32>) -> f32 {
+        self.wsum
+    }
+
+    fn apply(&mut self, t: &Vector3<f32>, dl: f32) {
+        let (w, tri) = (self.w, self.tri);
+        self.x[self.p] -= t * (w[self.p] * dl);
+        for k in 0..3 {
+            self.x[tri[k]] += t * (w[tri[k]] * self.bary[k] * dl);
+        }
+    }
+}
+
+/// Coulomb friction of one contact just projected ([`crate::response::friction`]).
 fn friction(
     c: &mut Candidate,
     x: &mut [Vector3<f32>],
@@ -364,31 +395,21 @@ fn friction(
     w: &[f32],
     s: &SoftContactSettings,
 ) {
-    let p = c.p as usize;
-    let tri = c.tri.map(|i| i as usize);
-    let (n, bary) = (c.n, c.bary);
-    let dq: Vector3<f32> = (0..3).map(|k| (x[tri[k]] - x_prev[tri[k]]) * bary[k]).sum();
-    let dp = (x[p] - x_prev[p]) - dq;
-    let dpt = dp - n * n.dot(&dp);
-    let len = dpt.norm();
-    if len.is_nan() || len <= 1e-9 || !len.is_finite() {
-        return;
-    }
-    let dir = dpt / len;
-    let full = len / c.wsum;
-    let applied = if c.lambda_t + full <= s.static_friction * c.lambda_n {
-        full
-    } else {
-        full.min((s.dynamic_friction * c.lambda_n - c.lambda_t).max(0.0))
+    let mut stencil = ParticleOnTriangle {
+        x,
+        x_prev,
+        w,
+        p: c.p as usize,
+        tri: c.tri.map(|i| i as usize),
+        bary: c.bary,
+        wsum: c.wsum,
     };
-    if applied.is_nan() || applied <= 0.0 || !applied.is_finite() {
-        return;
-    }
-    x[p] -= dir * (w[p] * applied);
-    for k in 0..3 {
-        x[tri[k]] += dir * (w[tri[k]] * bary[k] * applied);
-    }
-    c.lambda_t += applied;
+    let coulomb = Coulomb {
+        lambda_n: c.lambda_n,
+        mu_s: s.static_friction,
+        mu_d: s.dynamic_friction,
+    };
+    positional_friction(&mut stencil, &c.n, coulomb, &mut c.lambda_t);
 }
 
 #[cfg(test)]

@@ -23,7 +23,7 @@ use hecs::World;
 use nalgebra::Vector3;
 use tetpbd::Particles;
 
-use crate::soft_gather::{ContactFrame, Gather};
+use crate::soft_soft::gather::{ContactFrame, Gather};
 
 /// Applies the body-level restitution pass after a substep; `sums` is scratch.
 pub(crate) fn body_restitution(

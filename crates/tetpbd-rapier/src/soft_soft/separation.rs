@@ -32,9 +32,9 @@ use hecs::World;
 use nalgebra::Vector3;
 use tetpbd::Particles;
 
-use crate::soft_bvh::BodyCache;
-use crate::soft_contact::{SoftContactSettings, SoftContactStats};
-use crate::soft_gather::FrameBody;
+use crate::soft_soft::body::FrameBody;
+use crate::soft_soft::bvh::BodyCache;
+use crate::soft_soft::settings::{SoftContactSettings, SoftContactStats};
 
 /// A body pair with deep particles, and its separation budget for the frame.
 #[derive(Clone, Debug)]
