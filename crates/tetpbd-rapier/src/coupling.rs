@@ -169,12 +169,12 @@ impl<'a> RapierContext<'a> {
 /// * Gauss–Seidel with one iteration per substep carries large mass ratios poorly. A heavy
 ///   rigid body on a soft body resting on an immovable support is carried by the stacking
 ///   pass (a 1000 kg box on a 1 kg slab at 10 substeps × 1 iteration,
-///   `tests/collision_mass_ratio.rs`); one on a soft body that rests on nothing immovable
+///   `crates/tetpbd-rapier/tests/collision_mass_ratio.rs`); one on a soft body that rests on nothing immovable
 ///   (on another dynamic body, or in free flight) is not. The heavy body rests on the soft
 ///   surface as on a frozen one (step 3 of the pass), so a very compliant soft body is
 ///   squashed less under it than a converged solve would squash it. On a slender soft
 ///   column (a 1000 kg box on a 1 kg column 0.6 m wide and 16 cells tall) the box is held
-///   but rocks at up to 0.5 m/s after 3 s (`tests/issue_6_stacking_deep_bodies.rs`). The
+///   but rocks at up to 0.5 m/s after 3 s (`crates/tetpbd-rapier/tests/heavy_box_on_deep_soft_bodies.rs`). The
 ///   pass costs about one more sweep over the whole soft body per iteration (SIMD lanes;
 ///   `tetpbd-bench --bin stacking`).
 /// * A heavy soft body on a stack of supported rigid bodies keeps a small rocking motion
@@ -353,7 +353,7 @@ impl Coupling {
 /// call either: it stays a frame of its own in backtraces and profiles, with everything
 /// below it rapier's (`PhysicsPipeline::step` itself is a thin wrapper that optimised builds
 /// inline or turn into a jump, so its own name can be missing from a release backtrace).
-/// `tests/no_alloc_coupled.rs` excuses rapier's allocations by this frame: keep it to the
+/// `crates/tetpbd-rapier/tests/no_alloc_coupled.rs` excuses rapier's allocations by this frame: keep it to the
 /// call of rapier's step.
 #[inline(never)]
 fn step_rapier(ctx: &mut RapierContext<'_>) -> Duration {

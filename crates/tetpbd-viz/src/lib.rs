@@ -35,6 +35,7 @@
 mod camera;
 mod error;
 mod export;
+mod glam;
 mod mesh;
 mod options;
 mod png_out;

@@ -1,9 +1,9 @@
 //! Rapier collider shapes → triangles, through parry's `to_trimesh` tessellations.
 
+use crate::glam::{pose_to_na, to_na};
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::parry::shape::{Shape, SupportMap, TypedShape};
-use tetpbd_rapier::convert::{pose_to_na, to_na};
 
 use crate::mesh::TriangleMesh;
 

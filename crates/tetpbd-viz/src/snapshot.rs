@@ -1,10 +1,10 @@
 //! [`Snapshot`]: the triangles of one frame of a scene (soft surfaces and rigid colliders), and
 //! [`SceneView`], what a scene lends to take one.
 
+use crate::glam::pose_to_na;
 use hecs::World;
 use rapier3d::prelude::{ColliderSet, RigidBodySet};
 use tetpbd::{Particles, Surface};
-use tetpbd_rapier::convert::pose_to_na;
 use tetpbd_rapier::CoupledWorld;
 
 use crate::mesh::TriangleMesh;

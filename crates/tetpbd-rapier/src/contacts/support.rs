@@ -40,7 +40,7 @@
 //! off its supports is pushed back down by the soft body it lifts, rather than staying
 //! immovable against it while the attachment moves it up. That rule (pressing impulses
 //! never moving the body, whatever its pose) let the light box of scene a of
-//! `tests/issue_3_attachment_with_contacts.rs` with a compliant attachment (1e-5 m/N, a
+//! `crates/tetpbd-rapier/tests/attachment_to_body_with_contacts.rs` with a compliant attachment (1e-5 m/N, a
 //! 100 kg soft cube) do work on the cube each time the spring lifted it (+10–60 J per
 //! frame) and diverge within 2 s. The friction cone decides from the load alone, whether
 //! the soft side moved: a soft body pulling an anchored box sideways harder than its
@@ -63,7 +63,7 @@
 //! is that of the whole body, not of each contact, and ignores the body's weight; the
 //! moment of the load is not looked at (a held body does not tip).
 //!
-//! Measured on scene a (`tests/issue_3_attachment_with_contacts.rs`) with the soft cube
+//! Measured on scene a (`crates/tetpbd-rapier/tests/attachment_to_body_with_contacts.rs`) with the soft cube
 //! moved by up to 3 mm sideways: with the rigid pin (100 and 1000 kg) every run stays in
 //! place (box drift ≤ 0.2 mm). With the 1e-5 m/N attachment, over 28 shifts (−3 to 3 mm
 //! along x, −2 to 3 mm along z), the cube stays on the box, its particles below 0.42 m/s

@@ -200,7 +200,7 @@ impl BodyProxy {
     /// contact normal (towards the body), `friction` their smallest friction coefficient.
     /// It is written back every frame, which also keeps rapier from putting it to sleep:
     /// left at rapier's result in a frame where the soft body only pressed it into its
-    /// supports, the scene of `tests/issue_3_attachment_with_contacts.rs` (a) diverged
+    /// supports, the scene of `crates/tetpbd-rapier/tests/attachment_to_body_with_contacts.rs` (a) diverged
     /// after about 2 s.
     pub fn anchor(&mut self, normal: Vector3<f32>, friction: f32) {
         if self.kind == BodyKind::Supported {

@@ -2,6 +2,7 @@
 
 mod coupling_common;
 
+use coupling_common::to_na;
 use coupling_common::{particles, scene};
 use hecs::Entity;
 use nalgebra::Vector3;
@@ -9,7 +10,6 @@ use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RevoluteJointBuilder, RigidBodyBuilder, RigidBodyHandle};
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
-use tetpbd_rapier::convert::to_na;
 use tetpbd_rapier::{Attachments, CoupledWorld, CouplingError, CouplingSettings};
 
 /// A 0.6 m beam along +x from `root`, 6×1×1 cells, 0.1 m wide, `density` kg/m³, its root

@@ -2,11 +2,11 @@
 
 mod coupling_common;
 
+use coupling_common::to_na;
 use coupling_common::{particles, scene, soft_ball};
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
-use tetpbd_rapier::convert::to_na;
 use tetpbd_rapier::SoftCollider;
 
 #[test]

@@ -3,13 +3,13 @@
 
 mod coupling_common;
 
+use coupling_common::to_na;
 use coupling_common::{ground, soft_box_with_density};
 use hecs::Entity;
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
 use tetpbd::{Particles, Tetrahedra};
-use tetpbd_rapier::convert::to_na;
 use tetpbd_rapier::{AttachTarget, Attachments, CoupledWorld, SoftCollider};
 
 /// A scene at 60 Hz with 10 substeps and the ground cuboid (top face at y = 0).
@@ -113,7 +113,7 @@ fn sample(
     anchor_local: Vector3<f32>,
 ) -> Sample {
     let rb = &scene.physics.bodies[body];
-    let pose = tetpbd_rapier::convert::pose_to_na(rb.position());
+    let pose = coupling_common::pose_to_na(rb.position());
     let mut particle_speed = 0.0f32;
     let mut finite = true;
     let mut inverted = 0;
