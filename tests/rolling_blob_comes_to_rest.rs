@@ -1,9 +1,9 @@
-//! Issues 3 and 6: a rounded soft body dropped on fixed ground comes to rest instead of
-//! rocking on its belly.
+//! A rounded soft body dropped on fixed ground comes to rest instead of rocking on its
+//! belly.
 //!
 //! A blob stiff enough to roll like a rigid body rocks with sticking friction, which does no
 //! work; deformation damping only damps deformation. Without rolling resistance the
-//! `bunny_blob` asset still rocked at 0.03–0.07 m/s after 10 s; with a rolling resistance
+//! `bunny_blob` asset keeps rocking; with a rolling resistance
 //! of 0.01 ([`tetpbd_rapier::SoftColliderBuilder::rolling_resistance`], off by default) it
 //! rests within a few seconds (the `Coupling` docs of `tetpbd-rapier`).
 

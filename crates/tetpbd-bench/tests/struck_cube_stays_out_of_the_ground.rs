@@ -1,13 +1,10 @@
-//! Issue 6: in the pile of nine cubes (`ContactScene::pile`, rapier's `fem_bench` jelly pile)
-//! at 80 substeps with `DeformationDamping` 5/s and the self-weight sweep, a cube struck by
-//! another was pressed 15 cm into the ground at frames 56–58, and the push-out launched both
-//! at 60–160 m/s. Cause: a particle was a ground contact candidate for a frame only if its
-//! own path over the frame (position plus velocity × dt at the frame's start) came within the
-//! margin of the collider; a slow particle of a body being struck was left out and sank
-//! through the ground for the rest of the frame. Candidates now take the body's fastest
-//! particle into account (`tetpbd-rapier`, `frame.rs`). The test replays the scene's first
-//! 60 frames (about 1 s): it fails without the change (a particle 2.7 cm inside the ground at
-//! frame 56) and checks every substep's end.
+//! In the pile of nine cubes (`ContactScene::pile`, rapier's `fem_bench` jelly pile) at 80
+//! substeps with `DeformationDamping` 5/s and the self-weight sweep, a cube struck by another
+//! is not pressed into the ground, and nothing is launched by a push-out. A slow particle of
+//! a body being struck is sped up within the frame, so ground contact candidates must take
+//! the body's fastest particle into account, not only each particle's own path over the
+//! frame (`tetpbd-rapier`, `gather::candidates`). The test replays the scene's first 60
+//! frames (about 1 s) and checks every substep's end.
 
 use tetpbd::hecs::{Entity, World};
 use tetpbd::{Particles, SubstepHook};

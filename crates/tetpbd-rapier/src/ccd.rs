@@ -15,18 +15,17 @@
 //!   (previous pose → current pose, in the collider's frame) as a ray against the shape; when
 //!   the ray enters the shape, the contact uses the entry point and the entry face's normal.
 //!   The rigid-point–triangle contacts do the same with the point's motion relative to the
-//!   triangle's plane (`corner` module docs).
+//!   triangle's plane (`contacts::corner` module docs).
 //!
 //! The rigid body itself is still integrated by rapier up to its end pose; inside the soft
 //! substeps it follows its path `P₀ → P₁` plus the offset the soft contacts push it by
-//! (`bodies` module docs), so a body stopped by a soft one is written back where the soft
+//! (`rigid::body` module docs), so a body stopped by a soft one is written back where the soft
 //! contacts stopped it.
 //!
 //! Cost: one swept AABB per collider of each awake moving body per frame, one AABB test per
 //! fast collider and soft body, one ray cast per particle contact and iteration whose
 //! relative motion over the substep exceeds its distance to the surface (none at rest), and
-//! a pass over the rigid-point candidates of moving colliders per iteration; about +5 % per
-//! frame on `examples/rigid_ball_on_soft` (docs/stability.md).
+//! a pass over the rigid-point candidates of moving colliders per iteration.
 
 use nalgebra::{Isometry3, Point3, Vector3};
 use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};

@@ -10,7 +10,7 @@
 //! So after the ordinary projections of an iteration, a soft body that
 //!
 //! * touches an immovable support — a fixed or kinematic collider, a *supported* rigid
-//!   body (infinitely heavy inside the substeps, `bodies` module docs) — or has pinned
+//!   body (infinitely heavy inside the substeps, `rigid::body` module docs) — or has pinned
 //!   particles, and
 //! * carries a dynamic rigid body at least [`crate::CouplingSettings::stacking_mass_ratio`]
 //!   times heavier than the particles it touches (the body's generalized mass at the

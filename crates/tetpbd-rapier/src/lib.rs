@@ -17,6 +17,9 @@
 //! * Per-body collision properties (friction, restitution, rolling resistance, thickness)
 //!   and groups: the [`SoftCollider`] component; deformation damping: the
 //!   [`DeformationDamping`] component.
+//! * Triangle meshes without pseudo-normals are one-sided: their inside is behind each
+//!   face's counter-clockwise winding normal; heightfields are solid below their surface
+//!   (see [`SoftCollider`]).
 //! * Attachments: the [`Attachments`] component.
 //! * Contact reports: [`Coupling::contacts`]; statistics: [`CouplingStats`].
 //! * Other hooks (e.g. soft–soft contacts) run in the same substeps through
@@ -44,6 +47,16 @@
 //! assert!(!scene.coupling.contacts().is_empty());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! Where things are in the source: `gather` collects once per frame the colliders near each
+//! soft body and the contact candidates; `contacts` makes and projects the contacts against
+//! rigid bodies (`particle`: soft particles vs colliders, `corner`: rigid corners vs soft
+//! triangles, `support`: the rigid contacts of anchored bodies); `response` holds friction
+//! (one rule for every contact kind), restitution, rolling resistance and deformation
+//! damping; `rigid` the proxies of rapier bodies and colliders inside the substeps; `ccd`
+//! the swept tests for fast bodies; `heavy_loads` the pass that carries heavy rigid bodies
+//! on soft ones; `attachments`; `soft_soft` the contacts between soft bodies; `substep` the
+//! order of the work in one substep; `coupling` the frame ([`Coupling::step`]).
 //!
 //! Bad input is rejected with a [`CouplingError`] naming what is wrong; conditions that can
 //! only be seen during a step (an attachment whose body was removed, a point parry gives no

@@ -34,9 +34,8 @@ pub struct CouplingSettings {
     /// stacking pass under its own weight too, not only under a heavy rigid load (default
     /// `false`). One Gauss–Seidel iteration per substep leaves a resting body sagging by a
     /// volume error that falls only as `h²`; the sweep carries the support's reaction to the
-    /// top within the substep and cuts that error by 4× or more (1 m cubes of 4³–12³ cells at 10
-    /// substeps: 0.025–0.117 % → 0.000–0.030 %, `docs/performance.md`), at 1.7–2.0× the
-    /// cost per frame (edges + volume, SIMD lanes).
+    /// top within the substep and cuts that error several times, at up to about twice the
+    /// cost per frame (figures in `docs/performance.md`).
     /// Only the sweep runs; the frozen-surface contact pass and
     /// velocity pass stay reserved for heavy loads. The sweep is one-way (the support acts
     /// as infinitely heavy), so leave it off for bodies that are not meant to rest.

@@ -12,6 +12,18 @@ use crate::error::{check_coefficient, CouplingError};
 /// combine rules, exactly as rapier combines two colliders
 /// ([`CoefficientCombineRule::combine`]).
 ///
+/// What counts as the inside of a rapier collider, which a soft particle is pushed out of:
+///
+/// * solid shapes (ball, cuboid, capsule, cylinder, cone, convex polyhedron, compounds of
+///   those, their rounded variants): parry's own inside;
+/// * a heightfield: everything below its surface (local −y);
+/// * a triangle mesh built with `TriMeshFlags::ORIENTED` or `FIX_INTERNAL_EDGES` (it has
+///   pseudo-normals): parry's inside of the closed, oriented mesh;
+/// * any other triangle mesh is **one-sided**: a particle behind the face it projects onto,
+///   against the face's counter-clockwise winding normal, is inside and is pushed out to the
+///   front. Wind such a mesh with its faces towards the soft bodies, or build it oriented;
+///   a soft body that reaches the back of a one-sided face is pushed through to its front.
+///
 /// ```
 /// use tetpbd_rapier::SoftColliderBuilder;
 /// let c = SoftColliderBuilder::new().friction(0.3).restitution(0.5).thickness(0.01).build()?;
@@ -87,8 +99,8 @@ impl SoftCollider {
     }
 
     /// Rolling resistance coefficient, dimensionless: the couple opposing the body's rotation
-    /// relative to a collider it touches is at most this times the normal force times the
-    /// lever from the body's centre of mass to the contact (`rolling` module docs; 0 = none).
+    /// relative to a collider it touches is at most this times the normal force times the lever
+    /// from the body's centre of mass to the contact (`response::rolling` module docs; 0 = none).
     pub fn rolling_resistance(&self) -> f32 {
         self.rolling_resistance
     }

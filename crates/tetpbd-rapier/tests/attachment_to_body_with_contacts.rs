@@ -1,5 +1,5 @@
-//! Issue 3, item 5 (two-way attachments): a soft body attached to a dynamic rigid body that
-//! also has soft contacts, or rigid contacts, stays bounded and the attachment holds.
+//! Two-way attachments: a soft body attached to a dynamic rigid body that also has soft
+//! contacts, or rigid contacts, stays bounded and the attachment holds.
 
 mod coupling_common;
 
@@ -285,7 +285,8 @@ fn check_box_in_place(name: &str, samples: &[Sample], start: Vector3<f32>) {
 
 /// Scene (a) with a rigid pin (100 kg, or 1000 kg soft cube), the cube centred on the box or
 /// moved by 1–2 mm (the scene is chaotic). The box touches the ground (rapier contact) and
-/// the soft cube: it used to be flung away within two frames. Over 10 s the box stays within
+/// the soft cube; handing the attachment's reaction over a frame late would fling it away
+/// within a few frames. Over 10 s the box stays within
 /// 5 cm of its place, upright, and the pin holds.
 #[test]
 fn soft_cube_attached_to_a_box_on_the_ground() {
@@ -309,9 +310,9 @@ fn soft_cube_attached_to_a_box_on_the_ground() {
 /// spring by up to about 1 cm before the cube rests on the box (7.6 mm measured with a fixed
 /// box): the attachment is held to 1.2 cm once settled.
 ///
-/// It used to diverge within 2 s: every 1–2 s the rocking cube lifted the box off the
-/// ground through the spring while soft impulses pressing the box into its supports still
-/// left it unmoved, and the scene gained 10–60 J in such frames (`support` module docs).
+/// Guards against a gain of energy: the rocking cube lifts the box off the ground through
+/// the spring, and soft impulses pressing the box into its supports must then move it back
+/// down (`contacts::support` module docs).
 /// With the cube moved sideways, see
 /// [`soft_cube_attached_compliantly_to_a_box_keeps_its_energy`].
 #[test]
@@ -362,13 +363,10 @@ fn soft_cube_hanging_from_a_box_on_a_soft_cube() {
 /// The cube's 2 × 2 bottom face meets the box top (0.5 m wide) only at its centre particle,
 /// so the cube rests on that particle and on the box's top corners, which its bottom
 /// triangles hold. Those triangles all share the centre particle, in contact with the box
-/// top; a vertex holding the collider used to rule its triangles out, so the corners sank
-/// into the cube unchecked (16 cm measured against the fixed box), the cube tipped on the
-/// spring like an inverted pendulum and, once its tilt passed the 30° holding angle, the
-/// triangle pushed the whole depth out in one substep: particles at up to 160 m/s, the
-/// scene up to 90 kJ over its start of 991 J, in 24 of 28 shifts (up to 3 mm along x and z)
-/// against a fixed box. Each of the 12 runs here did so (10–160 m/s, 1.7–91 kJ over the
-/// start). A polyhedral corner is now never left to a vertex (`corner` module docs).
+/// top. If a vertex holding the collider ruled its triangles out, the corners would sink into
+/// the cube unchecked, the cube would tip on the spring like an inverted pendulum and, once
+/// its tilt passed the holding angle, a triangle would push the whole depth out in one
+/// substep. A polyhedral corner is never left to a vertex (`contacts::corner` module docs).
 #[test]
 fn soft_cube_attached_compliantly_to_a_box_keeps_its_energy() {
     let shifts = [

@@ -1,17 +1,16 @@
-//! Issue #5, scene d): the pile of nine soft cubes (rapier's `fem_bench` "jelly pile" on
+//! The pile of nine soft cubes (rapier's `fem_bench` "jelly pile" on
 //! rigid ground, as `tetpbd-bench` builds it) comes to rest at 10 substeps, undamped and with
 //! `DeformationDamping` 5/s.
 //!
-//! Cause: the cubes are placed face to face, so a falling cube's bottom edge passes a landed
-//! neighbour's top edge flush with it. A landed cube bulges by a few millimetres, so the
+//! What it guards: the cubes are placed face to face, so a falling cube's bottom edge passes
+//! a landed neighbour's top edge flush with it. A landed cube bulges by a few millimetres, so the
 //! neighbour's top-edge particles lie just inside the falling cube's bottom face (and its
-//! bottom-edge particles just inside the neighbour's top face). The vertex–triangle contact
-//! of that face stopped the falling cube on the edge and kicked it sideways (a snag: 0.7 m/s
-//! sideways, its fall stopped, in the two-cube test below). Displaced cubes then landed
-//! partly on their neighbours' edges, crushed them into ramps and were thrown off, and the
-//! pile did not come to rest. Fix: a particle behind a face it has not been touching is left
-//! alone when it is less deep behind a side face of the same body across a crease, whose
-//! prism it is in (it is grazing that side face); see `soft_project::flush_beside`.
+//! bottom-edge particles just inside the neighbour's top face). If the vertex–triangle
+//! contact of that face caught them, it would stop the falling cube on the edge and kick it
+//! sideways; displaced cubes would land partly on their neighbours' edges, crush them into
+//! ramps and be thrown off. A particle behind a face it has not been touching is left alone
+//! when it is less deep behind a side face of the same body across a crease, whose prism it
+//! is in (it is grazing that side face; `SoftContacts` docs).
 
 mod soft_soft_common;
 
@@ -138,9 +137,8 @@ fn run_pile(substeps: u32, damping: f32, at: &[Vector3<f32>]) -> Rest {
 }
 
 /// A cube released 10 cm above the top of a landed neighbour, face to face with it, falls
-/// past it until it reaches the ground. Before the fix it was stopped on the neighbour's top
-/// edge (vertical speed 0.2 m/s instead of 1.8 m/s after 10 frames) and pushed off sideways
-/// at 0.7 m/s.
+/// past it until it reaches the ground, neither stopped on the neighbour's top edge nor pushed
+/// off sideways.
 #[test]
 fn cube_falls_past_a_flush_neighbour_without_snagging() {
     let at = [Vector3::new(0.0, 0.502, 0.0), Vector3::new(1.0, 1.6, 0.0)];
@@ -178,8 +176,7 @@ fn assert_rest(what: &str, r: &Rest) {
     assert!(r.inter < 0.01, "{what}: interpenetration {} m", r.inter);
 }
 
-/// The bench's pile at 10 substeps comes to rest (before the fix: 0.32 m/s undamped, 0.17 m/s
-/// damped after 5 s).
+/// The bench's pile at 10 substeps comes to rest, undamped and damped.
 #[test]
 fn pile_comes_to_rest_at_10_substeps() {
     for damping in [0.0, 5.0] {
@@ -190,9 +187,8 @@ fn pile_comes_to_rest_at_10_substeps() {
 
 /// Which pile comes to rest is chaotic (a millimetre moves where the cubes end up), so one
 /// run proves little: eight layouts with every cube moved by up to 2 mm, undamped and damped,
-/// at 10 and 5 substeps. Measured with this test: before the fix 8 of 16 came to rest at 10
-/// substeps and 9 of 16 settled (max |v| < 0.02 m/s) at 5; after it 13 and 13. Most of the
-/// rest is a cube perched off-centre on another, swaying on its edge at 0.03–0.25 m/s (a
+/// at 10 and 5 substeps (the thresholds are in the test). A pile that does not settle is
+/// mostly a cube perched off-centre on another, swaying on its edge at 0.03–0.25 m/s (a
 /// weakly damped mode of the soft pair, left open). At 5 substeps a particle of a loaded cube
 /// also ends up to 2.4 mm below the rigid ground (the coupling's ground contact, not the
 /// soft–soft contacts), so only the speed and the interpenetration are asserted there.

@@ -1,19 +1,16 @@
-//! Issue 3 / issue 6: a fast rigid ball against a soft slab one cell thick lying on the
-//! ground must not tunnel through the slab (nor through the ground under it).
+//! A fast rigid ball against a soft slab one cell thick lying on the ground must not tunnel
+//! through the slab (nor through the ground under it).
 //!
-//! Before the fix the ball was not even a contact candidate when rapier's step had already
-//! carried it past the slab (candidates came from its end pose), a particle poking into the
-//! ball from the side deflected it, and the triangle contacts ignored a point more than
-//! half a cell behind the triangle. The ball ended inside (and then under) the ground.
+//! What it takes: the ball must be a contact candidate even when rapier's step has already
+//! carried it past the slab (candidates from its swept motion, `ccd` module docs), a
+//! particle poking into the ball from the side must not deflect it, and the triangle
+//! contacts must catch a point that crossed the triangle within the substep at any depth.
 //!
-//! Issue 6: with soft compliances (edges and vertex–face α = 1e-6 m/N, volume α = 1e-9 m⁵/N)
-//! the ball at 100 m/s still went into the slab (edges + volume: through it and the ground,
-//! vertex–face: into its lower half). The impact pushed a triangle vertex into the ball's
-//! side; the triangle was left to that vertex's particle contact, whose normal was tilted
-//! about 45° from the triangle's, and the ball slid past the particle into the slab. A
-//! vertex contact now leaves the triangle to the particle only when its normal is within 30°
-//! of the triangle's (`corner` module docs). The same let a ball at 150 m/s straight onto a
-//! particle of a soft vertex–face + edges slab through it (centre at −0.76 m).
+//! With soft compliances (edges and vertex–face α = 1e-6 m/N, volume α = 1e-9 m⁵/N) the
+//! impact pushes a triangle vertex into the ball's side, its contact normal tilted about 45°
+//! from the triangle's; a vertex contact leaves the triangle to the particle only when its
+//! normal is within 30° of the triangle's (`contacts::corner` module docs), so the ball does
+//! not slide past the particle into the slab, also at 150 m/s straight onto a particle.
 
 mod coupling_common;
 
@@ -23,7 +20,7 @@ use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 use tetpbd_rapier::SoftCollider;
 
-/// Hard edges + volume, the slab of the issue 3 cases.
+/// Hard edges + volume.
 const HARD: Families = (Some(0.0), None, Some(0.0));
 
 /// What a drop measured.
@@ -164,7 +161,7 @@ fn ball_at_100_m_s_stays_on_a_soft_vertex_face_edges_slab() {
     check(100.0, true, (Some(1e-6), Some(1e-6), None));
 }
 
-/// Straight onto a particle, faster: before the fix the ball's centre reached −0.76 m. The
+/// Straight onto a particle, faster: the ball stays above the slab. The
 /// ball is not held at rest here: the particle under it deflects it, and it leaves rolling
 /// (about 11 m/s after 10 frames).
 #[test]

@@ -1,9 +1,6 @@
-//! Issue 3: rigid corners of triangle meshes and heightfields poking into a coarse soft
-//! surface are caught by the soft surface triangles, as those of polyhedra are.
-//!
-//! Before the fix a mesh's or heightfield's vertices took no part in the rigid-point–soft-
-//! triangle contacts: a spike of a fixed terrain passed between the particles of a coarse
-//! soft slab, which then fell around it onto the ground.
+//! Rigid corners of triangle meshes and heightfields poking into a coarse soft surface are
+//! caught by the soft surface triangles, as those of polyhedra are: a spike of a fixed
+//! terrain does not pass between the particles of a coarse soft slab.
 
 mod coupling_common;
 
@@ -81,7 +78,7 @@ fn trimesh_spike_is_caught_by_soft_triangles() {
 }
 
 /// A fixed polyhedron's corners are paired only with the soft triangles that can reach them
-/// (`corner` module docs, issue 6): the tip is still caught by the triangle over it.
+/// (`contacts::corner` module docs): the tip is still caught by the triangle over it.
 #[test]
 fn fixed_convex_spike_is_caught_by_soft_triangles() {
     let v = [

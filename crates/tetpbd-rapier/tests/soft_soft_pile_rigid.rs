@@ -1,4 +1,4 @@
-//! The pile: nine soft cubes (4×4×4 cells) dropped in the layout of rapier's
+//! A pile of nine soft cubes (4×4×4 cells) dropped in the layout of rapier's
 //! `fem_bench` "jelly pile" onto *rigid* ground, through the rigid coupling with
 //! [`SoftContacts`] passed as its extra hook (`CoupledWorld::step_with`). 60 Hz, 20
 //! substeps, deformation damping 5/s on the cubes (applied by the coupling).

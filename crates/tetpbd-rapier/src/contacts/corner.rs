@@ -14,7 +14,7 @@
 //!
 //! The correction is spread over the triangle's particles barycentrically and the opposite
 //! impulse goes to the rigid body at `v`; Coulomb friction acts on the relative tangential
-//! motion as for particles. The rigid points (`corner_points` module) are
+//! motion as for particles. The rigid points (`gather::corner_points` module) are
 //!
 //! * every vertex of a polyhedral shape (cuboid, convex polyhedron, triangle; the inner
 //!   vertices of the rounded variants, border radius added to the thickness), each its own
@@ -28,7 +28,7 @@
 //!
 //! A point that crossed the triangle's plane from the front within the substep (a fast
 //! rigid body, motion taken relative to the triangle) is caught at any depth, at the point
-//! where it crossed (`sweep` module docs). Points of moving bodies that crossed are projected
+//! where it crossed (`ccd` module docs). Points of moving bodies that crossed are projected
 //! in a pass of their own before the particle contacts, even where a vertex touches the
 //! collider: one particle alone cannot stop a fast body, and its contact normal may be tilted
 //! enough to let the body slip past it.
@@ -38,24 +38,20 @@
 //! normal lies within 30° of the triangle's normal. There the particle contact holds the
 //! surface, and two sets of constraints on the same spot only fight. A vertex touching the
 //! collider's side (its normal tilted further) does not hold it: the body slides past that
-//! particle into the triangle. Issue 6: a ball at 100 m/s pushed a vertex of a compliant slab
-//! into its side, the vertex's normal was about 45° off the triangle's, and with every
-//! touching vertex ruling its triangles out the ball sank into the slab (and, under soft
-//! edges + volume, through it and the ground); the triangle now stops it.
+//! particle into the triangle. (A fast ball pressing a vertex of a compliant slab into its
+//! side tilts that vertex's normal about 45° off the triangle's; if every touching vertex
+//! ruled its triangles out, the ball would sink into the slab.)
 //!
-//! Only a smooth shape's support point is left to a holding vertex: it lies on the same
-//! smooth surface as the vertex's contact, near it (projecting it as well let the ball of
-//! issue 6 bounce off a compliant slab, 5.5–6.5 m/s after 10 frames). A polyhedral corner is
-//! a feature of its own, which a vertex resting on a face beside it does not keep out of the
-//! triangle (where the vertex rests on the corner itself, the triangle's constraint is about
-//! met already), so it is always projected. Issue 3: a soft cube whose 2 × 2 bottom face met
-//! a smaller box top only at its centre particle rested on that particle alone, the box's
-//! top corners sinking unchecked into the bottom triangles around it (16 cm deep); the cube
-//! tipped over like an inverted pendulum, and when its tilt passed the holding angle a
-//! triangle pushed the whole depth out in one substep (particles at up to 160 m/s).
-//! Tolerating the corner within the triangle's skin (the thickness) while a vertex holds
-//! does not do either: the skin is pushed out whenever the vertex lets go, 2 mm in one
-//! substep, which kept the cube rattling at up to 1.5 m/s.
+//! Only a smooth shape's support point is left to a holding vertex: it lies on the same smooth
+//! surface as the vertex's contact, near it (projecting it as well makes a ball bounce off a
+//! compliant slab). A polyhedral corner is a feature of its own, which a vertex resting on a face
+//! beside it does not keep out of the triangle (where the vertex rests on the corner itself, the
+//! triangle's constraint is about met already), so it is always projected: a soft cube whose coarse
+//! bottom face meets a smaller box top only at its centre particle would otherwise rest on that
+//! particle alone, the box's top corners sinking unchecked into the triangles around it, and tip
+//! over. Tolerating the corner within the triangle's skin (the thickness) while a vertex holds does
+//! not do either: the skin is pushed out whenever the vertex lets go, which keeps the body
+//! rattling.
 //!
 //! The smooth parts of a compound take no part (their contacts with the soft particles
 //! still act). `v` is only caught while its projection
@@ -79,8 +75,7 @@ use crate::rigid::collider::ColliderProxy;
 
 /// Cosine of the largest angle between a vertex's particle contact normal and its triangle's
 /// normal at which the particle contact still holds the collider against the triangle, so
-/// the triangle is left to it in the ordinary pass (30°; 20° and 45° held the fast balls of
-/// issue 6 as well, see `docs/stability.md`).
+/// the triangle is left to it in the ordinary pass (30°; not sensitive between 20° and 45°).
 const HOLDING_ANGLE_COS: f32 = 0.866;
 
 /// One rigid shape over one soft surface triangle.
@@ -122,9 +117,9 @@ pub(crate) enum CornerPass {
     Crossing,
     /// Every point, except on triangles with a vertex holding the same collider (module docs).
     Ordinary,
-    /// Every point, on every triangle: the soft surface is frozen (the `stacking` pass), so
-    /// a particle contact and a triangle on the same spot cannot fight; they both push the
-    /// rigid body out.
+    /// Every point, on every triangle: the soft surface is frozen (the heavy-load pass,
+    /// `heavy_loads`), so a particle contact and a triangle on the same spot cannot fight; they
+    /// both push the rigid body out.
     Frozen,
 }
 
@@ -305,12 +300,12 @@ fn sweep_corners(
     }
 }
 
-/// Whether a vertex of the triangle (unit outward normal `n`) already touches the collider
-/// with a contact normal close to the triangle's: that particle contact then holds the body
-/// against the surface, and the triangle only stops a support point that slips between
-/// particles (and what crosses it within the substep). A vertex touching the body's side, its normal tilted more
-/// than `HOLDING_ANGLE_COS` from the triangle's, does not hold it: the body slides past that
-/// particle into the triangle.
+/// Whether a vertex of the triangle (unit outward normal `n`) already touches the collider with a
+/// contact normal close to the triangle's: that particle contact then holds the body against the
+/// surface, and the triangle only stops a support point that slips between particles (and what
+/// crosses it within the substep). A vertex touching the body's side, its normal tilted more than
+/// `HOLDING_ANGLE_COS` from the triangle's, does not hold it: the body slides past that particle
+/// into the triangle.
 fn vertex_holds(k: &CornerContact, contacts: &[ParticleContact], n: &Vector3<f32>) -> bool {
     k.vertex_contacts.iter().flatten().any(|&i| {
         contacts

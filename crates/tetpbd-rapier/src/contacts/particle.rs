@@ -17,7 +17,7 @@
 //!
 //! A particle whose motion relative to the collider entered the shape during the substep
 //! (a fast body, or a thin shape) takes the entry point and entry face's normal as `q` and
-//! `n` instead of the closest point, which may lie on the far side (`sweep` module docs).
+//! `n` instead of the closest point, which may lie on the far side (`ccd` module docs).
 //!
 //! Overlap a soft body is created with (its first frame in the coupling, a particle already
 //! inside a collider) is not resolved at once: the contact tolerates an allowance, the
@@ -92,7 +92,7 @@ pub(crate) fn project_contacts(
         let pose = cp.pose(bodies);
         let fallback = c.has_normal.then_some(c.normal);
         let closest = surface_point(shape, cp.rule, &pose, &x, fallback);
-        // Relative motion that entered the shape within the substep (`sweep` module docs).
+        // Relative motion that entered the shape within the substep (`ccd` module docs).
         let moving = cp.body.is_some_and(|b| bodies[b].kind != BodyKind::Fixed);
         let swept = swept_entry(
             shape,

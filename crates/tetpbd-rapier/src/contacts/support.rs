@@ -2,12 +2,12 @@
 //!
 //! A dynamic body that rapier reports in contact with other rigid colliders is normally
 //! *supported*: infinitely heavy inside the substeps, its summed soft reaction handed to
-//! rapier as a force for its next step (`bodies` module docs). That is an explicit coupling
+//! rapier as a force for its next step (`rigid::body` module docs). That is an explicit coupling
 //! with a frame of lag, stable for contacts, which mostly press a body onto its supports. An
 //! attachment is two-way and bilateral: rapier moves the body by the reaction, the body drags
 //! the attached soft body along, whose reaction moves the body further. The gain of that loop
-//! is the mass ratio soft/rigid, so a light body holding a heavy soft body diverged within a
-//! few frames (issue 3).
+//! is the mass ratio soft/rigid, so a light body holding a heavy soft body would diverge
+//! within a few frames.
 //!
 //! A supported body that carries an attachment is therefore *anchored*: it takes part in the
 //! substeps with its generalized inverse mass like a body touched only by soft bodies
@@ -32,19 +32,17 @@
 //! either: a soft load handed to a light body a frame late is what made it unstable. The
 //! cost: such a load neither tips the body nor weighs on a dynamic support below it.
 //!
-//! A body that is not held moves with its generalized inverse mass under every soft impulse,
-//! except that one pressing it into its supports (more than 60° against their mean normal)
-//! does not move it while it stands on them, and moves it at most down to them otherwise
-//! (its clearance, measured at every iteration and followed by its centre of mass). The
-//! soft load is then shared as Newton's third law has it: a body that an attachment lifts
-//! off its supports is pushed back down by the soft body it lifts, rather than staying
-//! immovable against it while the attachment moves it up. That rule (pressing impulses
-//! never moving the body, whatever its pose) let the light box of scene a of
-//! `crates/tetpbd-rapier/tests/attachment_to_body_with_contacts.rs` with a compliant attachment (1e-5 m/N, a
-//! 100 kg soft cube) do work on the cube each time the spring lifted it (+10–60 J per
-//! frame) and diverge within 2 s. The friction cone decides from the load alone, whether
-//! the soft side moved: a soft body pulling an anchored box sideways harder than its
-//! supports' friction can hold moves it, and one pulling it up off them lifts it.
+//! A body that is not held moves with its generalized inverse mass under every soft impulse, except
+//! that one pressing it into its supports (more than 60° against their mean normal) does not move
+//! it while it stands on them, and moves it at most down to them otherwise (its clearance, measured
+//! at every iteration and followed by its centre of mass). The soft load is then shared as Newton's
+//! third law has it: a body that an attachment lifts off its supports is pushed back down by the
+//! soft body it lifts, rather than staying immovable against it while the attachment moves it up.
+//! (Never moving the body under a pressing impulse, whatever its pose, would let a light box
+//! holding a heavy soft cube by a compliant attachment do work on the cube each time the spring
+//! lifts it.) The friction cone decides from the load alone, whether the soft side moved: a soft
+//! body pulling an anchored box sideways harder than its supports' friction can hold moves it, and
+//! one pulling it up off them lifts it.
 //!
 //! The reaction of a dynamic support to the body's own motion into it is summed over the
 //! frame and applied to it as an impulse (its velocity at rapier's next step); a fixed or
@@ -63,15 +61,9 @@
 //! is that of the whole body, not of each contact, and ignores the body's weight; the
 //! moment of the load is not looked at (a held body does not tip).
 //!
-//! Measured on scene a (`crates/tetpbd-rapier/tests/attachment_to_body_with_contacts.rs`) with the soft cube
-//! moved by up to 3 mm sideways: with the rigid pin (100 and 1000 kg) every run stays in
-//! place (box drift ≤ 0.2 mm). With the 1e-5 m/N attachment, over 28 shifts (−3 to 3 mm
-//! along x, −2 to 3 mm along z), the cube stays on the box, its particles below 0.42 m/s
-//! and its energy (with the spring's) at most 0.24 J over its start, the box drifting up to
-//! 1 cm in 10 s as the cube rocks on its top. The cube used to tip off the box top in most of them, with the
-//! box made fixed too, and swing on the spring at up to 200 m/s: the box's top corners sank
-//! unchecked into the cube's bottom triangles (`corner` module docs, issue 3), a limit of
-//! the soft side, not of the anchored body.
+//! Guarded by `tests/attachment_to_body_with_contacts.rs`: a soft cube attached to the top
+//! of a light box on the ground stays on it, bounded in speed and energy, with a rigid pin
+//! and with a compliant attachment.
 
 use nalgebra::{Point3, Vector3};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
@@ -203,7 +195,7 @@ pub(crate) fn hold_supported(supports: &[Support], bodies: &mut [BodyProxy]) {
 
 /// One sweep over the supports: keeps each anchored body's contact points out of its
 /// supports (the support immovable), with static Coulomb friction on the point's motion
-/// over the substep (as the particle contacts, `contact` module docs).
+/// over the substep (as the particle contacts, `contacts::particle` module docs).
 pub(crate) fn project_supports(supports: &mut [Support], bodies: &mut [BodyProxy]) {
     for s in supports {
         let body = &mut bodies[s.body];

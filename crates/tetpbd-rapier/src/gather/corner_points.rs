@@ -1,6 +1,6 @@
-//! The rigid points of a shape for the rigid-point–soft-triangle contacts (`corner` module
-//! docs): polyhedron vertices, the vertices of triangle meshes and heightfields near the soft
-//! body, and a compound's parts by the same rules, each with its part's border radius.
+//! The rigid points of a shape for the rigid-point–soft-triangle contacts (`contacts::corner`
+//! module docs): polyhedron vertices, the vertices of triangle meshes and heightfields near the
+//! soft body, and a compound's parts by the same rules, each with its part's border radius.
 
 use nalgebra::Vector3;
 use rapier3d::geometry::Aabb;

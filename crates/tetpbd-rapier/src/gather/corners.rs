@@ -15,7 +15,7 @@ use crate::gather::corner_points::Corners;
 /// Adds the corner–triangle candidates of one collider against one soft body. `corners` is
 /// scratch space (its capacity is reused across calls). `still`: the collider stands at
 /// `pose` for the whole frame (fixed), so each of its corners is only paired with the
-/// triangles it can reach (see the module docs).
+/// triangles it can reach (`contacts::corner` module docs).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn gather_corners(
     out: &mut Vec<CornerContact>,

@@ -52,7 +52,7 @@ pub(crate) struct Frame {
     /// `(entity bits, collider handle (index, generation), particle)`, with the overlap
     /// allowance they still had (m). A contact found in this frame whose pair is not here is
     /// new: an overlap it starts with is pushed out at the bounded depenetration speed (see
-    /// `contact::project_contacts`); one that is here continues with its allowance.
+    /// `contacts::particle::project_contacts`); one that is here continues with its allowance.
     pub touching: Vec<(PairKey, f32)>,
     /// Soft bodies (entity bits) stepped in the previous frame, sorted. Only a body not in
     /// this list (created this frame) gets an overlap allowance: an overlap it was created
@@ -69,7 +69,7 @@ pub(crate) struct Frame {
     pub contacts: Vec<ParticleContact>,
     pub corners: Vec<CornerContact>,
     pub attachments: Vec<AttachRun>,
-    /// Rigid contacts of anchored bodies (`support` module docs).
+    /// Rigid contacts of anchored bodies (`contacts::support` module docs).
     pub supports: Vec<Support>,
     /// Force (N) and torque (N·m) added to bodies for rapier's next step (the load of the
     /// previous frame, `BodyProxy::load`), taken off again after that step.
@@ -80,12 +80,13 @@ pub(crate) struct Frame {
     /// Scratch of the stacking pass: which particles were pinned before it froze them.
     pub pinned: Vec<bool>,
     near: Vec<ColliderHandle>,
-    /// Colliders of fast bodies with their swept AABB over the frame (`sweep` module docs).
+    /// Colliders of fast bodies with their swept AABB over the frame (`ccd` module docs).
     fast: Vec<(ColliderHandle, Aabb)>,
     vertex_contacts: Vec<(u32, usize)>,
-    /// Scratch: a shape's corners (`corner::gather_corners`).
+    /// Scratch: a shape's corners (`gather_corners`).
     shape_corners: Corners,
-    /// Scratch: the colliders of a body's active contacts (`restitution::restitution_pass`).
+    /// Scratch: the colliders of a body's active contacts
+    /// (`response::restitution::restitution_pass`).
     pub active_colliders: Vec<usize>,
     /// Impact episodes in progress (kept across frames).
     pub episodes: Vec<Episode>,

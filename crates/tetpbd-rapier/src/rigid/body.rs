@@ -19,7 +19,7 @@
 //!
 //! A dynamic body in contact with other rigid colliders is *supported*: infinitely heavy
 //! inside the substeps, its summed soft reaction handed to rapier as a force for its next
-//! step. One that also carries an attachment is *anchored* (`support` module docs): it
+//! step. One that also carries an attachment is *anchored* (`contacts::support` module docs): it
 //! takes part with its mass, except while its supports hold it against the soft load and
 //! against impulses pressing it into supports it stands on.
 
@@ -40,7 +40,7 @@ pub(crate) enum BodyKind {
     Fixed,
     Kinematic,
     /// Dynamic, touched only by soft bodies, or *anchored* (supported and carrying an
-    /// attachment, its rigid contacts kept as constraints: `support` module docs): takes
+    /// attachment, its rigid contacts kept as constraints: `contacts::support` module docs): takes
     /// part with its generalized inverse mass.
     Dynamic,
     /// Dynamic and in contact with other rigid colliders: infinitely heavy inside the soft
@@ -88,10 +88,10 @@ pub(crate) struct BodyProxy {
     angular: Vector3<f32>,
     /// Mean contact normal of an anchored body's rigid supports (unit, towards the body;
     /// zero for any other body): the soft load they hold and impulses pressing the body
-    /// into them are left to them (`support` module docs).
+    /// into them are left to them (`contacts::support` module docs).
     support_normal: Vector3<f32>,
-    /// An anchored body's clearance above its supports (m, the smallest support constraint
-    /// value, `support` module docs) when it was last measured, and its centre of mass then.
+    /// An anchored body's clearance above its supports (m, the smallest support constraint value,
+    /// `contacts::support` module docs) when it was last measured, and its centre of mass then.
     clearance: (f32, Vector3<f32>),
     /// The soft positional impulses on an anchored body (kg·m), moving it or not, summed
     /// over the current and over the previous substep.
@@ -194,14 +194,13 @@ impl BodyProxy {
         }
     }
 
-    /// Makes a supported body *anchored* (`support` module docs): it takes part with its
+    /// Makes a supported body *anchored* (`contacts::support` module docs): it takes part with its
     /// generalized inverse mass, except while its supports hold it ([`Self::hold`]) and
     /// against impulses pressing it into supports it stands on; `normal` is their mean
     /// contact normal (towards the body), `friction` their smallest friction coefficient.
     /// It is written back every frame, which also keeps rapier from putting it to sleep:
     /// left at rapier's result in a frame where the soft body only pressed it into its
-    /// supports, the scene of `crates/tetpbd-rapier/tests/attachment_to_body_with_contacts.rs` (a) diverged
-    /// after about 2 s.
+    /// supports, a light box holding a heavy soft body diverges within seconds.
     pub fn anchor(&mut self, normal: Vector3<f32>, friction: f32) {
         if self.kind == BodyKind::Supported {
             self.friction = friction;

@@ -36,7 +36,7 @@ pub(crate) struct Candidate {
     pub prism_prev: bool,
     /// Candidates `group[0]..group[1]` are those of the same particle against the same
     /// body (this one included): the faces next to this triangle that the particle may be
-    /// flush with (see `soft_project::flush_beside`).
+    /// flush with (see `project::flush_beside`).
     pub group: [u32; 2],
     /// `w_p + Σ β² w` of the last projection, 1/kg.
     pub wsum: f32,

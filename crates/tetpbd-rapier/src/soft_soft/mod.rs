@@ -46,7 +46,7 @@
 //! each other face to face, edges flush), not entering through the face it passes. Without
 //! this, a landed cube's few millimetres of bulge put its top-edge particles inside the
 //! falling neighbour's bottom face, which stopped the neighbour on the edge and kicked it
-//! sideways (issue #5). The side face takes the particle over from the next substep on, once
+//! sideways. The side face takes the particle over from the next substep on, once
 //! the particle was inside its prism at the substep start.
 //!
 //! # Deep overlap and the speed bound
