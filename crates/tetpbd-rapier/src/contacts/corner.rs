@@ -63,7 +63,7 @@
 //! thickness and half the triangle's longest edge, contain it: the far corners of a ground
 //! cuboid are not evaluated against every soft triangle beside the particles resting on it.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use rapier3d::geometry::ColliderSet;
 use tetpbd::{Particles, Surface};
 
@@ -212,18 +212,8 @@ fn sweep_corners(
             continue;
         }
         let pose = cp.pose(bodies);
-        let local = match k.corner {
-            Some(c) => c,
-            None => {
-                let Some(support) = set
-                    .get(cp.handle)
-                    .and_then(|co| co.shape().as_support_map())
-                else {
-                    continue;
-                };
-                let dir = pose.rotation.inverse() * (-n);
-                to_na(support.local_support_point(to_glam(&dir)))
-            }
+        let Some(local) = rigid_point(k, cp, set, &pose, &n) else {
+            continue;
         };
         let v = (pose * Point3::from(local)).coords;
         if !crate::convert::finite3(&v) {
@@ -260,44 +250,102 @@ fn sweep_corners(
         } else {
             continue;
         };
-        // Barycentric weights of q's projection onto the triangle's plane.
-        let q = q - n * (q - a).dot(&n);
-        let wa = (b - q).cross(&(c - q)).dot(&n) / area2;
-        let wb = (c - q).cross(&(a - q)).dot(&n) / area2;
-        let wc = 1.0 - wa - wb;
-        // A point on a shared edge must not fall through the crack between two triangles:
-        // accept a small tolerance and clamp.
-        const TOL: f32 = 1e-3;
-        if [wa, wb, wc].iter().any(|w| *w < -TOL || *w > 1.0 + TOL) {
+        let Some(beta) = barycentric(&q, [a, b, c], &n, area2) else {
             continue;
-        }
-        let clamped = [wa, wb, wc].map(|w| w.clamp(0.0, 1.0));
-        let sum: f32 = clamped.iter().sum();
-        let beta = clamped.map(|w| w / sum);
-        let w = idx.map(|i| p.inv_masses()[i]);
-        let w_body = cp.body.map_or(0.0, |bi| bodies[bi].inv_mass_pushed(&v, &n));
-        let denom: f32 = (0..3).map(|j| w[j] * beta[j] * beta[j]).sum::<f32>() + w_body;
-        if denom.is_nan() || denom <= 0.0 {
-            continue;
-        }
-        let dl = -c_val / denom;
-        let x = p.positions_mut();
-        for j in 0..3 {
-            x[idx[j]] -= n * (w[j] * beta[j] * dl);
-        }
-        if let Some(bi) = cp.body {
-            bodies[bi].apply_position_impulse(&(n * dl), &v);
-        }
-        k.ever_active = true;
-        k.active = true;
-        k.depth = k.depth.max(-c_val);
-        k.normal = -n;
-        k.point = v;
-        k.beta = beta;
-        k.sub_impulse -= n * dl;
-        k.lambda_n += dl;
-        friction(k, p, idx, beta, bodies, cp.body, &v, &n);
+        };
+        let hit = Hit { v, n, c_val, beta };
+        push_out(k, p, idx, bodies, cp.body, &hit);
     }
+}
+
+/// The rigid point of `k` in its collider's frame: the polyhedral corner, or the support
+/// point of the shape (placed at `pose`) in the direction `−n`.
+fn rigid_point(
+    k: &CornerContact,
+    cp: &ColliderProxy,
+    set: &ColliderSet,
+    pose: &Isometry3<f32>,
+    n: &Vector3<f32>,
+) -> Option<Vector3<f32>> {
+    match k.corner {
+        Some(c) => Some(c),
+        None => {
+            let support = set
+                .get(cp.handle)
+                .and_then(|co| co.shape().as_support_map())?;
+            let dir = pose.rotation.inverse() * (-n);
+            Some(to_na(support.local_support_point(to_glam(&dir))))
+        }
+    }
+}
+
+/// Barycentric weights of `q`'s projection onto the plane of triangle `[a, b, c]` (unit
+/// normal `n`, `area2` twice its area), clamped and normalised; `None` outside it. A point on
+/// a shared edge must not fall through the crack between two triangles: a small tolerance
+/// is accepted and clamped.
+fn barycentric(
+    q: &Vector3<f32>,
+    [a, b, c]: [Vector3<f32>; 3],
+    n: &Vector3<f32>,
+    area2: f32,
+) -> Option<[f32; 3]> {
+    let q = q - n * (q - a).dot(n);
+    let wa = (b - q).cross(&(c - q)).dot(n) / area2;
+    let wb = (c - q).cross(&(a - q)).dot(n) / area2;
+    let wc = 1.0 - wa - wb;
+    const TOL: f32 = 1e-3;
+    if [wa, wb, wc].iter().any(|w| *w < -TOL || *w > 1.0 + TOL) {
+        return None;
+    }
+    let clamped = [wa, wb, wc].map(|w| w.clamp(0.0, 1.0));
+    let sum: f32 = clamped.iter().sum();
+    Some(clamped.map(|w| w / sum))
+}
+
+/// A rigid point found behind its triangle.
+struct Hit {
+    /// The rigid point (world, m) and the triangle's unit outward normal.
+    v: Vector3<f32>,
+    n: Vector3<f32>,
+    /// Constraint value (< 0), m.
+    c_val: f32,
+    /// Barycentric weights of the point's projection on the triangle.
+    beta: [f32; 3],
+}
+
+/// Projects the corner contact `k` (module docs) and applies its friction.
+fn push_out(
+    k: &mut CornerContact,
+    p: &mut Particles,
+    idx: [usize; 3],
+    bodies: &mut [BodyProxy],
+    body: Option<usize>,
+    hit: &Hit,
+) {
+    let Hit { v, n, c_val, beta } = *hit;
+    let w = idx.map(|i| p.inv_masses()[i]);
+    let w_body = body.map_or(0.0, |bi| bodies[bi].inv_mass_pushed(&v, &n));
+    let denom: f32 = (0..3).map(|j| w[j] * beta[j] * beta[j]).sum::<f32>() + w_body;
+    if denom.is_nan() || denom <= 0.0 {
+        return;
+    }
+    let dl = -c_val / denom;
+    let x = p.positions_mut();
+    for j in 0..3 {
+        x[idx[j]] -= n * (w[j] * beta[j] * dl);
+    }
+    if let Some(bi) = body {
+        bodies[bi].apply_position_impulse(&(n * dl), &v);
+    }
+    k.ever_active = true;
+    k.active = true;
+    k.depth = k.depth.max(-c_val);
+    k.normal = -n;
+    k.point = v;
+    k.beta = beta;
+    k.sub_impulse -= n * dl;
+    k.lambda_n += dl;
+    friction(k, p, idx, beta, bodies, body, &v, &n);
 }
 
 /// Whether a vertex of the triangle (unit outward normal `n`) already touches the collider with a

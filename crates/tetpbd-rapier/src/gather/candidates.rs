@@ -162,41 +162,8 @@ impl Frame {
         let (mu_d, mu_s) = sc.combined_friction(cp.friction, cp.friction_rule);
         let e = sc.combined_restitution(cp.restitution, cp.restitution_rule);
         let first = self.contacts.len();
-        for &i in body.surface.vertices() {
-            let x = p.positions()[i as usize];
-            let y = x + p.velocities()[i as usize] * dt;
-            let pa = Aabb::new(to_glam(&x.inf(&y)), to_glam(&x.sup(&y)));
-            if !pa.intersects(&caabb) {
-                continue;
-            }
-            let key = (body.entity.to_bits().get(), handle.into_raw_parts(), i);
-            let previous = self.touching.binary_search_by_key(&key, |t| t.0).ok();
-            // Allowance decided now unless the body is new (see `seen`).
-            let decided = previous.is_some() || !body.newcomer;
-            self.contacts.push(ParticleContact {
-                particle: i,
-                collider: ci,
-                mu_d,
-                mu_s,
-                restitution: e,
-                thickness: sc.thickness,
-                solve,
-                lambda_n: 0.0,
-                lambda_t: 0.0,
-                active: false,
-                ever_active: false,
-                has_normal: false,
-                normal: Vector3::zeros(),
-                point: Vector3::zeros(),
-                depth: 0.0,
-                // Touching in the previous frame: an ongoing contact, which keeps what is
-                // left of its overlap allowance (usually nothing).
-                allowance: previous.map_or(0.0, |k| self.touching[k].1),
-                allowance_fresh: decided,
-                sub_impulse: Vector3::zeros(),
-                impulse: Vector3::zeros(),
-            });
-        }
+        let material = (mu_d, mu_s, e);
+        self.gather_particle_contacts(body, handle, ci, &caabb, solve, material);
         if sc.triangles && solve {
             let mut vertex_contacts = std::mem::take(&mut self.vertex_contacts);
             vertex_contacts.clear();
@@ -219,6 +186,55 @@ impl Frame {
                 &mut self.shape_corners,
             );
             self.vertex_contacts = vertex_contacts;
+        }
+    }
+
+    /// The particle–collider candidates of one soft body against collider proxy `ci`: its
+    /// surface particles whose path over the frame meets the collider's swept bounds.
+    fn gather_particle_contacts(
+        &mut self,
+        body: &SoftInFrame<'_>,
+        handle: ColliderHandle,
+        ci: usize,
+        caabb: &Aabb,
+        solve: bool,
+        (mu_d, mu_s, e): (f32, f32, f32),
+    ) {
+        let (p, dt) = (body.p, self.dt);
+        for &i in body.surface.vertices() {
+            let x = p.positions()[i as usize];
+            let y = x + p.velocities()[i as usize] * dt;
+            let pa = Aabb::new(to_glam(&x.inf(&y)), to_glam(&x.sup(&y)));
+            if !pa.intersects(caabb) {
+                continue;
+            }
+            let key = (body.entity.to_bits().get(), handle.into_raw_parts(), i);
+            let previous = self.touching.binary_search_by_key(&key, |t| t.0).ok();
+            // Allowance decided now unless the body is new (see `seen`).
+            let decided = previous.is_some() || !body.newcomer;
+            self.contacts.push(ParticleContact {
+                particle: i,
+                collider: ci,
+                mu_d,
+                mu_s,
+                restitution: e,
+                thickness: body.sc.thickness,
+                solve,
+                lambda_n: 0.0,
+                lambda_t: 0.0,
+                active: false,
+                ever_active: false,
+                has_normal: false,
+                normal: Vector3::zeros(),
+                point: Vector3::zeros(),
+                depth: 0.0,
+                // Touching in the previous frame: an ongoing contact, which keeps what is
+                // left of its overlap allowance (usually nothing).
+                allowance: previous.map_or(0.0, |k| self.touching[k].1),
+                allowance_fresh: decided,
+                sub_impulse: Vector3::zeros(),
+                impulse: Vector3::zeros(),
+            });
         }
     }
 

@@ -42,6 +42,17 @@ pub(crate) struct Episode {
     seen: bool,
 }
 
+impl Episode {
+    fn new(key: (u64, (u32, u32)), approach: f32, compressing: bool) -> Episode {
+        Episode {
+            key,
+            approach,
+            compressing,
+            seen: false,
+        }
+    }
+}
+
 /// Centre-of-mass velocity and mass of the free particles of `p`.
 pub(crate) fn com_velocity(p: &Particles) -> (Vector3<f32>, f32) {
     let mut m = 0.0;
@@ -84,31 +95,9 @@ pub(crate) fn restitution_pass(
     let anchored = p.inv_masses().contains(&0.0);
     active_colliders(active, contacts, corners);
     for &ci in active.iter() {
-        let mut n = Vector3::zeros();
-        let mut q = Vector3::zeros();
-        let mut count = 0usize;
-        let mut e = 0.0f32;
-        for c in contacts
-            .iter()
-            .filter(|c| c.collider == ci && c.active && c.solve)
-        {
-            n += c.normal;
-            q += c.point;
-            count += 1;
-            e = e.max(c.restitution);
-        }
-        for k in corners.iter().filter(|k| k.collider == ci && k.active) {
-            n += k.normal;
-            q += k.point;
-            count += 1;
-            e = e.max(k.restitution);
-        }
-        let len = n.norm();
-        if count == 0 || len.is_nan() || len <= 1e-6 {
+        let Some((n, q, count, e)) = contact_patch(ci, contacts, corners) else {
             continue;
-        }
-        let n = n / len;
-        let q = q / count as f32;
+        };
         let cp = &colliders[ci];
         let vb = cp
             .body
@@ -121,15 +110,8 @@ pub(crate) fn restitution_pass(
                     .body
                     .map_or(Vector3::zeros(), |b| bodies[b].velocity_at_pre(&q));
                 let approach = n.dot(&(v_cm_pre - vb_pre));
-                episodes.insert(
-                    k,
-                    Episode {
-                        key,
-                        approach,
-                        compressing: approach < -threshold,
-                        seen: false,
-                    },
-                );
+                let compressing = approach < -threshold;
+                episodes.insert(k, Episode::new(key, approach, compressing));
                 k
             }
         };
@@ -177,6 +159,40 @@ pub(crate) fn restitution_pass(
             k.impulse += share;
         }
     }
+}
+
+/// The active contacts of a soft body with collider `ci`, as one patch: unit mean normal,
+/// mean point (world, m), number of contacts and the largest restitution coefficient.
+/// `None` without contacts or without a usable normal.
+fn contact_patch(
+    ci: usize,
+    contacts: &[ParticleContact],
+    corners: &[CornerContact],
+) -> Option<(Vector3<f32>, Vector3<f32>, usize, f32)> {
+    let mut n = Vector3::zeros();
+    let mut q = Vector3::zeros();
+    let mut count = 0usize;
+    let mut e = 0.0f32;
+    for c in contacts
+        .iter()
+        .filter(|c| c.collider == ci && c.active && c.solve)
+    {
+        n += c.normal;
+        q += c.point;
+        count += 1;
+        e = e.max(c.restitution);
+    }
+    for k in corners.iter().filter(|k| k.collider == ci && k.active) {
+        n += k.normal;
+        q += k.point;
+        count += 1;
+        e = e.max(k.restitution);
+    }
+    let len = n.norm();
+    if count == 0 || len.is_nan() || len <= 1e-6 {
+        return None;
+    }
+    Some((n / len, q / count as f32, count, e))
 }
 
 /// Fills `active` with the sorted, distinct collider indices of the solved particle

@@ -109,21 +109,7 @@ impl Gather {
         sep.clear();
         self.bodies.clear();
         self.pairs.clear();
-        self.list.clear();
-        for (e, _, _, _, sc) in world.query_mut::<(
-            Entity,
-            &Particles,
-            &Surface,
-            &Tetrahedra,
-            Option<&SelfCollision>,
-        )>() {
-            self.list.push((e.to_bits().get(), e, sc.is_some()));
-        }
-        self.list.sort_unstable_by_key(|l| l.0);
-        for c in &mut self.caches {
-            c.seen = self.list.binary_search_by_key(&c.key, |l| l.0).is_ok();
-        }
-        self.caches.retain(|c| c.seen);
+        self.list_bodies(world);
         let dt = if dt.is_finite() && dt > 0.0 { dt } else { 0.0 };
         let fall = 0.5 * s.max_acceleration * dt * dt;
         for li in 0..self.list.len() {
@@ -133,31 +119,7 @@ impl Gather {
             else {
                 continue;
             };
-            let ci = match self.caches.binary_search_by_key(&key, |c| c.key) {
-                Ok(ci) if self.caches[ci].cache.matches(surface, tets, p.len()) => Some(ci),
-                Ok(ci) => match BodyCache::build(surface, tets, p.len()) {
-                    Some(cache) => {
-                        self.caches[ci].cache = cache;
-                        Some(ci)
-                    }
-                    None => {
-                        self.caches.remove(ci);
-                        None
-                    }
-                },
-                Err(ci) => BodyCache::build(surface, tets, p.len()).map(|cache| {
-                    self.caches.insert(
-                        ci,
-                        CacheEntry {
-                            key,
-                            seen: true,
-                            cache,
-                        },
-                    );
-                    ci
-                }),
-            };
-            let Some(ci) = ci else {
+            let Some(ci) = self.cache_of(key, p, surface, tets) else {
                 stats.skipped_bodies += 1;
                 continue;
             };
@@ -170,19 +132,7 @@ impl Gather {
                 continue;
             }
             let offset = frame.x.len();
-            let (mut lo, mut hi) = (Vector3::repeat(f32::MAX), Vector3::repeat(f32::MIN));
-            for &i in &cache.vertices {
-                let i = i as usize;
-                let x = p.positions()[i];
-                let m = p.velocities()[i].norm() * dt + fall;
-                frame.x.push(x);
-                frame.x_prev.push(x);
-                frame.v.push(p.velocities()[i]);
-                frame.w.push(p.inv_masses()[i]);
-                frame.motion.push(m);
-                lo = lo.inf(&(x - Vector3::repeat(m)));
-                hi = hi.sup(&(x + Vector3::repeat(m)));
-            }
+            let (lo, hi) = load_particles(frame, p, &cache.vertices, dt, fall);
             if self_collide {
                 cache.ensure_rings();
             }
@@ -209,6 +159,74 @@ impl Gather {
         self.broad_phase(s.margin + s.thickness);
         stats.body_pairs = self.pairs.len();
         self.refit(world, frame);
+        self.pair_candidates(world, frame, s, sep, stats);
+        stats.candidates = frame.candidates.len();
+    }
+
+    /// Lists the soft bodies of `world` by entity bits and drops the caches of bodies gone.
+    fn list_bodies(&mut self, world: &mut World) {
+        self.list.clear();
+        for (e, _, _, _, sc) in world.query_mut::<(
+            Entity,
+            &Particles,
+            &Surface,
+            &Tetrahedra,
+            Option<&SelfCollision>,
+        )>() {
+            self.list.push((e.to_bits().get(), e, sc.is_some()));
+        }
+        self.list.sort_unstable_by_key(|l| l.0);
+        for c in &mut self.caches {
+            c.seen = self.list.binary_search_by_key(&c.key, |l| l.0).is_ok();
+        }
+        self.caches.retain(|c| c.seen);
+    }
+
+    /// The index of the body's cache (entity bits `key`), built or rebuilt when missing or
+    /// stale; `None` when the body has no usable cache.
+    fn cache_of(
+        &mut self,
+        key: u64,
+        p: &Particles,
+        surface: &Surface,
+        tets: &Tetrahedra,
+    ) -> Option<usize> {
+        match self.caches.binary_search_by_key(&key, |c| c.key) {
+            Ok(ci) if self.caches[ci].cache.matches(surface, tets, p.len()) => Some(ci),
+            Ok(ci) => match BodyCache::build(surface, tets, p.len()) {
+                Some(cache) => {
+                    self.caches[ci].cache = cache;
+                    Some(ci)
+                }
+                None => {
+                    self.caches.remove(ci);
+                    None
+                }
+            },
+            Err(ci) => BodyCache::build(surface, tets, p.len()).map(|cache| {
+                self.caches.insert(
+                    ci,
+                    CacheEntry {
+                        key,
+                        seen: true,
+                        cache,
+                    },
+                );
+                ci
+            }),
+        }
+    }
+
+    /// The candidates of every body pair (both ways, and the pair's deep-overlap separation)
+    /// and of every self-colliding body; marks the bodies that some candidate refers to.
+    fn pair_candidates(
+        &mut self,
+        world: &mut World,
+        frame: &mut ContactFrame,
+        s: &SoftContactSettings,
+        sep: &mut Separation,
+        stats: &mut SoftContactStats,
+    ) {
         for k in 0..self.pairs.len() {
             let (a, b) = self.pairs[k];
             let c0 = frame.candidates.len();
@@ -238,7 +256,6 @@ impl Gather {
                 self.bodies[b].involved = true;
             }
         }
-        stats.candidates = frame.candidates.len();
     }
 
     fn side<'s>(&'s self, k: usize, deep: &'s [Vector3<f32>], frame: &'s ContactFrame) -> Side<'s> {
@@ -399,4 +416,29 @@ fn candidate(p: u32, tri: [u32; 3], recovery: bool, depth_limit: f32) -> Candida
         n: Vector3::zeros(),
         bary: [1.0 / 3.0; 3],
     }
+}
+
+/// Appends a body's surface particles (`vertices`) to the frame's slots with their motion
+/// bound `|v| dt + fall` (m); returns the bounds of their swept neighbourhoods, m.
+fn load_particles(
+    frame: &mut ContactFrame,
+    p: &Particles,
+    vertices: &[u32],
+    dt: f32,
+    fall: f32,
+) -> (Vector3<f32>, Vector3<f32>) {
+    let (mut lo, mut hi) = (Vector3::repeat(f32::MAX), Vector3::repeat(f32::MIN));
+    for &i in vertices {
+        let i = i as usize;
+        let x = p.positions()[i];
+        let m = p.velocities()[i].norm() * dt + fall;
+        frame.x.push(x);
+        frame.x_prev.push(x);
+        frame.v.push(p.velocities()[i]);
+        frame.w.push(p.inv_masses()[i]);
+        frame.motion.push(m);
+        lo = lo.inf(&(x - Vector3::repeat(m)));
+        hi = hi.sup(&(x + Vector3::repeat(m)));
+    }
+    (lo, hi)
 }
