@@ -305,6 +305,16 @@ impl Coupling {
             self.solver.step_with(world, &mut (hook, extra))?
         };
         let mut stats = std::mem::take(&mut self.frame.stats);
+        self.write_back(ctx.bodies, &mut stats);
+        stats.soft = soft;
+        stats.rigid_time = rigid_time;
+        stats.total_time = start.elapsed();
+        Ok(stats)
+    }
+
+    /// Hands the soft reaction to the rapier bodies the soft bodies touched (module docs of
+    /// [`Coupling`], step 3), and the anchored bodies' reaction to their dynamic supports.
+    fn write_back(&mut self, bodies: &mut RigidBodySet, stats: &mut CouplingStats) {
         // Only the bodies that get a reaction are borrowed mutably: `get_mut` marks a body
         // as modified for rapier's next step.
         for b in self
@@ -313,7 +323,7 @@ impl Coupling {
             .iter()
             .filter(|b| b.is_dynamic() && b.touched)
         {
-            if let Some(rb) = ctx.bodies.get_mut(b.handle) {
+            if let Some(rb) = bodies.get_mut(b.handle) {
                 if b.write_back(rb) {
                     stats.bodies_written += 1;
                     if let Some((force, torque)) = b.load() {
@@ -326,16 +336,12 @@ impl Coupling {
         }
         // The reaction of the anchored bodies' pushes on their dynamic supports.
         for (handle, j, l) in self.frame.supports.iter().filter_map(support_reaction) {
-            if let Some(rb) = ctx.bodies.get_mut(handle) {
+            if let Some(rb) = bodies.get_mut(handle) {
                 if !apply_reaction(rb, &j, &l) {
                     stats.non_finite_bodies += 1;
                 }
             }
         }
-        stats.soft = soft;
-        stats.rigid_time = rigid_time;
-        stats.total_time = start.elapsed();
-        Ok(stats)
     }
 }
 

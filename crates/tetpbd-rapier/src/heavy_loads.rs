@@ -173,8 +173,8 @@ pub(crate) fn stacking_pass(
     }
     // Roots: particles in contact with an immovable support in this substep. (Those in
     // contact at any time in the frame would change less often, but keep particles frozen
-    // that already left the support: the slab jumping out of the ground's contact skin at
-    // the start then reached 1.6–3.1 m/s instead of 0.7–2.2.)
+    // that already left the support, which speeds up a body jumping out of the ground's
+    // contact skin.)
     let supported = contacts
         .iter()
         .filter(|c| c.active && c.solve && immovable(&s.colliders[c.collider], s.bodies))
@@ -198,52 +198,7 @@ pub(crate) fn stacking_pass(
     if !heavy {
         return Some(false);
     }
-    // The dynamic bodies against the frozen soft surface.
-    s.pinned.clear();
-    s.pinned.extend((0..p.len()).map(|i| p.is_pinned(i)));
-    for i in 0..p.len() {
-        // In range by construction.
-        let _ = p.set_pinned(i, true);
-    }
-    // Only the runs of dynamic colliders (candidates are gathered collider by collider):
-    // against a frozen surface nothing else can move.
-    let mut i = 0;
-    while i < contacts.len() {
-        let end = run_end(contacts, i, |c| c.collider);
-        if dynamic(&s.colliders[contacts[i].collider], s.bodies).is_some() {
-            project_contacts(
-                &mut contacts[i..end],
-                p,
-                s.bodies,
-                s.colliders,
-                s.set,
-                s.max_push,
-            );
-        }
-        i = end;
-    }
-    let mut i = 0;
-    while i < corners.len() {
-        let end = run_end(corners, i, |k| k.collider);
-        if dynamic(&s.colliders[corners[i].collider], s.bodies).is_some() {
-            project_corners(
-                &mut corners[i..end],
-                contacts,
-                p,
-                surface,
-                s.bodies,
-                s.colliders,
-                s.set,
-                CornerPass::Frozen,
-            );
-        }
-        i = end;
-    }
-    for (i, &was) in s.pinned.iter().enumerate() {
-        if !was {
-            let _ = p.set_pinned(i, false);
-        }
-    }
+    project_on_frozen_surface(contacts, corners, p, surface, s);
     Some(true)
 }
 
@@ -309,6 +264,63 @@ pub(crate) fn stacked_velocity_pass(
         let w = body.inv_mass_at(&q, &n);
         if vn > 0.0 && w > 0.0 {
             body.apply_velocity_impulse(&(n * (vn / w)), &q);
+        }
+    }
+}
+
+/// The contacts of dynamic bodies projected once more against the soft surface frozen (every
+/// particle pinned for the pass, then unpinned again unless it was pinned before).
+fn project_on_frozen_surface(
+    contacts: &mut [ParticleContact],
+    corners: &mut [CornerContact],
+    p: &mut Particles,
+    surface: &Surface,
+    s: &mut Stacking<'_>,
+) {
+    // The dynamic bodies against the frozen soft surface.
+    s.pinned.clear();
+    s.pinned.extend((0..p.len()).map(|i| p.is_pinned(i)));
+    for i in 0..p.len() {
+        // In range by construction.
+        let _ = p.set_pinned(i, true);
+    }
+    // Only the runs of dynamic colliders (candidates are gathered collider by collider):
+    // against a frozen surface nothing else can move.
+    let mut i = 0;
+    while i < contacts.len() {
+        let end = run_end(contacts, i, |c| c.collider);
+        if dynamic(&s.colliders[contacts[i].collider], s.bodies).is_some() {
+            project_contacts(
+                &mut contacts[i..end],
+                p,
+                s.bodies,
+                s.colliders,
+                s.set,
+                s.max_push,
+            );
+        }
+        i = end;
+    }
+    let mut i = 0;
+    while i < corners.len() {
+        let end = run_end(corners, i, |k| k.collider);
+        if dynamic(&s.colliders[corners[i].collider], s.bodies).is_some() {
+            project_corners(
+                &mut corners[i..end],
+                contacts,
+                p,
+                surface,
+                s.bodies,
+                s.colliders,
+                s.set,
+                CornerPass::Frozen,
+            );
+        }
+        i = end;
+    }
+    for (i, &was) in s.pinned.iter().enumerate() {
+        if !was {
+            let _ = p.set_pinned(i, false);
         }
     }
 }

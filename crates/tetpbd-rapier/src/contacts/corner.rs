@@ -188,12 +188,9 @@ fn sweep_corners(
         };
         let idx = tri.map(|i| i as usize);
         let [a, b, c] = idx.map(|i| p.positions()[i]);
-        let m = (b - a).cross(&(c - a));
-        let area2 = m.norm();
-        if area2.is_nan() || area2 <= 1e-12 {
+        let Some((n, area2)) = unit_normal(&a, &b, &c) else {
             continue;
-        }
-        let n = m / area2;
+        };
         // In the ordinary pass a vertex holding the collider rules the triangle out for a
         // support point (a crossing there is only taken in the crossing pass); a polyhedral
         // corner is never left to a vertex (module docs).
@@ -237,11 +234,8 @@ fn sweep_corners(
         // plane, so triangles on the far side of the body never grab it.
         let crossing = fast.then(|| {
             let v_start = (cp.prev_pose(bodies) * Point3::from(local)).coords;
-            let v_prev = v_start + (a - p.prev_positions()[idx[0]]);
-            let s_prev = (v_prev - a).dot(&n);
-            let fast_point = (v - v_start).norm_squared() > (0.1 * shortest).powi(2);
-            (s_prev > 0.0 && s < 0.0 && fast_point)
-                .then(|| v_prev + (v - v_prev) * (s_prev / (s_prev - s)))
+            let a_prev = p.prev_positions()[idx[0]];
+            crossing_point(&v, &v_start, &a, &a_prev, &n, shortest)
         });
         let q = if let Some(Some(q)) = crossing {
             q
@@ -256,6 +250,39 @@ fn sweep_corners(
         let hit = Hit { v, n, c_val, beta };
         push_out(k, p, idx, bodies, cp.body, &hit);
     }
+}
+
+/// Unit outward normal and twice the area of triangle `(a, b, c)`; `None` when degenerate.
+fn unit_normal(
+    a: &Vector3<f32>,
+    b: &Vector3<f32>,
+    c: &Vector3<f32>,
+) -> Option<(Vector3<f32>, f32)> {
+    let m = (b - a).cross(&(c - a));
+    let area2 = m.norm();
+    if area2.is_nan() || area2 <= 1e-12 {
+        return None;
+    }
+    Some((m / area2, area2))
+}
+
+/// Where the rigid point (now at `v`, at `v_start` at the substep start) crossed the plane of
+/// a triangle (vertex `a`, at `a_prev` at the substep start; unit normal `n`) from the front
+/// within the substep, its motion taken relative to the triangle; `None` if it did not or
+/// moved less than a tenth of the triangle's `shortest` edge.
+fn crossing_point(
+    v: &Vector3<f32>,
+    v_start: &Vector3<f32>,
+    a: &Vector3<f32>,
+    a_prev: &Vector3<f32>,
+    n: &Vector3<f32>,
+    shortest: f32,
+) -> Option<Vector3<f32>> {
+    let s = (v - a).dot(n);
+    let v_prev = v_start + (a - a_prev);
+    let s_prev = (v_prev - a).dot(n);
+    let fast_point = (v - v_start).norm_squared() > (0.1 * shortest).powi(2);
+    (s_prev > 0.0 && s < 0.0 && fast_point).then(|| v_prev + (v - v_prev) * (s_prev / (s_prev - s)))
 }
 
 /// The rigid point of `k` in its collider's frame: the polyhedral corner, or the support

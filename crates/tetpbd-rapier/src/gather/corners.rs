@@ -33,14 +33,7 @@ pub(crate) fn gather_corners(
     corners: &mut Corners,
 ) {
     // The soft body's surface over the frame, in the collider's frame (at its end pose).
-    let mut lo = Vector3::repeat(f32::INFINITY);
-    let mut hi = Vector3::repeat(f32::NEG_INFINITY);
-    for &i in surface.vertices() {
-        let x = p.positions()[i as usize];
-        let y = x + p.velocities()[i as usize] * dt;
-        lo = lo.inf(&x.inf(&y));
-        hi = hi.sup(&x.sup(&y));
-    }
+    let (lo, hi) = swept_bounds(p, surface.vertices(), dt);
     let near = Aabb::new(to_glam(&lo), to_glam(&hi))
         .loosened(thickness)
         .transform_by(&pose_to_glam(&pose.inverse()));
@@ -57,14 +50,7 @@ pub(crate) fn gather_corners(
     let reach = thickness + max_extra;
     let first = out.len();
     for (t, tri) in surface.triangles().iter().enumerate() {
-        let mut lo = Vector3::repeat(f32::INFINITY);
-        let mut hi = Vector3::repeat(f32::NEG_INFINITY);
-        for &i in tri {
-            let x = p.positions()[i as usize];
-            let y = x + p.velocities()[i as usize] * dt;
-            lo = lo.inf(&x.inf(&y));
-            hi = hi.sup(&x.sup(&y));
-        }
+        let (lo, hi) = swept_bounds(p, tri, dt);
         let ta = Aabb::new(to_glam(&lo), to_glam(&hi)).loosened(reach);
         if !ta.intersects(collider_aabb) {
             continue;
@@ -94,31 +80,67 @@ pub(crate) fn gather_corners(
             }) {
                 continue;
             }
-            out.push(CornerContact {
+            out.push(CornerContact::candidate(
                 collider,
-                run: 0,
                 corner,
-                triangle: t as u32,
-                vertex_contacts: vc,
-                thickness: thickness + extra,
-                restitution,
-                active: false,
-                mu_d,
-                mu_s,
-                lambda_n: 0.0,
-                lambda_t: 0.0,
-                ever_active: false,
-                depth: 0.0,
-                normal: Vector3::zeros(),
-                point: Vector3::zeros(),
-                beta: [0.0; 3],
-                sub_impulse: Vector3::zeros(),
-                impulse: Vector3::zeros(),
-            });
+                t as u32,
+                vc,
+                thickness + extra,
+                (mu_d, mu_s, restitution),
+            ));
         }
     }
     let run = out.len() - first;
     if let Some(k) = out.get_mut(first) {
         k.run = u32::try_from(run).unwrap_or(u32::MAX);
+    }
+}
+
+/// Bounds of particles `indices` over the frame (their positions and their predicted
+/// positions one frame on), m.
+fn swept_bounds(p: &Particles, indices: &[u32], dt: f32) -> (Vector3<f32>, Vector3<f32>) {
+    let mut lo = Vector3::repeat(f32::INFINITY);
+    let mut hi = Vector3::repeat(f32::NEG_INFINITY);
+    for &i in indices {
+        let x = p.positions()[i as usize];
+        let y = x + p.velocities()[i as usize] * dt;
+        lo = lo.inf(&x.inf(&y));
+        hi = hi.sup(&x.sup(&y));
+    }
+    (lo, hi)
+}
+
+impl CornerContact {
+    /// A fresh candidate of rigid point `corner` (`None`: the support point) over soft
+    /// triangle `triangle`.
+    fn candidate(
+        collider: usize,
+        corner: Option<Vector3<f32>>,
+        triangle: u32,
+        vertex_contacts: [Option<usize>; 3],
+        thickness: f32,
+        (mu_d, mu_s, restitution): (f32, f32, f32),
+    ) -> CornerContact {
+        CornerContact {
+            collider,
+            run: 0,
+            corner,
+            triangle,
+            vertex_contacts,
+            thickness,
+            restitution,
+            active: false,
+            mu_d,
+            mu_s,
+            lambda_n: 0.0,
+            lambda_t: 0.0,
+            ever_active: false,
+            depth: 0.0,
+            normal: Vector3::zeros(),
+            point: Vector3::zeros(),
+            beta: [0.0; 3],
+            sub_impulse: Vector3::zeros(),
+            impulse: Vector3::zeros(),
+        }
     }
 }

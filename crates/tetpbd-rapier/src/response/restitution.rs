@@ -133,21 +133,10 @@ pub(crate) fn restitution_pass(
         } else {
             continue;
         };
-        let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_at(&q, &n));
         let w_soft = if anchored { 0.0 } else { 1.0 / mass };
-        let j = dv / (w_soft + w_b);
-        if !j.is_finite() {
+        let Some(j) = bounce(p, w_soft, bodies, cp.body, (&n, &q), dv) else {
             continue;
-        }
-        let dv_soft = n * (j * w_soft);
-        for i in 0..p.len() {
-            if p.inv_masses()[i] > 0.0 {
-                p.velocities_mut()[i] += dv_soft;
-            }
-        }
-        if let Some(b) = cp.body {
-            bodies[b].apply_velocity_impulse(&(-n * j), &q);
-        }
+        };
         let share = n * (j / count as f32);
         for c in contacts
             .iter_mut()
@@ -159,6 +148,35 @@ pub(crate) fn restitution_pass(
             k.impulse += share;
         }
     }
+}
+
+/// Changes the relative normal velocity at the patch (unit normal `n` towards the soft
+/// body, point `q`) by `dv` (m/s): the soft body's free particles (inverse mass `w_soft`,
+/// 1/kg) all get the same velocity change, the rigid body the opposite impulse at `q`.
+/// Returns the impulse (N·s), `None` when it is not finite.
+fn bounce(
+    p: &mut Particles,
+    w_soft: f32,
+    bodies: &mut [BodyProxy],
+    body: Option<usize>,
+    (n, q): (&Vector3<f32>, &Vector3<f32>),
+    dv: f32,
+) -> Option<f32> {
+    let w_b = body.map_or(0.0, |b| bodies[b].inv_mass_at(q, n));
+    let j = dv / (w_soft + w_b);
+    if !j.is_finite() {
+        return None;
+    }
+    let dv_soft = n * (j * w_soft);
+    for i in 0..p.len() {
+        if p.inv_masses()[i] > 0.0 {
+            p.velocities_mut()[i] += dv_soft;
+        }
+    }
+    if let Some(b) = body {
+        bodies[b].apply_velocity_impulse(&(-n * j), q);
+    }
+    Some(j)
 }
 
 /// The active contacts of a soft body with collider `ci`, as one patch: unit mean normal,

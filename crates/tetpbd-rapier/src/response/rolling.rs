@@ -79,47 +79,15 @@ pub(crate) fn rolling_pass(
         return;
     };
     for &ci in active.iter() {
-        let mut lambda = 0.0f32;
-        let mut q = Vector3::zeros();
-        let mut count = 0usize;
-        for c in contacts
-            .iter()
-            .filter(|c| c.collider == ci && c.active && c.solve)
-        {
-            lambda += c.lambda_n;
-            q += c.point;
-            count += 1;
-        }
-        for k in corners.iter().filter(|k| k.collider == ci && k.active) {
-            lambda += k.lambda_n;
-            q += k.point;
-            count += 1;
-        }
-        if count == 0 || lambda.is_nan() || lambda <= 0.0 {
+        let Some((lambda, q)) = normal_load(ci, contacts, corners) else {
             continue;
-        }
-        let q = q / count as f32;
+        };
         let cp = &colliders[ci];
         let w_collider = cp
             .body
             .map_or(Vector3::zeros(), |b| angular_velocity(&bodies[b]));
         let w_rel = fit.omega - w_collider;
-        let mut stop = fit.inertia * w_rel;
-        // A dynamic body turns back under the reaction: the angular impulse that stops the
-        // relative rotation is smaller by the ratio of the two bodies' inverse inertias
-        // about its axis (`I_s⁻¹` of the soft body, `I_b⁻¹` of the rigid one).
-        if let Some(b) = cp.body {
-            let rigid = inv_inertia_about(&bodies[b], &stop);
-            if rigid > 0.0 {
-                let soft = fit
-                    .inertia
-                    .try_inverse()
-                    .map_or(0.0, |inv| inv_inertia_along(&inv, &stop));
-                if soft > 0.0 {
-                    stop *= soft / (soft + rigid);
-                }
-            }
-        }
+        let stop = stopping_impulse(&fit, &w_rel, cp.body.map(|b| &bodies[b]));
         let need = stop.norm();
         let cap = coefficient * (lambda / h) * (q - fit.x_cm).norm();
         if need.is_nan() || need <= 0.0 || !cap.is_finite() {
@@ -147,6 +115,60 @@ pub(crate) fn rolling_pass(
 }
 
 /// `ûᵀ I⁻¹ û` for the unit direction `û` of `axis`, 1/(kg·m²); 0 for a zero axis.
+/// Summed normal multiplier (kg·m) and mean point (world, m) of a soft body's active
+/// contacts with collider `ci`; `None` without a load.
+fn normal_load(
+    ci: usize,
+    contacts: &[ParticleContact],
+    corners: &[CornerContact],
+) -> Option<(f32, Vector3<f32>)> {
+    let mut lambda = 0.0f32;
+    let mut q = Vector3::zeros();
+    let mut count = 0usize;
+    for c in contacts
+        .iter()
+        .filter(|c| c.collider == ci && c.active && c.solve)
+    {
+        lambda += c.lambda_n;
+        q += c.point;
+        count += 1;
+    }
+    for k in corners.iter().filter(|k| k.collider == ci && k.active) {
+        lambda += k.lambda_n;
+        q += k.point;
+        count += 1;
+    }
+    if count == 0 || lambda.is_nan() || lambda <= 0.0 {
+        return None;
+    }
+    Some((lambda, q / count as f32))
+}
+
+/// The angular impulse (kg·m²/s) that stops the soft body's rotation `w_rel` relative to
+/// the collider. A dynamic body turns back under the reaction: the impulse is then smaller
+/// by the ratio of the two bodies' inverse inertias about its axis (`I_s⁻¹` of the soft
+/// body, `I_b⁻¹` of the rigid one).
+fn stopping_impulse(
+    fit: &RigidFit,
+    w_rel: &Vector3<f32>,
+    body: Option<&BodyProxy>,
+) -> Vector3<f32> {
+    let mut stop = fit.inertia * w_rel;
+    if let Some(body) = body {
+        let rigid = inv_inertia_about(body, &stop);
+        if rigid > 0.0 {
+            let soft = fit
+                .inertia
+                .try_inverse()
+                .map_or(0.0, |inv| inv_inertia_along(&inv, &stop));
+            if soft > 0.0 {
+                stop *= soft / (soft + rigid);
+            }
+        }
+    }
+    stop
+}
+
 fn inv_inertia_along(inv: &nalgebra::Matrix3<f32>, axis: &Vector3<f32>) -> f32 {
     let u = axis.try_normalize(0.0).unwrap_or_else(Vector3::zeros);
     u.dot(&(inv * u))
