@@ -4,7 +4,7 @@ use hecs::Entity;
 use nalgebra::Vector3;
 
 /// A soft body taking part in the frame; its surface particles occupy the slots
-/// `offset..offset + len` of the [`ContactFrame`] arrays.
+/// `offset..offset + len` of the [`ContactFrame`](super::gather::ContactFrame) arrays.
 #[derive(Clone, Debug)]
 pub(crate) struct FrameBody {
     pub entity: Entity,

@@ -99,6 +99,8 @@ use crate::error::CouplingError;
 use crate::soft_soft::gather::{ContactFrame, Gather};
 use crate::soft_soft::restitution::body_restitution;
 use crate::soft_soft::separation::Separation;
+#[cfg(doc)]
+use settings::SelfCollision;
 use settings::{SoftContactSettings, SoftContactStats};
 
 /// Soft–soft and self collision of the `tetpbd` bodies of a world, run inside the soft

@@ -1,6 +1,8 @@
 //! Settings and statistics of soft–soft contacts, and the self-collision marker.
 
 use crate::error::CouplingError;
+#[cfg(doc)]
+use crate::SoftContacts;
 
 /// Opt-in marker component: this soft body also collides with itself (surface particles
 /// against its own surface triangles, excluding those of their tetrahedron neighbours).
