@@ -3,7 +3,6 @@
 
 mod coupling_common;
 
-use coupling_common::to_na;
 use coupling_common::{ground, soft_box_with_density};
 use hecs::Entity;
 use nalgebra::Vector3;
@@ -113,7 +112,7 @@ fn sample(
     anchor_local: Vector3<f32>,
 ) -> Sample {
     let rb = &scene.physics.bodies[body];
-    let pose = coupling_common::pose_to_na(rb.position());
+    let pose = nalgebra::Isometry3::from(*rb.position());
     let mut particle_speed = 0.0f32;
     let mut finite = true;
     let mut inverted = 0;
@@ -144,8 +143,8 @@ fn sample(
     }
     Sample {
         particle_speed,
-        box_speed: to_na(rb.linvel()).norm(),
-        box_spin: to_na(rb.angvel()).norm(),
+        box_speed: Vector3::from(rb.linvel()).norm(),
+        box_spin: Vector3::from(rb.angvel()).norm(),
         gap,
         box_at: pose.translation.vector,
         upright: (pose.rotation * Vector3::y()).y,

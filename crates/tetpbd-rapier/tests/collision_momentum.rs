@@ -2,7 +2,6 @@
 
 mod coupling_common;
 
-use coupling_common::to_na;
 use coupling_common::{particles, scene, soft_ball};
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
@@ -30,7 +29,7 @@ fn total_linear_momentum_is_conserved() {
     );
     let momentum = |s: &tetpbd_rapier::CoupledWorld| {
         let b = &s.physics.bodies[boxh];
-        particles(s, ball).linear_momentum() + to_na(b.linvel()) * b.mass()
+        particles(s, ball).linear_momentum() + Vector3::from(b.linvel()) * b.mass()
     };
     let p0 = momentum(&s);
     let mut touched = false;
@@ -39,7 +38,7 @@ fn total_linear_momentum_is_conserved() {
         touched |= stats.contacts > 0;
     }
     let p1 = momentum(&s);
-    let vbox = to_na(s.physics.bodies[boxh].linvel());
+    let vbox = Vector3::from(s.physics.bodies[boxh].linvel());
     let err = (p1 - p0).norm() / p0.norm();
     println!(
         "momentum before {p0:?}, after {p1:?}: relative error {err:.2e}; box velocity {vbox:?}"

@@ -2,7 +2,6 @@
 
 mod coupling_common;
 
-use coupling_common::to_na;
 use coupling_common::{particles, scene};
 use hecs::Entity;
 use nalgebra::Vector3;
@@ -101,7 +100,7 @@ fn swings_a_hinged_dynamic_body() {
         let stats = s.step().expect("step");
         worst = worst.max(stats.max_attachment_error);
     }
-    let w = to_na(s.physics.bodies[wheel].angvel());
+    let w = Vector3::from(s.physics.bodies[wheel].angvel());
     let angle = s.physics.bodies[wheel].rotation().to_scaled_axis().z;
     let tip = particles(&s, e).aabb().0.y;
     println!("after 0.5 s: hinge angle {angle:.3} rad, ω {w:?}, attachment error {worst:.2e} m, beam low {tip:.3} m");
@@ -132,14 +131,14 @@ fn momentum_is_shared_with_a_free_body() {
     }
     let momentum = |s: &CoupledWorld| {
         let b = &s.physics.bodies[free];
-        particles(s, e).linear_momentum() + to_na(b.linvel()) * b.mass()
+        particles(s, e).linear_momentum() + Vector3::from(b.linvel()) * b.mass()
     };
     let p0 = momentum(&s);
     for _ in 0..60 {
         s.step().expect("step");
     }
     let p1 = momentum(&s);
-    let vb = to_na(s.physics.bodies[free].linvel());
+    let vb = Vector3::from(s.physics.bodies[free].linvel());
     let err = (p1 - p0).norm() / p0.norm();
     println!("momentum {p0:?} -> {p1:?} (relative error {err:.2e}), body velocity {vb:?}");
     assert!(err < 0.01);

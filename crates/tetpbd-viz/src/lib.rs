@@ -35,7 +35,6 @@
 mod camera;
 mod error;
 mod export;
-mod glam;
 mod mesh;
 mod options;
 mod png_out;

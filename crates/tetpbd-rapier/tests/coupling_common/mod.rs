@@ -3,8 +3,8 @@
 #![allow(dead_code)]
 
 use hecs::Entity;
-use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
-use rapier3d::math::{Pose, Vector};
+use nalgebra::Vector3;
+use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, ColliderHandle, RigidBodyBuilder, RigidBodyHandle};
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings, Tetrahedra};
@@ -179,18 +179,4 @@ pub fn volume_ratio(scene: &CoupledWorld, e: Entity) -> f32 {
 /// Lowest particle height, m.
 pub fn min_y(scene: &CoupledWorld, e: Entity) -> f32 {
     particles(scene, e).aabb().0.y
-}
-
-/// rapier's glam vector → nalgebra.
-pub fn to_na(v: Vector) -> Vector3<f32> {
-    Vector3::new(v.x, v.y, v.z)
-}
-
-/// rapier's glam pose → nalgebra.
-pub fn pose_to_na(p: &Pose) -> Isometry3<f32> {
-    let r = p.rotation;
-    Isometry3::from_parts(
-        Translation3::from(to_na(p.translation)),
-        UnitQuaternion::new_normalize(Quaternion::new(r.w, r.x, r.y, r.z)),
-    )
 }
