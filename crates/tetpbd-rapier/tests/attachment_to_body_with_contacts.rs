@@ -306,8 +306,8 @@ fn soft_cube_attached_to_a_box_on_the_ground() {
 
 /// Scene (a) with a compliant attachment (1e-5 m/N, 100 kg soft cube). The anchor lies 1 cm
 /// above the box top (where the particle started), so the cube's weight compresses the
-/// spring by up to about 1 cm before the cube rests on the box (7.6 mm measured with a fixed
-/// box): the attachment is held to 1.2 cm once settled.
+/// spring by up to about 1 cm before the cube rests on the box: the attachment is held to
+/// 1.2 cm once settled.
 ///
 /// Guards against a gain of energy: the rocking cube lifts the box off the ground through
 /// the spring, and soft impulses pressing the box into its supports must then move it back

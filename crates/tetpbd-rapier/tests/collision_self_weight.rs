@@ -54,7 +54,7 @@ fn rest(self_weight: bool) -> Rest {
     r
 }
 
-/// The sweep cuts the resting sag of a cube at least threefold (measured: 5.8×) and the cube stays at rest.
+/// The sweep cuts the resting sag of a cube at least threefold and the cube stays at rest.
 #[test]
 fn self_weight_sweep_cuts_the_resting_volume_error() {
     let off = rest(false);
