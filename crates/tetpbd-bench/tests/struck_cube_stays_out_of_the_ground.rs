@@ -7,7 +7,7 @@
 //! frames (about 1 s) and checks every substep's end.
 
 use tetpbd::hecs::{Entity, World};
-use tetpbd::{Particles, SubstepHook};
+use tetpbd::{Particles, SubstepContext, SubstepHook};
 use tetpbd_bench::{tetpbd_contact_world, ContactScene};
 use tetpbd_rapier::{SoftContactSettings, SoftContacts};
 
@@ -18,7 +18,7 @@ struct Lowest {
 }
 
 impl SubstepHook for Lowest {
-    fn end_substep(&mut self, world: &mut World, _h: f32) {
+    fn end_substep(&mut self, world: &mut World, _substep: SubstepContext) {
         for &e in &self.bodies {
             let p = world.get::<&Particles>(e).unwrap();
             for x in p.positions() {

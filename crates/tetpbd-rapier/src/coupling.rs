@@ -26,9 +26,9 @@ use crate::substep::CouplingHook;
 pub struct RapierContext<'a> {
     /// The integrator's physics pipeline.
     pub pipeline: &'a mut PhysicsPipeline,
-    /// Gravity, m/s² (also used for the soft bodies).
+    /// Gravity, m/s²: the scene's, for the rigid and the soft bodies alike.
     pub gravity: Vector,
-    /// Integration parameters; their `dt` is the frame time of the soft bodies too.
+    /// Integration parameters; their `dt` is the scene's frame time, for the soft bodies too.
     pub integration_parameters: &'a IntegrationParameters,
     /// Islands.
     pub islands: &'a mut IslandManager,
@@ -83,8 +83,8 @@ impl<'a> RapierContext<'a> {
 /// 1. Every non-fixed rigid body's pose `P₀` is recorded, then **rapier steps first**
 ///    (`PhysicsPipeline::step` with the borrowed state): rigid–rigid contacts, joints,
 ///    gravity on rigid bodies, kinematic targets. Bodies end at `P₁`.
-/// 2. **The soft substeps run** ([`tetpbd::Solver::step_with`], `dt` and gravity taken from
-///    rapier). Once per frame, surface particles and rigid corners near each collider are
+/// 2. **The soft substeps run** ([`tetpbd::Solver::step_frame`] over rapier's `dt`, under
+///    rapier's gravity). Once per frame, surface particles and rigid corners near each collider are
 ///    gathered from rapier's broad-phase BVH. In every substep each rigid body stands at the
 ///    interpolation of `P₀ → P₁` plus the offset the soft body pushed it by; contacts and
 ///    attachments are XPBD constraints projected after the soft body's own constraints, with
@@ -198,8 +198,8 @@ pub struct Coupling {
 }
 
 impl Coupling {
-    /// A coupling with validated settings. The solver's `dt` and `gravity` are replaced by
-    /// rapier's at every step.
+    /// A coupling with validated settings. The solver's `dt` and `gravity` are not used: the
+    /// frame's are rapier's.
     pub fn new(solver: SolverSettings, settings: CouplingSettings) -> Result<Self, CouplingError> {
         settings.validate()?;
         Ok(Coupling {
@@ -236,7 +236,7 @@ impl Coupling {
     }
 
     /// Advances rapier and every soft body of `world` by one frame (see the type docs for
-    /// the order). Settings are validated before anything moves.
+    /// the order). Settings and rapier's `dt` and gravity are checked before anything moves.
     pub fn step(
         &mut self,
         world: &mut World,
@@ -264,9 +264,7 @@ impl Coupling {
         if !gravity.iter().all(|g| g.is_finite()) {
             return Err(CouplingError::NonFiniteGravity);
         }
-        self.solver.settings.dt = dt;
-        self.solver.settings.gravity = gravity;
-        self.solver.settings.validate()?;
+        self.solver.settings.validate_frame(dt, gravity)?;
 
         self.frame.capture_start(ctx.bodies);
         let rigid_time = step_rapier(&mut ctx);
@@ -278,9 +276,6 @@ impl Coupling {
             }
         }
 
-        self.frame.dt = dt;
-        self.frame.substeps = self.solver.settings.substeps;
-        self.frame.gravity = gravity.norm();
         self.frame.stats = CouplingStats::default();
         let soft = {
             let qp = ctx.broad_phase.as_query_pipeline(
@@ -298,11 +293,10 @@ impl Coupling {
                 max_depenetration_speed: self.settings.max_depenetration_speed,
                 stacking_mass_ratio: self.settings.stacking_mass_ratio,
                 self_weight_stacking: self.settings.self_weight_stacking,
-                order: self.solver.settings.order,
-                kernel: self.solver.settings.kernel,
                 reports: &mut self.reports,
             };
-            self.solver.step_with(world, &mut (hook, extra))?
+            self.solver
+                .step_frame(world, dt, gravity, &mut (hook, extra))?
         };
         let mut stats = std::mem::take(&mut self.frame.stats);
         self.write_back(ctx.bodies, &mut stats);

@@ -22,11 +22,11 @@
 //! 1. the particles in an active contact with an immovable support, and pinned particles,
 //!    are the roots (the levels are kept while the roots stay the same);
 //! 2. the body's own constraints are projected once more, level by level away from the
-//!    roots, with the roots held ([`tetpbd::project_stacked`]): each level is corrected
+//!    roots, with the roots held ([`tetpbd::GroundUpSweep`]): each level is corrected
 //!    against the levels below it, which were corrected just before, so the support's
 //!    reaction reaches the top of the body within the sweep. (Holding every lower level,
 //!    as shock propagation holds the lower bodies of a rigid stack, blew bodies of 8 levels
-//!    and more up under a heavy box: `tetpbd::project_stacked`'s docs.)
+//!    and more up under a heavy box: the module docs of the core's `stabilisation::ground_up`.)
 //! 3. with every particle frozen, the contacts and rigid-point contacts of the dynamic
 //!    bodies are projected once more: a heavy body is pushed out of the soft surface
 //!    entirely instead of pushing the particles into the body.
@@ -57,10 +57,7 @@
 
 use hecs::{Entity, World};
 use rapier3d::geometry::ColliderSet;
-use tetpbd::{
-    project_stacked, BodyConstraints, EdgeConstraints, Family, Particles, StackingLayers, Surface,
-    Tetrahedra, VertexFaceConstraints, VolumeConstraints,
-};
+use tetpbd::{GroundUpSweep, Particles, SubstepContext, Surface};
 
 use crate::contacts::corner::{project_corners, CornerContact, CornerPass};
 use crate::contacts::particle::project_contacts;
@@ -68,27 +65,24 @@ use crate::contacts::particle::ParticleContact;
 use crate::rigid::body::{BodyKind, BodyProxy};
 use crate::rigid::collider::ColliderProxy;
 use nalgebra::Vector3;
-use tetpbd::systems::Kernel;
 
 /// What the pass borrows besides one soft body's contacts.
 pub(crate) struct Stacking<'a> {
     pub bodies: &'a mut [BodyProxy],
     pub colliders: &'a [ColliderProxy],
     pub set: &'a ColliderSet,
-    /// Levels of this soft body, kept across substeps and frames (rebuilt when the entity
-    /// or its mesh size changes).
-    pub layers: &'a mut (Option<Entity>, StackingLayers),
+    /// The ground-up sweep of this soft body, kept across substeps and frames (its levels
+    /// are rebuilt when the entity, its mesh size or its roots change).
+    pub sweep: &'a mut GroundUpSweep,
     /// Scratch: which particles were pinned before freezing.
     pub pinned: &'a mut Vec<bool>,
-    pub order: [Family; 3],
-    /// The solver's projection kernel.
-    pub kernel: Kernel,
     /// Mass ratio from which a dynamic body counts as heavy.
     pub ratio: f32,
     /// `CouplingSettings::self_weight_stacking`: the sweep (step 2) runs without a heavy
     /// load too.
     pub self_weight: bool,
-    pub h: f32,
+    /// The substep (its length, and the solver's family order and kernel for the sweep).
+    pub substep: SubstepContext,
     pub max_push: f32,
 }
 
@@ -157,47 +151,29 @@ pub(crate) fn stacking_pass(
     corners: &mut [CornerContact],
     s: &mut Stacking<'_>,
 ) -> Option<bool> {
-    let Ok((p, tets, surface, edges, vertex_face, volume)) = world.query_one_mut::<(
-        &mut Particles,
-        &Tetrahedra,
-        &Surface,
-        Option<&mut EdgeConstraints>,
-        Option<&mut VertexFaceConstraints>,
-        Option<&mut VolumeConstraints>,
-    )>(entity) else {
-        return None;
-    };
+    let (p, surface) = world.query_one_mut::<(&Particles, &Surface)>(entity).ok()?;
     let heavy = carries_heavy(contacts, corners, p, surface, s);
     if !heavy && !s.self_weight {
         return None;
     }
-    // Roots: particles in contact with an immovable support in this substep. (Those in
-    // contact at any time in the frame would change less often, but keep particles frozen
-    // that already left the support, which speeds up a body jumping out of the ground's
-    // contact skin.)
+    // Roots: particles in contact with an immovable support in this substep (the sweep adds
+    // the pinned ones). (Those in contact at any time in the frame would change less often,
+    // but keep particles frozen that already left the support, which speeds up a body
+    // jumping out of the ground's contact skin.)
     let supported = contacts
         .iter()
         .filter(|c| c.active && c.solve && immovable(&s.colliders[c.collider], s.bodies))
         .map(|c| c.particle);
-    let pinned = (0..p.len() as u32).filter(|&i| p.inv_masses()[i as usize] == 0.0);
-    let (owner, layers) = &mut *s.layers;
-    if *owner != Some(entity) || !layers.fits(p.len(), tets) {
-        *layers = StackingLayers::new(p.len(), tets);
-        *owner = Some(entity);
-    }
-    let top = layers.set_roots(tets, edges.as_deref(), supported.chain(pinned));
-    if top == 0 {
+    let levels = s.sweep.project(world, entity, supported, &s.substep);
+    if levels.unwrap_or(0) == 0 {
         return None;
     }
-    let families = BodyConstraints {
-        edges,
-        vertex_face,
-        volume,
-    };
-    project_stacked(p, tets, families, s.order, s.h, layers, s.kernel);
     if !heavy {
         return Some(false);
     }
+    let (p, surface) = world
+        .query_one_mut::<(&mut Particles, &Surface)>(entity)
+        .ok()?;
     project_on_frozen_surface(contacts, corners, p, surface, s);
     Some(true)
 }

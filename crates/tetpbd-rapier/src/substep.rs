@@ -3,7 +3,7 @@
 use hecs::World;
 use rapier3d::geometry::NarrowPhase;
 use rapier3d::pipeline::QueryPipeline;
-use tetpbd::{Particles, SubstepHook, Surface};
+use tetpbd::{FrameContext, Particles, SubstepContext, SubstepHook, Surface};
 
 use crate::attachments::{anchor_of, project_attachments, Attachments};
 use crate::contacts::corner::{project_corners, CornerPass};
@@ -32,21 +32,19 @@ pub(crate) struct CouplingHook<'q, 'a> {
     pub stacking_mass_ratio: f32,
     /// `CouplingSettings::self_weight_stacking`.
     pub self_weight_stacking: bool,
-    /// The solver's family order (the stacking pass projects in it).
-    pub order: [tetpbd::Family; 3],
-    /// The solver's projection kernel (the stacking pass's sweep runs with it).
-    pub kernel: tetpbd::systems::Kernel,
     pub reports: &'q mut Vec<ContactReport>,
 }
 
-impl CouplingHook<'_, '_> {
-    fn frac(&self) -> f32 {
-        (self.frame.substep as f32 / self.frame.substeps.max(1) as f32).min(1.0)
-    }
+/// The fraction of the frame elapsed at the end of `substep`: where the rigid bodies stand
+/// on their `P₀ → P₁` path during it.
+fn frac(substep: &SubstepContext) -> f32 {
+    ((substep.substep() + 1) as f32 / substep.substeps().max(1) as f32).min(1.0)
 }
 
 impl SubstepHook for CouplingHook<'_, '_> {
-    fn begin_frame(&mut self, world: &mut World, _dt: f32) {
+    fn begin_frame(&mut self, world: &mut World, frame: FrameContext) {
+        self.frame.dt = frame.dt();
+        self.frame.gravity = frame.gravity().norm();
         let input = GatherInput {
             qp: &self.qp,
             narrow_phase: self.narrow_phase,
@@ -56,15 +54,15 @@ impl SubstepHook for CouplingHook<'_, '_> {
         self.frame.gather(world, &input);
     }
 
-    fn begin_substep(&mut self, world: &mut World, h: f32) {
-        self.frame.substep += 1;
+    fn begin_substep(&mut self, world: &mut World, substep: SubstepContext) {
+        let h = substep.h();
         for s in &mut self.frame.soft {
             s.stacked = false;
             if let Ok(p) = world.query_one_mut::<&Particles>(s.entity) {
                 s.v_cm_pre = com_velocity(p).0;
             }
         }
-        let frac = self.frac();
+        let frac = frac(&substep);
         for b in &mut self.frame.bodies {
             b.begin_substep(frac, h);
         }
@@ -74,8 +72,8 @@ impl SubstepHook for CouplingHook<'_, '_> {
         }
     }
 
-    fn project(&mut self, world: &mut World, h: f32) {
-        let frac = self.frac();
+    fn project(&mut self, world: &mut World, substep: SubstepContext) {
+        let (frac, h) = (frac(&substep), substep.h());
         let Frame {
             soft,
             bodies,
@@ -85,15 +83,15 @@ impl SubstepHook for CouplingHook<'_, '_> {
             attachments,
             supports,
             stats,
-            layers,
+            sweeps,
             pinned,
             ..
         } = &mut *self.frame;
-        if layers.len() < soft.len() {
-            layers.resize_with(soft.len(), Default::default);
+        if sweeps.len() < soft.len() {
+            sweeps.resize_with(soft.len(), Default::default);
         }
         measure_clearance(supports, bodies);
-        for (s, cache) in soft.iter_mut().zip(layers.iter_mut()) {
+        for (s, sweep) in soft.iter_mut().zip(sweeps.iter_mut()) {
             let Ok((p, surface)) = world.query_one_mut::<(&mut Particles, &Surface)>(s.entity)
             else {
                 continue;
@@ -131,13 +129,11 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 bodies,
                 colliders,
                 set: self.qp.colliders,
-                layers: cache,
+                sweep,
                 pinned,
-                order: self.order,
-                kernel: self.kernel,
                 ratio: self.stacking_mass_ratio,
                 self_weight: self.self_weight_stacking,
-                h,
+                substep,
                 max_push: self.max_depenetration_speed * h,
             };
             let t = std::time::Instant::now();
@@ -156,7 +152,8 @@ impl SubstepHook for CouplingHook<'_, '_> {
         project_supports(supports, bodies);
     }
 
-    fn end_substep(&mut self, world: &mut World, h: f32) {
+    fn end_substep(&mut self, world: &mut World, substep: SubstepContext) {
+        let h = substep.h();
         let threshold = 2.0 * self.frame.gravity * h;
         let Frame {
             soft,
@@ -235,7 +232,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
         }
     }
 
-    fn end_frame(&mut self, world: &mut World, _dt: f32) {
+    fn end_frame(&mut self, world: &mut World, _frame: FrameContext) {
         self.frame.remember_touching();
         let frame = &mut *self.frame;
         self.reports.clear();

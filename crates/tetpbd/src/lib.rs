@@ -58,12 +58,12 @@ pub use body::mesh::{Surface, Tetrahedra};
 pub use body::particles::{ExternalAcceleration, Particles};
 pub use error::{BuildError, SettingsError, StateError};
 pub use ordering::ColourClasses;
-pub use solver::hook::SubstepHook;
+pub use solver::hook::{FrameContext, SubstepContext, SubstepHook};
 pub use solver::settings::SolverSettings;
 pub use solver::stats::{ErrorAccumulator, ErrorStats, FamilyStats, StepStats};
 pub use solver::step::Solver;
 pub use solver::systems;
-pub use stabilisation::ground_up::{project_stacked, BodyConstraints, StackingLayers};
+pub use stabilisation::ground_up_sweep::GroundUpSweep;
 
 /// The constraint math under its former name; the same module as [`constraints`].
 #[doc(hidden)]

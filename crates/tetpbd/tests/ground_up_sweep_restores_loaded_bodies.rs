@@ -5,8 +5,8 @@ use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::systems::Kernel;
 use tetpbd::{
-    project_stacked, BodyConstraints, EdgeConstraints, Family, Particles, SoftBodyBuilder,
-    StackingLayers, Tetrahedra, VertexFaceConstraints, VolumeConstraints,
+    EdgeConstraints, FrameContext, GroundUpSweep, Particles, SoftBodyBuilder, SolverSettings,
+    SubstepContext, Tetrahedra,
 };
 
 /// A column of three cells standing on y = 0; returns the entity and its bottom particles.
@@ -35,35 +35,51 @@ fn column_of(world: &mut World, families: &str, cells: [u32; 3]) -> (hecs::Entit
     (e, bottom)
 }
 
+/// The context of a substep of 1/600 s (the default 1/60 s frame in 10 substeps) with
+/// `kernel`.
+fn substep(kernel: Kernel) -> SubstepContext {
+    let settings = SolverSettings {
+        kernel,
+        ..SolverSettings::default()
+    };
+    FrameContext::new(&settings, settings.dt, settings.gravity).substep(0, 0)
+}
+
 #[test]
 fn levels_count_cells_from_the_roots() {
     let mut world = World::new();
     let (e, bottom) = column(&mut world, "edges+volume");
     assert_eq!(bottom.len(), 4);
-    let (p, tets, edges) = world
-        .query_one_mut::<(&Particles, &Tetrahedra, &EdgeConstraints)>(e)
-        .unwrap();
-    let mut layers = StackingLayers::new(p.len(), tets);
-    assert!(layers.fits(p.len(), tets));
-    let top = layers.set_roots(tets, Some(edges), bottom.iter().copied());
-    assert_eq!(top, 3);
-    for (i, x) in p.positions().iter().enumerate() {
+    let positions = world.get::<&Particles>(e).unwrap().positions().to_vec();
+    let ctx = substep(Kernel::Simd);
+    let mut sweep = GroundUpSweep::new();
+    let top = sweep.project(&mut world, e, bottom.iter().copied(), &ctx);
+    assert_eq!(top, Ok(3));
+    for (i, x) in positions.iter().enumerate() {
         let expected = (x.y / 0.2).round() as u32;
-        assert_eq!(layers.level(i), Some(expected), "particle {i} at {x:?}");
+        assert_eq!(sweep.level(i), Some(expected), "particle {i} at {x:?}");
     }
     // The same roots again (in another order): the same levels.
-    let again = layers.set_roots(tets, Some(edges), bottom.iter().rev().copied());
-    assert_eq!(again, 3);
+    let again = sweep.project(&mut world, e, bottom.iter().rev().copied(), &ctx);
+    assert_eq!(again, Ok(3));
     // One root: the column is reached from one corner.
-    let one = layers.set_roots(tets, Some(edges), [bottom[0]]);
+    let one = sweep.project(&mut world, e, [bottom[0]], &ctx).unwrap();
     assert!(one >= 3, "{one}");
-    assert_eq!(layers.level(bottom[0] as usize), Some(0));
+    assert_eq!(sweep.level(bottom[0] as usize), Some(0));
     // No roots: nothing reached.
-    assert_eq!(layers.set_roots(tets, Some(edges), []), 0);
-    assert_eq!(layers.level(0), None);
-    // Built for another body.
-    assert!(!StackingLayers::new(p.len() + 1, tets).fits(p.len(), tets));
-    assert!(!StackingLayers::default().fits(p.len(), tets));
+    assert_eq!(sweep.project(&mut world, e, [], &ctx), Ok(0));
+    assert_eq!(sweep.level(0), None);
+    // Pinned particles are roots too.
+    world
+        .get::<&mut Particles>(e)
+        .unwrap()
+        .set_pinned(bottom[1] as usize, true)
+        .unwrap();
+    assert!(sweep.project(&mut world, e, [], &ctx).unwrap() >= 3);
+    assert_eq!(sweep.level(bottom[1] as usize), Some(0));
+    // An entity that is not a soft body.
+    let empty = world.spawn(());
+    assert!(sweep.project(&mut world, empty, [], &ctx).is_err());
 }
 
 /// Largest edge error `| |x_i − x_j| − d |` of a body, m.
@@ -87,39 +103,18 @@ fn sweep_with(world: &mut World, e: hecs::Entity, bottom: &[u32], kernel: Kernel
     sweep_kept(world, e, bottom, kernel, &mut None);
 }
 
-/// [`sweep_with`] on the layers in `kept` (built there on the first call), as a caller
-/// that keeps them across sweeps does.
+/// [`sweep_with`] with the sweep in `kept` (created there on the first call), as a
+/// caller that keeps it across sweeps does.
 fn sweep_kept(
     world: &mut World,
     e: hecs::Entity,
     bottom: &[u32],
     kernel: Kernel,
-    kept: &mut Option<StackingLayers>,
+    kept: &mut Option<GroundUpSweep>,
 ) {
-    let (p, tets, edges, vf, vol) = world
-        .query_one_mut::<(
-            &mut Particles,
-            &Tetrahedra,
-            Option<&mut EdgeConstraints>,
-            Option<&mut VertexFaceConstraints>,
-            Option<&mut VolumeConstraints>,
-        )>(e)
-        .unwrap();
-    let layers = kept.get_or_insert_with(|| StackingLayers::new(p.len(), tets));
-    layers.set_roots(tets, edges.as_deref(), bottom.iter().copied());
-    project_stacked(
-        p,
-        tets,
-        BodyConstraints {
-            edges,
-            vertex_face: vf,
-            volume: vol,
-        },
-        Family::ALL,
-        1.0 / 600.0,
-        layers,
-        kernel,
-    );
+    let sweep = kept.get_or_insert_with(GroundUpSweep::new);
+    let levels = sweep.project(world, e, bottom.iter().copied(), &substep(kernel));
+    assert!(levels.unwrap() > 0);
 }
 
 /// The top of the column pushed down by 5 cm: ground-up sweeps with hard constraints
@@ -246,8 +241,8 @@ fn simd_sweep_agrees_with_the_scalar_reference() {
     }
 }
 
-/// Layers kept across sweeps and changes of the roots (as the coupling keeps them) sweep
-/// exactly as layers built afresh for each set of roots.
+/// A sweep kept across sweeps and changes of the roots (as the coupling keeps it) sweeps
+/// exactly as one built afresh for each set of roots.
 #[test]
 fn kept_layers_sweep_as_fresh_ones() {
     for families in ["edges+volume", "vertex-face+edges"] {
@@ -266,7 +261,7 @@ fn kept_layers_sweep_as_fresh_ones() {
         let mut fresh_world = World::new();
         let (b, _) = squashed(&mut fresh_world);
         let root_sets = [bottom.clone(), bottom[..3].to_vec(), bottom.clone()];
-        let mut kept: Option<StackingLayers> = None;
+        let mut kept: Option<GroundUpSweep> = None;
         for roots in &root_sets {
             sweep_kept(&mut kept_world, a, roots, Kernel::Simd, &mut kept);
             sweep(&mut fresh_world, b, roots);
@@ -285,47 +280,33 @@ fn kept_layers_sweep_as_fresh_ones() {
     }
 }
 
-/// Layers built for another body (other particle and tetrahedron counts) leave the body
-/// alone.
+/// One sweep kept for two bodies of different sizes, called on each in turn, sweeps each as
+/// a sweep of its own.
 #[test]
-fn layers_of_another_body_do_nothing() {
-    let mut world = World::new();
-    let (a, bottom) = column_of(&mut world, "edges+volume", [2, 3, 2]);
-    let (b, _) = column_of(&mut world, "edges+volume", [2, 2, 2]);
-    let mut layers = {
-        let (p, tets, edges) = world
-            .query_one_mut::<(&Particles, &Tetrahedra, &EdgeConstraints)>(a)
-            .unwrap();
-        let mut l = StackingLayers::new(p.len(), tets);
-        assert!(l.set_roots(tets, Some(edges), bottom.iter().copied()) > 0);
-        l
+fn a_sweep_shared_by_two_bodies_sweeps_each_as_its_own() {
+    let squash = |world: &mut World, e: hecs::Entity| {
+        for x in world.get::<&mut Particles>(e).unwrap().positions_mut() {
+            x.y *= 0.9;
+        }
     };
-    let (p, tets, edges, vol) = world
-        .query_one_mut::<(
-            &mut Particles,
-            &Tetrahedra,
-            &mut EdgeConstraints,
-            &mut VolumeConstraints,
-        )>(b)
-        .unwrap();
-    for x in p.positions_mut() {
-        x.y *= 0.9;
+    let mut shared_world = World::new();
+    let (a, bottom_a) = column_of(&mut shared_world, "edges+volume", [2, 3, 2]);
+    let (b, bottom_b) = column_of(&mut shared_world, "edges+volume", [2, 2, 2]);
+    let mut own_world = World::new();
+    let (c, _) = column_of(&mut own_world, "edges+volume", [2, 3, 2]);
+    let (d, _) = column_of(&mut own_world, "edges+volume", [2, 2, 2]);
+    squash(&mut shared_world, a);
+    squash(&mut shared_world, b);
+    squash(&mut own_world, c);
+    squash(&mut own_world, d);
+    let (mut shared, mut own_c, mut own_d) = (None, None, None);
+    for _ in 0..3 {
+        sweep_kept(&mut shared_world, a, &bottom_a, Kernel::Simd, &mut shared);
+        sweep_kept(&mut shared_world, b, &bottom_b, Kernel::Simd, &mut shared);
+        sweep_kept(&mut own_world, c, &bottom_a, Kernel::Simd, &mut own_c);
+        sweep_kept(&mut own_world, d, &bottom_b, Kernel::Simd, &mut own_d);
     }
-    let before = p.positions().to_vec();
-    let families = BodyConstraints {
-        edges: Some(edges),
-        vertex_face: None,
-        volume: Some(vol),
-    };
-    let count = project_stacked(
-        p,
-        tets,
-        families,
-        Family::ALL,
-        1.0 / 600.0,
-        &mut layers,
-        Kernel::Simd,
-    );
-    assert_eq!(count.applied, 0);
-    assert_eq!(p.positions(), &before[..]);
+    let x = |w: &World, e| w.get::<&Particles>(e).unwrap().positions().to_vec();
+    assert_eq!(x(&shared_world, a), x(&own_world, c));
+    assert_eq!(x(&shared_world, b), x(&own_world, d));
 }

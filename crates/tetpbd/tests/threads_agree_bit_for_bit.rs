@@ -5,14 +5,14 @@ mod common;
 
 use std::time::Duration;
 
-use tetpbd::{Particles, Solver, SolverSettings, SubstepHook};
+use tetpbd::{Particles, Solver, SolverSettings, SubstepContext, SubstepHook};
 
 /// A hook slower than the time the step's helper threads wait for work (they leave, and the
 /// passes after it wake the pool through rayon instead).
 struct Slow;
 
 impl SubstepHook for Slow {
-    fn begin_substep(&mut self, _: &mut hecs::World, _: f32) {
+    fn begin_substep(&mut self, _: &mut hecs::World, _: SubstepContext) {
         std::thread::sleep(Duration::from_millis(2));
     }
 }

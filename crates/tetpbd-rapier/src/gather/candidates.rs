@@ -44,7 +44,6 @@ impl Frame {
         self.corners.clear();
         self.attachments.clear();
         self.supports.clear();
-        self.substep = 0;
         let qp = input.qp;
         crate::ccd::fast_colliders(
             &mut self.fast,

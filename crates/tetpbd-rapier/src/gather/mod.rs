@@ -74,9 +74,9 @@ pub(crate) struct Frame {
     /// Force (N) and torque (N·m) added to bodies for rapier's next step (the load of the
     /// previous frame, `BodyProxy::load`), taken off again after that step.
     pub loads: Vec<(RigidBodyHandle, Vector3<f32>, Vector3<f32>)>,
-    /// Levels of the stacking pass (`heavy_loads` module docs), one per soft body (by its
-    /// index in `soft`), kept across frames.
-    pub layers: Vec<(Option<Entity>, tetpbd::StackingLayers)>,
+    /// Ground-up sweeps of the stacking pass (`heavy_loads` module docs), one per soft body
+    /// (by its index in `soft`), kept across frames.
+    pub sweeps: Vec<tetpbd::GroundUpSweep>,
     /// Scratch of the stacking pass: which particles were pinned before it froze them.
     pub pinned: Vec<bool>,
     near: Vec<ColliderHandle>,
@@ -90,9 +90,9 @@ pub(crate) struct Frame {
     pub active_colliders: Vec<usize>,
     /// Impact episodes in progress (kept across frames).
     pub episodes: Vec<Episode>,
-    pub substep: u32,
-    pub substeps: u32,
+    /// Frame length, s (the solver's, `begin_frame`).
     pub dt: f32,
+    /// Magnitude of the frame's gravity, m/s².
     pub gravity: f32,
     pub stats: CouplingStats,
 }

@@ -93,7 +93,7 @@ pub(crate) mod separation;
 pub(crate) mod settings;
 
 use hecs::World;
-use tetpbd::SubstepHook;
+use tetpbd::{FrameContext, SubstepContext, SubstepHook};
 
 use crate::error::CouplingError;
 use crate::soft_soft::gather::{ContactFrame, Gather};
@@ -181,11 +181,11 @@ impl std::fmt::Debug for SoftContacts {
 }
 
 impl SubstepHook for SoftContacts {
-    fn begin_frame(&mut self, world: &mut World, dt: f32) {
+    fn begin_frame(&mut self, world: &mut World, frame: FrameContext) {
         self.stats = SoftContactStats::default();
         self.gather.run(
             world,
-            dt,
+            frame.dt(),
             &self.settings,
             &mut self.frame,
             &mut self.separation,
@@ -193,33 +193,34 @@ impl SubstepHook for SoftContacts {
         );
     }
 
-    fn begin_substep(&mut self, world: &mut World, h: f32) {
+    fn begin_substep(&mut self, world: &mut World, substep: SubstepContext) {
         self.frame
             .begin_substep(world, &self.gather, &self.settings);
         self.separation.apply(
             world,
             &self.gather.bodies,
             &self.settings,
-            h,
+            substep.h(),
             &mut self.stats,
         );
     }
 
-    fn project(&mut self, world: &mut World, h: f32) {
+    fn project(&mut self, world: &mut World, substep: SubstepContext) {
+        let h = substep.h();
         self.frame
             .project(world, &self.gather, &self.settings, h, &mut self.stats);
     }
 
-    fn end_substep(&mut self, world: &mut World, h: f32) {
+    fn end_substep(&mut self, world: &mut World, substep: SubstepContext) {
         self.separation
-            .remove_velocity(world, &self.gather.bodies, h);
+            .remove_velocity(world, &self.gather.bodies, substep.h());
         self.frame.velocity_pass(world, &self.gather);
         if self.settings.inelastic {
             body_restitution(world, &self.gather, &self.frame, &mut self.pair_normals);
         }
     }
 
-    fn end_frame(&mut self, world: &mut World, _dt: f32) {
+    fn end_frame(&mut self, world: &mut World, _frame: FrameContext) {
         self.frame.finish(world, &self.gather, &mut self.stats);
     }
 }

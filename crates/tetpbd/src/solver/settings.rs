@@ -12,7 +12,11 @@ use crate::solver::systems;
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SolverSettings {
-    /// Frame time step, s (> 0).
+    /// Frame time step, s (> 0). The length of a frame of [`Solver::step`](crate::Solver::step)
+    /// and [`Solver::step_with`](crate::Solver::step_with); not used by
+    /// [`Solver::step_frame`](crate::Solver::step_frame), whose caller gives the frame's length
+    /// (in a scene coupled to rapier, rapier's `IntegrationParameters::dt` is the frame's, and
+    /// `tetpbd-rapier` rejects a value here other than the default or rapier's).
     pub dt: f32,
     /// Substeps per frame (≥ 1); each has length `h = dt / substeps`.
     pub substeps: u32,
@@ -20,7 +24,11 @@ pub struct SolverSettings {
     /// Physics Simulation") show that spending a budget on substeps beats iterations, so the
     /// default is many substeps of one iteration.
     pub iterations: u32,
-    /// Gravity, m/s².
+    /// Gravity, m/s². Used by [`Solver::step`](crate::Solver::step) and
+    /// [`Solver::step_with`](crate::Solver::step_with); not by
+    /// [`Solver::step_frame`](crate::Solver::step_frame), whose caller gives the frame's
+    /// gravity (in a scene coupled to rapier, rapier's gravity is the frame's, and
+    /// `tetpbd-rapier` rejects a value here other than the default or rapier's).
     pub gravity: Vector3<f32>,
     /// Linear velocity damping, 1/s (0 = none).
     pub damping: f32,
@@ -113,5 +121,17 @@ impl SolverSettings {
     /// Substep length `dt / substeps`, s.
     pub fn substep_dt(&self) -> f32 {
         self.dt / self.substeps as f32
+    }
+
+    /// [`SolverSettings::validate`] for a frame of length `dt` (s) under `gravity` (m/s²)
+    /// given by the caller: those are checked in place of the settings' own `dt` and
+    /// `gravity`, which are not looked at ([`crate::Solver::step_frame`]).
+    pub fn validate_frame(&self, dt: f32, gravity: Vector3<f32>) -> Result<(), SettingsError> {
+        SolverSettings {
+            dt,
+            gravity,
+            ..self.clone()
+        }
+        .validate()
     }
 }

@@ -4,10 +4,11 @@
 use std::time::{Duration, Instant};
 
 use hecs::World;
+use nalgebra::Vector3;
 
 use crate::error::SettingsError;
 use crate::kernels::working_copy::{self, CopyMode};
-use crate::solver::hook::SubstepHook;
+use crate::solver::hook::{FrameContext, SubstepHook};
 use crate::solver::settings::SolverSettings;
 use crate::solver::stats::StepStats;
 use crate::solver::systems;
@@ -50,15 +51,34 @@ impl Solver {
         world: &mut World,
         hook: &mut dyn SubstepHook,
     ) -> Result<StepStats, SettingsError> {
-        self.settings.validate()?;
+        let (dt, gravity) = (self.settings.dt, self.settings.gravity);
+        self.step_frame(world, dt, gravity, hook)
+    }
+
+    /// Advances every soft body by one frame of length `dt` (s) under `gravity` (m/s²),
+    /// running `hook` inside the substep loop: [`Solver::step_with`] with the frame's length
+    /// and gravity given by the caller instead of taken from the settings, whose `dt` and
+    /// `gravity` are neither used nor changed. For a caller whose clock and gravity belong
+    /// to another engine, as a coupled scene's belong to its rigid-body engine. Both are
+    /// validated as the settings' own would be ([`SettingsError::BadDt`],
+    /// [`SettingsError::NonFiniteGravity`]).
+    pub fn step_frame(
+        &mut self,
+        world: &mut World,
+        dt: f32,
+        gravity: Vector3<f32>,
+        hook: &mut dyn SubstepHook,
+    ) -> Result<StepStats, SettingsError> {
+        self.settings.validate_frame(dt, gravity)?;
+        let frame = FrameContext::new(&self.settings, dt, gravity);
         // With the `parallel` feature and a body large enough for a parallel pass, the pool's
         // other threads stay awake for the step (crate::parallel::team), so the passes need not wake
         // them.
         #[cfg(feature = "parallel")]
         if crate::parallel::sweeps::any_parallel(world) {
-            return crate::parallel::team::with_team(|| self.run_step(world, hook));
+            return crate::parallel::team::with_team(|| self.run_step(world, frame, hook));
         }
-        self.run_step(world, hook)
+        self.run_step(world, frame, hook)
     }
 
     /// One frame with validated settings: the frame starts here, each substep in
@@ -66,6 +86,7 @@ impl Solver {
     fn run_step(
         &self,
         world: &mut World,
+        frame: FrameContext,
         hook: &mut dyn SubstepHook,
     ) -> Result<StepStats, SettingsError> {
         let s = &self.settings;
@@ -82,15 +103,14 @@ impl Solver {
             stats.vertex_face.before = Some(m.vertex_face);
             stats.volume.before = Some(m.volume);
         }
-        let h = s.substep_dt();
         let t = Instant::now();
-        hook.begin_frame(world, s.dt);
+        hook.begin_frame(world, frame);
         let mut hook_time = t.elapsed();
-        for _ in 0..s.substeps {
-            self.substep(world, hook, h, &mut stats, &mut hook_time);
+        for i in 0..s.substeps {
+            self.substep(world, hook, frame, i, &mut stats, &mut hook_time);
         }
         let t = Instant::now();
-        hook.end_frame(world, s.dt);
+        hook.end_frame(world, frame);
         hook_time += t.elapsed();
         stats.hook_time = hook_time;
         if s.measure_error {
@@ -106,27 +126,30 @@ impl Solver {
         Ok(stats)
     }
 
-    /// One substep of length `h`: prediction, `iterations` iterations, the velocity update.
+    /// Substep `index` of `frame` (length `h = dt / substeps`): prediction, `iterations`
+    /// iterations, the velocity update.
     fn substep(
         &self,
         world: &mut World,
         hook: &mut dyn SubstepHook,
-        h: f32,
+        frame: FrameContext,
+        index: u32,
         stats: &mut StepStats,
         hook_time: &mut Duration,
     ) {
         let s = &self.settings;
+        let h = frame.h();
         let t = Instant::now();
-        systems::predict(world, h, s.gravity, s.damping);
+        systems::predict(world, h, frame.gravity(), s.damping);
         systems::reset_lambdas(world);
         stats.predict_time += t.elapsed();
         let t = Instant::now();
-        hook.begin_substep(world, h);
+        hook.begin_substep(world, frame.substep(index, 0));
         *hook_time += t.elapsed();
-        for _ in 0..s.iterations {
+        for k in 0..s.iterations {
             self.iteration(world, h, stats);
             let t = Instant::now();
-            hook.project(world, h);
+            hook.project(world, frame.substep(index, k));
             *hook_time += t.elapsed();
         }
         let t = Instant::now();
@@ -135,7 +158,7 @@ impl Solver {
         stats.velocity_clamps += u.clamped;
         stats.velocity_time += t.elapsed();
         let t = Instant::now();
-        hook.end_substep(world, h);
+        hook.end_substep(world, frame.substep(index, 0));
         *hook_time += t.elapsed();
     }
 

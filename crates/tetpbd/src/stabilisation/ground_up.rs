@@ -68,7 +68,7 @@ const UNREACHED: u32 = u32::MAX;
 /// ([`project_stacked`]). Built for one body ([`StackingLayers::new`]); keeps its
 /// allocations, and its levels while the roots stay the same.
 #[derive(Clone, Debug, Default)]
-pub struct StackingLayers {
+pub(crate) struct StackingLayers {
     /// Per particle: distance from the roots in tetrahedra, [`UNREACHED`] when none.
     level: Vec<u32>,
     /// Per particle, the tetrahedra it belongs to (compressed rows).
@@ -103,7 +103,7 @@ pub struct StackingLayers {
 
 impl StackingLayers {
     /// Layers of a body with `n` particles and tetrahedra `tets`, with no roots yet.
-    pub fn new(n: usize, tets: &Tetrahedra) -> Self {
+    pub(crate) fn new(n: usize, tets: &Tetrahedra) -> Self {
         let mut s = StackingLayers {
             level: vec![UNREACHED; n],
             used: vec![0; n],
@@ -119,7 +119,7 @@ impl StackingLayers {
 
     /// Whether these layers were built for a body with `n` particles and tetrahedra `tets`
     /// (by their counts).
-    pub fn fits(&self, n: usize, tets: &Tetrahedra) -> bool {
+    pub(crate) fn fits(&self, n: usize, tets: &Tetrahedra) -> bool {
         self.level.len() == n
             && self.used.len() == n
             && self.first.len() == n + 1
@@ -132,7 +132,7 @@ impl StackingLayers {
     /// The levels are only recomputed when the set of roots differs from the previous
     /// call's. Returns the highest level reached (0 when there are no roots, or the layers
     /// do not fit `tets`).
-    pub fn set_roots(
+    pub(crate) fn set_roots(
         &mut self,
         tets: &Tetrahedra,
         edges: Option<&EdgeConstraints>,
@@ -208,7 +208,7 @@ impl StackingLayers {
     }
 
     /// Level of particle `i` (`None` when no root reaches it or `i` is out of range).
-    pub fn level(&self, i: usize) -> Option<u32> {
+    pub(crate) fn level(&self, i: usize) -> Option<u32> {
         self.level.get(i).copied().filter(|&l| l != UNREACHED)
     }
 
@@ -314,13 +314,13 @@ fn held_masks(
 }
 
 /// The constraint families of one body, as [`project_stacked`] borrows them.
-pub struct BodyConstraints<'a> {
+pub(crate) struct BodyConstraints<'a> {
     /// Edge distance constraints, if the body has them.
-    pub edges: Option<&'a mut EdgeConstraints>,
+    pub(crate) edges: Option<&'a mut EdgeConstraints>,
     /// Vertex–face constraints, if the body has them.
-    pub vertex_face: Option<&'a mut VertexFaceConstraints>,
+    pub(crate) vertex_face: Option<&'a mut VertexFaceConstraints>,
     /// Volume constraints, if the body has them.
-    pub volume: Option<&'a mut VolumeConstraints>,
+    pub(crate) volume: Option<&'a mut VolumeConstraints>,
 }
 
 /// One ground-up sweep over a body's constraints (module docs), with the levels of the
@@ -336,7 +336,7 @@ pub struct BodyConstraints<'a> {
 /// one, the reference). Of the vertex–face constraints only the heights of the level's own
 /// vertices are projected. The roots are held by setting their inverse mass to 0 in the
 /// working copy for the sweep.
-pub fn project_stacked(
+pub(crate) fn project_stacked(
     p: &mut Particles,
     tets: &Tetrahedra,
     families: BodyConstraints<'_>,

@@ -6,11 +6,13 @@
 //! * [`momentum_restoration`] — giving back, as a rigid velocity change, the momentum the
 //!   correction-speed safety net ([`crate::SolverSettings::max_correction_speed`]) clamped;
 //! * [`ground_up`] — one more sweep ordered from a body's supports outwards, for heavy loads
-//!   on light bodies (its level order in [`ground_up_levels`]), called by a coupling;
+//!   on light bodies (its level order in [`ground_up_levels`]), offered as one call by
+//!   [`ground_up_sweep`] ([`crate::GroundUpSweep`]) to a hook such as a coupling's;
 //! * [`rigid_fit`] — the rigid fit of a field on a body's particles both momentum passes use.
 
 pub(crate) mod angular_momentum;
 pub(crate) mod ground_up;
 pub(crate) mod ground_up_levels;
+pub(crate) mod ground_up_sweep;
 pub(crate) mod momentum_restoration;
 pub(crate) mod rigid_fit;
