@@ -4,6 +4,7 @@
 use std::time::{Duration, Instant};
 
 use hecs::World;
+use nalgebra::Vector3;
 use rapier3d::dynamics::{
     CCDSolver, ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet,
     RigidBodySet, SoftBodySet,
@@ -84,7 +85,7 @@ impl<'a> RapierContext<'a> {
 ///    (`PhysicsPipeline::step` with the borrowed state): rigid–rigid contacts, joints,
 ///    gravity on rigid bodies, kinematic targets. Bodies end at `P₁`.
 /// 2. **The soft substeps run** ([`tetpbd::Solver::step_frame`] over rapier's `dt`, under
-///    rapier's gravity). Once per frame, surface particles and rigid corners near each collider are
+///    rapier's gravity: "Time step and gravity" below). Once per frame, surface particles and rigid corners near each collider are
 ///    gathered from rapier's broad-phase BVH. In every substep each rigid body stands at the
 ///    interpolation of `P₀ → P₁` plus the offset the soft body pushed it by; contacts and
 ///    attachments are XPBD constraints projected after the soft body's own constraints, with
@@ -129,6 +130,19 @@ impl<'a> RapierContext<'a> {
 /// relative to the collider cast as a ray; a rigid point that crossed a surface triangle's
 /// plane caught where it crossed, in a pass before the particle contacts). A body the soft
 /// contacts stop is written back where they stopped it (`ccd` module docs).
+///
+/// # Time step and gravity
+///
+/// A coupled scene has one clock and one gravity, rapier's: `IntegrationParameters::dt` and
+/// the gravity of [`RapierContext`]. rapier steps first with them, so the soft bodies must
+/// advance over the same interval under the same field; the coupling hands both to the
+/// solver for the frame ([`tetpbd::Solver::step_frame`]) and never writes the solver's
+/// settings. The solver's own [`SolverSettings::dt`] and [`SolverSettings::gravity`] are not
+/// used: left at their defaults, or equal to rapier's, they are accepted; any other value
+/// says the integrator expects it to act and is rejected before anything moves
+/// ([`CouplingError::SolverDtDisagrees`], [`CouplingError::SolverGravityDisagrees`]). The
+/// substep count, iterations and every other solver setting are the solver's; hooks read the
+/// frame's `dt`, gravity and substep from their [`tetpbd::SubstepContext`].
 ///
 /// # Constraints in the substeps
 ///
@@ -199,7 +213,7 @@ pub struct Coupling {
 
 impl Coupling {
     /// A coupling with validated settings. The solver's `dt` and `gravity` are not used: the
-    /// frame's are rapier's.
+    /// frame's are rapier's ("Time step and gravity" in the type docs).
     pub fn new(solver: SolverSettings, settings: CouplingSettings) -> Result<Self, CouplingError> {
         settings.validate()?;
         Ok(Coupling {
@@ -236,7 +250,8 @@ impl Coupling {
     }
 
     /// Advances rapier and every soft body of `world` by one frame (see the type docs for
-    /// the order). Settings and rapier's `dt` and gravity are checked before anything moves.
+    /// the order). Settings, rapier's `dt` and gravity, and their agreement with the solver's
+    /// ("Time step and gravity" in the type docs) are checked before anything moves.
     pub fn step(
         &mut self,
         world: &mut World,
@@ -264,6 +279,7 @@ impl Coupling {
         if !gravity.iter().all(|g| g.is_finite()) {
             return Err(CouplingError::NonFiniteGravity);
         }
+        check_solver_frame(&self.solver.settings, dt, gravity)?;
         self.solver.settings.validate_frame(dt, gravity)?;
 
         self.frame.capture_start(ctx.bodies);
@@ -337,6 +353,31 @@ impl Coupling {
             }
         }
     }
+}
+
+/// Checks that the solver's own `dt` and `gravity`, which a coupled step does not use (it
+/// steps the soft bodies over rapier's `dt` under rapier's gravity), were not set to other
+/// values than rapier's: each must be at its default ([`SolverSettings::default`]) or equal
+/// rapier's (exactly).
+fn check_solver_frame(
+    solver: &SolverSettings,
+    dt: f32,
+    gravity: Vector3<f32>,
+) -> Result<(), CouplingError> {
+    let defaults = SolverSettings::default();
+    if solver.dt != dt && solver.dt != defaults.dt {
+        return Err(CouplingError::SolverDtDisagrees {
+            solver: solver.dt,
+            rapier: dt,
+        });
+    }
+    if solver.gravity != gravity && solver.gravity != defaults.gravity {
+        return Err(CouplingError::SolverGravityDisagrees {
+            solver: solver.gravity,
+            rapier: gravity,
+        });
+    }
+    Ok(())
 }
 
 /// rapier's step with the borrowed state; returns how long it took.

@@ -2,6 +2,7 @@
 
 use std::fmt;
 
+use nalgebra::Vector3;
 use rapier3d::dynamics::RigidBodyHandle;
 
 /// Why a coupling call was rejected. Every variant names what is wrong.
@@ -23,6 +24,24 @@ pub enum CouplingError {
     },
     /// rapier's gravity is not finite.
     NonFiniteGravity,
+    /// The soft-body solver's `dt` was set, and not to rapier's. In a coupled scene rapier's
+    /// `IntegrationParameters::dt` is the frame time of both; the solver's `dt` must stay at
+    /// its default or equal rapier's (`Coupling` docs, "Time step and gravity").
+    SolverDtDisagrees {
+        /// The solver's `dt`, s.
+        solver: f32,
+        /// rapier's `dt`, s.
+        rapier: f32,
+    },
+    /// The soft-body solver's `gravity` was set, and not to rapier's. In a coupled scene
+    /// rapier's gravity acts on both; the solver's must stay at its default or equal rapier's
+    /// (`Coupling` docs, "Time step and gravity").
+    SolverGravityDisagrees {
+        /// The solver's gravity, m/s².
+        solver: Vector3<f32>,
+        /// rapier's gravity, m/s².
+        rapier: Vector3<f32>,
+    },
     /// A rigid body handle does not name a body of the set (e.g. it was removed).
     BodyNotFound {
         /// The handle.
@@ -78,6 +97,18 @@ impl fmt::Display for CouplingError {
                 write!(f, "rapier dt must be finite and > 0 s, got {value}")
             }
             CouplingError::NonFiniteGravity => write!(f, "rapier gravity is not finite"),
+            CouplingError::SolverDtDisagrees { solver, rapier } => write!(
+                f,
+                "solver dt {solver} s disagrees with rapier's dt {rapier} s, which a coupled \
+                 scene uses: set rapier's integration_parameters.dt"
+            ),
+            CouplingError::SolverGravityDisagrees { solver, rapier } => write!(
+                f,
+                "solver gravity {:?} m/s² disagrees with rapier's gravity {:?} m/s², which a \
+                 coupled scene uses: set rapier's gravity",
+                solver.as_slice(),
+                rapier.as_slice()
+            ),
             CouplingError::BodyNotFound { handle } => {
                 write!(f, "rigid body {handle:?} is not in the rigid body set")
             }

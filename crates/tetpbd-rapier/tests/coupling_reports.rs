@@ -137,3 +137,96 @@ fn bad_settings_are_rejected_before_anything_moves() {
     s.step().expect("step");
     assert!(particles(&s, e).center_of_mass().y < 1.0);
 }
+
+/// Mass-weighted mean velocity of a soft body, m/s.
+fn mean_velocity(s: &CoupledWorld, e: hecs::Entity) -> Vector3<f32> {
+    let p = particles(s, e);
+    let m: Vector3<f32> = p
+        .velocities()
+        .iter()
+        .zip(p.masses())
+        .map(|(v, &m)| v * m)
+        .sum();
+    m / p.total_mass()
+}
+
+/// A coupled scene runs on rapier's clock and gravity: a free soft body falls with rapier's
+/// gravity over rapier's `dt` (several of each) while the solver's `dt` and `gravity` stay
+/// at their defaults and are never written; a solver `dt` or `gravity` set to anything else
+/// is rejected, naming both values, before anything moves; set equal to rapier's it is
+/// accepted.
+#[test]
+fn rapier_owns_the_time_step_and_gravity() {
+    let defaults = SolverSettings::default();
+    for (g, dt) in [
+        (Vector::new(0.0, -9.81, 0.0), 1.0 / 60.0),
+        (Vector::new(0.0, -3.0, 0.0), 1.0 / 120.0),
+        (Vector::ZERO, 1.0 / 30.0),
+        (Vector::new(1.0, 2.0, -0.5), 1.0 / 90.0),
+    ] {
+        let mut s = scene(10);
+        let e = soft_box(
+            &mut s,
+            Vector3::repeat(0.2),
+            [1, 1, 1],
+            Vector3::new(0.0, 5.0, 0.0),
+            SoftCollider::default(),
+        );
+        s.physics.gravity = g;
+        s.physics.integration_parameters.dt = dt;
+        let frames = 6;
+        for _ in 0..frames {
+            s.step().expect("step");
+        }
+        let expected = Vector3::new(g.x, g.y, g.z) * (frames as f32 * dt);
+        let v = mean_velocity(&s, e);
+        assert!(
+            (v - expected).norm() <= 1e-4 * (1.0 + expected.norm()),
+            "gravity {g:?}, dt {dt}: {v:?} against {expected:?}"
+        );
+        let settings = &s.coupling.solver().settings;
+        assert_eq!(
+            (settings.dt, settings.gravity),
+            (defaults.dt, defaults.gravity)
+        );
+    }
+
+    let mut s = scene(10);
+    let e = soft_box(
+        &mut s,
+        Vector3::repeat(0.2),
+        [1, 1, 1],
+        Vector3::new(0.0, 5.0, 0.0),
+        SoftCollider::default(),
+    );
+    let before = particles(&s, e);
+    s.coupling.solver_mut().settings.gravity = Vector3::zeros();
+    assert_eq!(
+        s.step().map(|_| ()),
+        Err(CouplingError::SolverGravityDisagrees {
+            solver: Vector3::zeros(),
+            rapier: Vector3::new(0.0, -9.81, 0.0),
+        })
+    );
+    s.coupling.solver_mut().settings.gravity = defaults.gravity;
+    s.coupling.solver_mut().settings.dt = 0.01;
+    assert_eq!(
+        s.step().map(|_| ()),
+        Err(CouplingError::SolverDtDisagrees {
+            solver: 0.01,
+            rapier: 1.0 / 60.0,
+        })
+    );
+    assert_eq!(
+        particles(&s, e),
+        before,
+        "a rejected step moved the soft body"
+    );
+
+    // Set equal to rapier's, both are accepted.
+    s.physics.integration_parameters.dt = 0.01;
+    s.physics.gravity = Vector::ZERO;
+    s.coupling.solver_mut().settings.gravity = Vector3::zeros();
+    s.step().expect("step");
+    assert!(mean_velocity(&s, e).norm() < 1e-6);
+}
