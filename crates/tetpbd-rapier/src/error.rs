@@ -9,6 +9,10 @@ use rapier3d::dynamics::RigidBodyHandle;
 pub enum CouplingError {
     /// A soft-body solver setting is invalid.
     Solver(tetpbd::SettingsError),
+    /// A soft body's state was not finite at the start of a substep; the solver restored it
+    /// and finished the step ([`tetpbd::StepError::NonFiniteState`] names the body, particle
+    /// and value).
+    NonFiniteState(tetpbd::StepError),
     /// A coupling setting is out of range.
     BadSetting {
         /// The field's name.
@@ -71,6 +75,7 @@ impl fmt::Display for CouplingError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             CouplingError::Solver(e) => write!(f, "soft-body solver settings: {e}"),
+            CouplingError::NonFiniteState(e) => write!(f, "soft-body state: {e}"),
             CouplingError::BadSetting { name, value } => {
                 write!(f, "coupling setting `{name}` is out of range: {value}")
             }
@@ -105,6 +110,15 @@ impl fmt::Display for CouplingError {
 }
 
 impl std::error::Error for CouplingError {}
+
+impl From<tetpbd::StepError> for CouplingError {
+    fn from(e: tetpbd::StepError) -> Self {
+        match e {
+            tetpbd::StepError::Settings(e) => CouplingError::Solver(e),
+            e => CouplingError::NonFiniteState(e),
+        }
+    }
+}
 
 impl From<tetpbd::SettingsError> for CouplingError {
     fn from(e: tetpbd::SettingsError) -> Self {
