@@ -44,6 +44,15 @@ pub enum CouplingError {
         /// Number of particles of the body.
         len: usize,
     },
+    /// A soft body's `Surface` names a particle its `Particles` do not hold.
+    SurfaceOutOfRange {
+        /// The soft body.
+        entity: hecs::Entity,
+        /// The largest particle index of the surface.
+        index: u32,
+        /// Number of particles of the body.
+        len: usize,
+    },
     /// An attachment index is out of range.
     AttachmentOutOfRange {
         /// The index.
@@ -92,6 +101,11 @@ impl fmt::Display for CouplingError {
             CouplingError::ParticleOutOfRange { index, len } => {
                 write!(f, "particle {index} out of range ({len} particles)")
             }
+            CouplingError::SurfaceOutOfRange { entity, index, len } => write!(
+                f,
+                "the surface of soft body {entity:?} names particle {index}, \
+                 but the body has {len} particles"
+            ),
             CouplingError::AttachmentOutOfRange { index, len } => {
                 write!(f, "attachment {index} out of range ({len} attachments)")
             }
