@@ -62,6 +62,7 @@ use tetpbd::{GroundUpSweep, Particles, SubstepContext, Surface};
 use crate::contacts::corner::{project_corners, CornerContact, CornerPass};
 use crate::contacts::particle::project_contacts;
 use crate::contacts::particle::ParticleContact;
+use crate::impact::Impact;
 use crate::rigid::body::{BodyKind, BodyProxy};
 use crate::rigid::collider::ColliderProxy;
 use nalgebra::Vector3;
@@ -273,6 +274,7 @@ fn project_on_frozen_surface(
                 s.colliders,
                 s.set,
                 s.max_push,
+                &mut Impact::new(f32::INFINITY),
             );
         }
         i = end;
@@ -290,6 +292,7 @@ fn project_on_frozen_surface(
                 s.colliders,
                 s.set,
                 CornerPass::Frozen,
+                &mut Impact::new(f32::INFINITY),
             );
         }
         i = end;

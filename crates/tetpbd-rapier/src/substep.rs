@@ -1,6 +1,7 @@
 //! The [`tetpbd::SubstepHook`] that runs the coupling inside the soft solver's substeps.
 
 use hecs::World;
+use rapier3d::dynamics::{ImpulseJointSet, MultibodyJointSet};
 use rapier3d::geometry::NarrowPhase;
 use rapier3d::pipeline::QueryPipeline;
 use tetpbd::{FrameContext, Particles, SubstepContext, SubstepHook, Surface};
@@ -11,8 +12,11 @@ use crate::contacts::particle::{finish_substep, project_contacts, velocity_pass}
 use crate::contacts::support::{
     end_substep_supports, hold_supported, measure_clearance, project_supports,
 };
+use crate::depenetration::{cap_depenetration, settle_substeps};
 use crate::gather::{Frame, GatherInput};
 use crate::heavy_loads::{stacked_velocity_pass, stacking_pass, Stacking};
+use crate::impact::Impact;
+use crate::joints::project_joints;
 use crate::report::{ContactReport, SoftFeature};
 use crate::response::deformation_damping::{damp, DeformationDamping};
 use crate::response::restitution::{com_velocity, end_episodes, restitution_pass};
@@ -25,6 +29,8 @@ pub(crate) struct CouplingHook<'q, 'a> {
     pub frame: &'q mut Frame,
     pub qp: QueryPipeline<'a>,
     pub narrow_phase: &'a NarrowPhase,
+    pub impulse_joints: &'a ImpulseJointSet,
+    pub multibody_joints: &'a MultibodyJointSet,
     pub default_collider: SoftCollider,
     pub margin: f32,
     pub max_depenetration_speed: f32,
@@ -48,6 +54,8 @@ impl SubstepHook for CouplingHook<'_, '_> {
         let input = GatherInput {
             qp: &self.qp,
             narrow_phase: self.narrow_phase,
+            impulse_joints: self.impulse_joints,
+            multibody_joints: self.multibody_joints,
             default_collider: &self.default_collider,
             margin: self.margin,
         };
@@ -85,6 +93,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             stats,
             sweeps,
             pinned,
+            joints,
             ..
         } = &mut *self.frame;
         if sweeps.len() < soft.len() {
@@ -96,6 +105,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             else {
                 continue;
             };
+            let mut impact = Impact::new(s.reach);
             project_corners(
                 &mut corners[s.corners.clone()],
                 &contacts[s.contacts.clone()],
@@ -105,6 +115,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 colliders,
                 self.qp.colliders,
                 CornerPass::Crossing,
+                &mut impact,
             );
             stats.degenerate_contacts += project_contacts(
                 &mut contacts[s.contacts.clone()],
@@ -113,6 +124,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 colliders,
                 self.qp.colliders,
                 self.max_depenetration_speed * h,
+                &mut impact,
             );
             project_corners(
                 &mut corners[s.corners.clone()],
@@ -123,6 +135,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 colliders,
                 self.qp.colliders,
                 CornerPass::Ordinary,
+                &mut impact,
             );
             project_attachments(&mut attachments[s.attachments.clone()], p, bodies, frac, h);
             let mut stacking = Stacking {
@@ -150,6 +163,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             stats.stacking_time += t.elapsed();
         }
         project_supports(supports, bodies);
+        project_joints(joints, bodies);
     }
 
     fn end_substep(&mut self, world: &mut World, substep: SubstepContext) {
@@ -165,6 +179,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             active_colliders,
             supports,
             stats,
+            depenetrating,
             ..
         } = &mut *self.frame;
         for b in bodies.iter_mut() {
@@ -220,6 +235,14 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 rolling,
                 h,
             );
+            cap_depenetration(
+                depenetrating,
+                s.entity,
+                &contacts[range.clone()],
+                p,
+                &s.v_cm_pre,
+                settle_substeps(h),
+            );
             finish_substep(&mut contacts[range], h, self.max_depenetration_speed * h);
         }
         end_episodes(episodes);
@@ -250,7 +273,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                     let pose = cp.pose(&frame.bodies);
                     let x = p.positions()[c.particle as usize];
                     let fb = c.has_normal.then_some(c.normal);
-                    if let Some(sp) = surface_point(shape, cp.rule, &pose, &x, fb) {
+                    if let Some(sp) = surface_point(shape, cp.rule, &pose, &x, fb, fb) {
                         if c.solve {
                             max_pen = max_pen.max(-sp.distance);
                         }

@@ -6,13 +6,13 @@ use std::time::{Duration, Instant};
 use hecs::World;
 use nalgebra::Vector3;
 
-use crate::error::SettingsError;
+use crate::error::{SettingsError, StepError};
 use crate::kernels::working_copy::{self, CopyMode};
 use crate::solver::hook::{FrameContext, SubstepHook};
 use crate::solver::settings::SolverSettings;
 use crate::solver::stats::StepStats;
 use crate::solver::systems;
-use crate::stabilisation::angular_momentum;
+use crate::stabilisation::correction_energy;
 
 /// Runs frames of the soft-body systems on a [`hecs::World`].
 ///
@@ -23,7 +23,8 @@ use crate::stabilisation::angular_momentum;
 ///     repeat `iterations` times:
 ///         copy the particles into the projections' working copy (crate::kernels::working_copy)
 ///         project families in `order` on it, remove the rigid rotation of their
-///         corrections (conserve_angular_momentum), copy back, then hook.project
+///         corrections (conserve_angular_momentum), limit the kinetic energy they add
+///         (limit_correction_energy), copy back, then hook.project
 ///     update velocities  v ← (x − x_prev) / h
 ///     hook.end_substep
 /// ```
@@ -41,7 +42,11 @@ impl Solver {
     }
 
     /// Advances every soft body in `world` by one frame.
-    pub fn step(&mut self, world: &mut World) -> Result<StepStats, SettingsError> {
+    ///
+    /// Errors: [`StepError::Settings`] (nothing stepped) or [`StepError::NonFiniteState`]
+    /// (a particle was not finite at the start of a substep; it was restored and the frame
+    /// stepped to its end, see the error's documentation).
+    pub fn step(&mut self, world: &mut World) -> Result<StepStats, StepError> {
         self.step_with(world, &mut ())
     }
 
@@ -50,7 +55,7 @@ impl Solver {
         &mut self,
         world: &mut World,
         hook: &mut dyn SubstepHook,
-    ) -> Result<StepStats, SettingsError> {
+    ) -> Result<StepStats, StepError> {
         let (dt, gravity) = (self.settings.dt, self.settings.gravity);
         self.step_frame(world, dt, gravity, hook)
     }
@@ -59,16 +64,18 @@ impl Solver {
     /// running `hook` inside the substep loop: [`Solver::step_with`] with the frame's length
     /// and gravity given by the caller instead of taken from the settings, whose `dt` and
     /// `gravity` are neither used nor changed. For a caller whose clock and gravity belong
-    /// to another engine, as a coupled scene's belong to its rigid-body engine. Both are
-    /// validated as the settings' own would be ([`SettingsError::BadDt`],
-    /// [`SettingsError::NonFiniteGravity`]).
+    /// to another engine, as a coupled scene's belong to its rigid-body engine.
+    ///
+    /// Errors: as [`Solver::step`]; `dt` and `gravity` are validated as the settings' own
+    /// would be ([`SettingsError::BadDt`], [`SettingsError::NonFiniteGravity`] in
+    /// [`StepError::Settings`]).
     pub fn step_frame(
         &mut self,
         world: &mut World,
         dt: f32,
         gravity: Vector3<f32>,
         hook: &mut dyn SubstepHook,
-    ) -> Result<StepStats, SettingsError> {
+    ) -> Result<StepStats, StepError> {
         self.settings.validate_frame(dt, gravity)?;
         let frame = FrameContext::new(&self.settings, dt, gravity);
         // With the `parallel` feature and a body large enough for a parallel pass, the pool's
@@ -88,8 +95,9 @@ impl Solver {
         world: &mut World,
         frame: FrameContext,
         hook: &mut dyn SubstepHook,
-    ) -> Result<StepStats, SettingsError> {
+    ) -> Result<StepStats, StepError> {
         let s = &self.settings;
+        let mut restored = crate::solver::non_finite::Restored::default();
         let start = Instant::now();
         let mut stats = StepStats {
             substeps: s.substeps,
@@ -107,7 +115,9 @@ impl Solver {
         hook.begin_frame(world, frame);
         let mut hook_time = t.elapsed();
         for i in 0..s.substeps {
-            self.substep(world, hook, frame, i, &mut stats, &mut hook_time);
+            let r = self.substep(world, hook, frame, i, &mut stats, &mut hook_time);
+            restored.count += r.count;
+            restored.first = restored.first.or(r.first);
         }
         let t = Instant::now();
         hook.end_frame(world, frame);
@@ -123,11 +133,22 @@ impl Solver {
             stats.measure_time = t.elapsed();
         }
         stats.total_time = start.elapsed();
-        Ok(stats)
+        stats.non_finite_restored = restored.count;
+        match restored.first {
+            None => Ok(stats),
+            Some((entity, particle, what, value)) => Err(StepError::NonFiniteState {
+                entity,
+                particle,
+                what,
+                value,
+                restored: restored.count,
+            }),
+        }
     }
 
     /// Substep `index` of `frame` (length `h = dt / substeps`): prediction, `iterations`
-    /// iterations, the velocity update.
+    /// iterations, the velocity update. Returns the particles prediction found non-finite
+    /// and restored.
     fn substep(
         &self,
         world: &mut World,
@@ -136,11 +157,11 @@ impl Solver {
         index: u32,
         stats: &mut StepStats,
         hook_time: &mut Duration,
-    ) {
+    ) -> crate::solver::non_finite::Restored {
         let s = &self.settings;
         let h = frame.h();
         let t = Instant::now();
-        systems::predict(world, h, frame.gravity(), s.damping);
+        let restored = systems::predict(world, h, frame.gravity(), s.damping);
         systems::reset_lambdas(world);
         stats.predict_time += t.elapsed();
         let t = Instant::now();
@@ -160,10 +181,12 @@ impl Solver {
         let t = Instant::now();
         hook.end_substep(world, frame.substep(index, 0));
         *hook_time += t.elapsed();
+        restored
     }
 
     /// One iteration: copy the particles into the working copy, project the families in
-    /// order, copy back (removing the corrections' rigid rotation if asked).
+    /// order, copy back (removing the corrections' rigid rotation and limiting the kinetic
+    /// energy they add, if asked).
     fn iteration(&self, world: &mut World, h: f32, stats: &mut StepStats) {
         let s = &self.settings;
         let t = Instant::now();
@@ -178,8 +201,9 @@ impl Solver {
             f.degenerate += c.degenerate;
         }
         let t = Instant::now();
-        if s.conserve_angular_momentum {
-            angular_momentum::store_bodies_without_spin(world);
+        if s.conserve_angular_momentum || s.limit_correction_energy {
+            let (spin, limit) = (s.conserve_angular_momentum, s.limit_correction_energy);
+            stats.energy_limited += correction_energy::store_bodies(world, h, spin, limit);
             stats.spin_time += t.elapsed();
         } else {
             working_copy::store_bodies(world);
