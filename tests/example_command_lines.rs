@@ -170,9 +170,9 @@ fn the_documented_invocations_parse() {
 
 #[test]
 fn a_bad_argument_is_rejected_with_a_message_naming_it() {
-    let cases: [(clap::Command, &[&str], &str); 14] = [
+    let cases: [(clap::Command, &[&str], &str); 15] = [
         (rigid_ball_on_soft::Cli::command(), &["x", "ten"], "FRAMES"),
-        (rigid_ball_on_soft::Cli::command(), &["x", "-3"], "-3"),
+        (rigid_ball_on_soft::Cli::command(), &["x", "-3"], "FRAMES"),
         (soft_on_rigid_stack::Cli::command(), &["x", "1.5"], "FRAMES"),
         (
             kinematic_platform::Cli::command(),
@@ -204,6 +204,7 @@ fn a_bad_argument_is_rejected_with_a_message_naming_it() {
         ),
         (soft_pile::Cli::command(), &["x", "jelly"], "GROUND"),
         (soft_pile::Cli::command(), &["x", "soft", "0"], "SECONDS"),
+        (soft_pile::Cli::command(), &["x", "soft", "-1"], "SECONDS"),
         (
             asset_drop::Cli::command(),
             &["x", "a.obj", "60", "-0.1"],

@@ -21,7 +21,11 @@ pub struct Cli {
     )]
     pub obj: PathBuf,
     /// Frames to simulate, 1/60 s each.
-    #[arg(value_name = "FRAMES", default_value_t = 180)]
+    #[arg(
+        value_name = "FRAMES",
+        default_value_t = 180,
+        allow_negative_numbers = true
+    )]
     pub frames: usize,
     /// Edge of the tetrahedralization's background grid cells, m (finite, > 0).
     #[arg(

@@ -13,7 +13,11 @@ use tetpbd_viz::VizOptions;
 #[command(name = "kinematic_platform")]
 pub struct Cli {
     /// Frames to simulate, 1/60 s each.
-    #[arg(value_name = "FRAMES", default_value_t = 240)]
+    #[arg(
+        value_name = "FRAMES",
+        default_value_t = 240,
+        allow_negative_numbers = true
+    )]
     pub frames: usize,
     #[command(flatten)]
     pub viz: VizOptions,

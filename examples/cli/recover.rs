@@ -18,13 +18,18 @@ pub struct Cli {
     #[arg(value_name = "FAMILIES", value_enum, default_value_t = Families::VertexFaceEdges)]
     pub families: Families,
     /// Frames to simulate, 1/60 s each.
-    #[arg(value_name = "FRAMES", default_value_t = 120)]
+    #[arg(
+        value_name = "FRAMES",
+        default_value_t = 120,
+        allow_negative_numbers = true
+    )]
     pub frames: usize,
     /// Substeps per frame (at least 1).
     #[arg(
         value_name = "SUBSTEPS",
         default_value_t = 10,
-        value_parser = clap::value_parser!(u32).range(1..)
+        value_parser = clap::value_parser!(u32).range(1..),
+        allow_negative_numbers = true
     )]
     pub substeps: u32,
     /// Cells along each side of the cube (at least 1; the cube has CELLS³ cells of five
@@ -32,7 +37,8 @@ pub struct Cli {
     #[arg(
         value_name = "CELLS",
         default_value_t = 4,
-        value_parser = clap::value_parser!(u32).range(1..)
+        value_parser = clap::value_parser!(u32).range(1..),
+        allow_negative_numbers = true
     )]
     pub cells: u32,
     /// Compliance of every constraint family: m/N for edges and vertex–face, m⁵/N for volume

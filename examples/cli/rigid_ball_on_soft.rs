@@ -11,7 +11,11 @@ use tetpbd_viz::VizOptions;
 #[command(name = "rigid_ball_on_soft")]
 pub struct Cli {
     /// Frames to simulate, 1/60 s each.
-    #[arg(value_name = "FRAMES", default_value_t = 180)]
+    #[arg(
+        value_name = "FRAMES",
+        default_value_t = 180,
+        allow_negative_numbers = true
+    )]
     pub frames: usize,
     #[command(flatten)]
     pub viz: VizOptions,

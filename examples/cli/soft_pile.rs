@@ -19,7 +19,8 @@ pub struct Cli {
     #[arg(
         value_name = "SECONDS",
         default_value_t = 5,
-        value_parser = clap::value_parser!(u32).range(1..)
+        value_parser = clap::value_parser!(u32).range(1..),
+        allow_negative_numbers = true
     )]
     pub seconds: u32,
     #[command(flatten)]

@@ -25,7 +25,7 @@ const DEFAULT_STRIP_FRAMES: usize = 4;
 /// use tetpbd_viz::VizOptions;
 ///
 /// /// Drops a cube.
-/// #[derive(Parser)]
+/// #[derive(Debug, Parser)]
 /// struct Cli {
 ///     /// Frames to simulate (1/60 s each).
 ///     #[arg(default_value_t = 120)]
@@ -48,7 +48,7 @@ pub struct VizOptions {
     /// with per-tetrahedron volume ratio and inverted flag.
     #[arg(long, value_name = "DIR", env = "TETPBD_EXPORT")]
     pub export: Option<PathBuf>,
-    /// Render every frame to DIR/frame_0000.png, … .
+    /// Render every frame to DIR/frame_0000.png, DIR/frame_0001.png, …
     #[arg(long, value_name = "DIR", env = "TETPBD_RENDER")]
     pub render: Option<PathBuf>,
     /// Render a few frames side by side into one PNG file.
@@ -60,6 +60,7 @@ pub struct VizOptions {
         value_name = "N",
         default_value_t = DEFAULT_STRIP_FRAMES,
         value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..),
+        allow_negative_numbers = true,
     )]
     pub strip_frames: usize,
     /// Render an animated PNG file of up to 100 frames.

@@ -57,9 +57,9 @@ fn options_come_from_the_command_line_among_positionals_and_fall_back_on_the_env
     assert_eq!((cli.mode.as_str(), cli.frames), ("flatten", 60));
     assert_eq!(cli.viz.export.as_deref(), Some(Path::new("out/frames")));
     assert_eq!(cli.viz.animate.as_deref(), Some(Path::new("a.png")));
-    assert_eq!((cli.viz.render, cli.viz.strip), (None, None));
     assert_eq!(cli.viz.strip_frames, 3);
     assert!(cli.viz.renders());
+    assert_eq!((cli.viz.render, cli.viz.strip), (None, None));
 
     std::env::set_var("TETPBD_STRIP", "env_strip.png");
     std::env::set_var("TETPBD_EXPORT", "env_frames");
