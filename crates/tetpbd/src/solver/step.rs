@@ -11,7 +11,7 @@ use crate::solver::hook::SubstepHook;
 use crate::solver::settings::SolverSettings;
 use crate::solver::stats::StepStats;
 use crate::solver::systems;
-use crate::stabilisation::angular_momentum;
+use crate::stabilisation::{angular_momentum, deformation_damping};
 
 /// Runs frames of the soft-body systems on a [`hecs::World`].
 ///
@@ -23,7 +23,7 @@ use crate::stabilisation::angular_momentum;
 ///         copy the particles into the projections' working copy (crate::kernels::working_copy)
 ///         project families in `order` on it, remove the rigid rotation of their
 ///         corrections (conserve_angular_momentum), copy back, then hook.project
-///     update velocities  v ← (x − x_prev) / h
+///     update velocities  v ← (x − x_prev) / h, then damp deformation (DeformationDamping)
 ///     hook.end_substep
 /// ```
 #[derive(Clone, Debug, Default)]
@@ -133,6 +133,7 @@ impl Solver {
         let u = systems::update_velocities(world, h, s.max_correction_speed);
         stats.non_finite_resets += u.non_finite_resets;
         stats.velocity_clamps += u.clamped;
+        deformation_damping::damp_deformation(world, h);
         stats.velocity_time += t.elapsed();
         let t = Instant::now();
         hook.end_substep(world, h);
