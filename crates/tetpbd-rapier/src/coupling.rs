@@ -140,14 +140,14 @@ impl<'a> RapierContext<'a> {
 /// immovable support that carries a much heavier dynamic body, the *stacking pass*: its own
 /// constraints once more from the ground up with the supported particles held, and the
 /// heavy body's contacts with the surface frozen (`heavy_loads` module docs,
-/// [`CouplingSettings::stacking_mass_ratio`]). After each substep's velocity update: the
+/// [`CouplingSettings::stacking_mass_ratio`]). After each substep's velocity update (where
+/// the solver also damps the deformation of bodies with a [`tetpbd::DeformationDamping`]): the
 /// separating velocity a stacking pass gave a heavy body is removed, the per-particle
 /// separating velocity is removed, then restitution acts per (soft body,
 /// collider) impact episode on the body's centre of mass (`response::restitution` module docs), a
 /// rolling-resistance couple bounded by the substep's normal impulse opposes each body's
 /// rotation relative to every collider it touches (`response::rolling` module docs,
-/// [`crate::SoftCollider::rolling_resistance`]), and [`crate::DeformationDamping`] damps
-/// deformation of bodies that carry it.
+/// [`crate::SoftCollider::rolling_resistance`]).
 ///
 /// Why rolling resistance: sticking friction does no work on a rolling body and the
 /// deformation damping leaves rigid rotation alone, so without it a rounded soft body rocks

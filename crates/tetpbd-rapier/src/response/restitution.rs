@@ -53,23 +53,6 @@ impl Episode {
     }
 }
 
-/// Centre-of-mass velocity and mass of the free particles of `p`.
-pub(crate) fn com_velocity(p: &Particles) -> (Vector3<f32>, f32) {
-    let mut m = 0.0;
-    let mut mv = Vector3::zeros();
-    for i in 0..p.len() {
-        if p.inv_masses()[i] > 0.0 {
-            m += p.masses()[i];
-            mv += p.velocities()[i] * p.masses()[i];
-        }
-    }
-    if m > 0.0 {
-        (mv / m, m)
-    } else {
-        (Vector3::zeros(), 0.0)
-    }
-}
-
 /// Runs the episodes of one soft body after a substep's velocity update. `contacts` are the
 /// body's contacts (contiguous per collider), `v_cm_pre` its centre-of-mass velocity before
 /// the substep. `active` is scratch space (its capacity is reused across calls).
@@ -86,10 +69,9 @@ pub(crate) fn restitution_pass(
     colliders: &[ColliderProxy],
     threshold: f32,
 ) {
-    let (v_cm, mass) = com_velocity(p);
-    if mass <= 0.0 {
+    let Some((v_cm, mass)) = p.free_velocity() else {
         return;
-    }
+    };
     // A body with pinned particles is anchored to the world: its centre of mass takes no
     // share of the restitution impulse.
     let anchored = p.inv_masses().contains(&0.0);

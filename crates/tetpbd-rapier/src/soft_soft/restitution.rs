@@ -75,8 +75,8 @@ pub(crate) fn body_restitution(
 
 fn com_velocity(world: &mut World, g: &Gather, k: usize) -> Vector3<f32> {
     match world.query_one_mut::<&Particles>(g.bodies[k].entity) {
-        Ok(p) if p.total_mass() > 0.0 => p.linear_momentum() / p.total_mass(),
-        _ => Vector3::zeros(),
+        Ok(p) => p.free_velocity().map_or(Vector3::zeros(), |v| v.0),
+        Err(_) => Vector3::zeros(),
     }
 }
 

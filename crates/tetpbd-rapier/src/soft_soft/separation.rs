@@ -188,8 +188,8 @@ impl Separation {
 /// Mass-weighted mean velocity of a body, m/s (zero when it cannot be read).
 fn com_velocity(world: &mut World, b: &FrameBody) -> Vector3<f32> {
     match world.query_one_mut::<&Particles>(b.entity) {
-        Ok(p) if p.total_mass() > 0.0 => p.linear_momentum() / p.total_mass(),
-        _ => Vector3::zeros(),
+        Ok(p) => p.free_velocity().map_or(Vector3::zeros(), |v| v.0),
+        Err(_) => Vector3::zeros(),
     }
 }
 
