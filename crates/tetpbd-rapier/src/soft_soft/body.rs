@@ -3,6 +3,8 @@
 use hecs::Entity;
 use nalgebra::Vector3;
 
+use crate::soft_collider::SoftCollider;
+
 /// A soft body taking part in the frame; its surface particles occupy the slots
 /// `offset..offset + len` of the [`ContactFrame`](super::gather::ContactFrame) arrays.
 #[derive(Clone, Debug)]
@@ -15,6 +17,8 @@ pub(crate) struct FrameBody {
     pub lo: Vector3<f32>,
     pub hi: Vector3<f32>,
     pub self_collide: bool,
+    /// The body's collision properties (its component, or the default).
+    pub collider: SoftCollider,
     /// Inverse of the body's mass, 1/kg; 0 when a particle is pinned (the body is not
     /// shifted by deep-overlap separation).
     pub inv_mass: f32,
