@@ -19,6 +19,8 @@ use crate::error::CouplingError;
 use crate::gather::Frame;
 use crate::report::{ContactReport, CouplingStats};
 use crate::settings::CouplingSettings;
+use crate::soft_soft::settings::SoftContactSettings;
+use crate::soft_soft::SoftContacts;
 use crate::substep::CouplingHook;
 
 /// The user's rapier state, borrowed for one coupled step. Every field is the argument of
@@ -195,6 +197,7 @@ pub struct Coupling {
     settings: CouplingSettings,
     frame: Frame,
     reports: Vec<ContactReport>,
+    soft_contacts: SoftContacts,
 }
 
 impl Coupling {
@@ -207,6 +210,7 @@ impl Coupling {
             settings,
             frame: Frame::default(),
             reports: Vec::new(),
+            soft_contacts: SoftContacts::new(SoftContactSettings::default())?,
         })
     }
 
@@ -245,9 +249,9 @@ impl Coupling {
         self.step_with(world, ctx, &mut ())
     }
 
-    /// [`Coupling::step`] with another [`SubstepHook`] run inside the same substeps, after
-    /// the coupling's constraints at every point (e.g. [`crate::SoftContacts`] for soft–soft
-    /// contacts).
+    /// [`Coupling::step`] with another [`SubstepHook`] of the integrator's run inside the
+    /// same substeps, after the coupling's work (soft–rigid, then soft–soft contacts) at
+    /// every point.
     pub fn step_with(
         &mut self,
         world: &mut World,
@@ -302,11 +306,25 @@ impl Coupling {
                 kernel: self.solver.settings.kernel,
                 reports: &mut self.reports,
             };
-            self.solver.step_with(world, &mut (hook, extra))?
+            let mut off = ();
+            let soft_contacts: &mut dyn SubstepHook = match self.settings.soft_contacts {
+                Some(s) => {
+                    self.soft_contacts.set_settings(s)?;
+                    let default = self.settings.default_collider;
+                    self.soft_contacts.set_default_collider(default);
+                    &mut self.soft_contacts
+                }
+                None => &mut off,
+            };
+            self.solver
+                .step_with(world, &mut (hook, (soft_contacts, extra)))?
         };
         let mut stats = std::mem::take(&mut self.frame.stats);
         self.write_back(ctx.bodies, &mut stats);
         stats.soft = soft;
+        if self.settings.soft_contacts.is_some() {
+            stats.soft_contacts = *self.soft_contacts.stats();
+        }
         stats.rigid_time = rigid_time;
         stats.total_time = start.elapsed();
         Ok(stats)

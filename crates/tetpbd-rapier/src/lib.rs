@@ -22,8 +22,9 @@
 //!   (see [`SoftCollider`]).
 //! * Attachments: the [`Attachments`] component.
 //! * Contact reports: [`Coupling::contacts`]; statistics: [`CouplingStats`].
-//! * Other hooks (e.g. soft–soft contacts) run in the same substeps through
-//!   [`Coupling::step_with`].
+//! * Soft–soft and self contacts: on by default ([`CouplingSettings::soft_contacts`]), with
+//!   each body's [`SoftCollider`]; [`SoftContacts`] runs them on a bare `tetpbd` solver.
+//! * Hooks of the integrator's own run in the same substeps through [`Coupling::step_with`].
 //!
 //! ```
 //! use nalgebra::Vector3;
