@@ -91,38 +91,36 @@ impl<'a> RapierContext<'a> {
 ///    interpolation of `P₀ → P₁` plus the offset the soft body pushed it by; contacts and
 ///    attachments are XPBD constraints projected after the soft body's own constraints, with
 ///    dynamic bodies taking part through their generalized inverse mass.
-/// 3. The dynamic bodies the soft bodies touched get the soft reaction written back. A body
-///    touching only soft bodies took part in the substeps with its generalized inverse mass and
-///    gets its final pose and velocity (`P₁` plus offset; the velocity of the last substep). A body
-///    that rapier's narrow phase reports in contact with other rigid colliders is *supported*:
-///    inside the substeps it is infinitely heavy (it stays on its `P₀ → P₁` path), and the summed
-///    soft impulse and its moment become a force and torque added to the body for rapier's next
-///    step (and taken off again after it), which rapier's solver applies in its substeps together
-///    with the rigid contacts, as it does gravity. (A velocity change of the same impulse is an
-///    impact: a 100 kg soft body resting on a 0.125 kg box would hand the box about 100 m/s per
-///    frame, which rapier's contacts do not cancel cleanly.) Moving such a body by the offset would
-///    push it into its rigid neighbours, which rapier only pushes out again over several frames (a
-///    soft body on a stack of boxes would squash the stack). A supported body that a soft body is
-///    attached to is *anchored* instead (`contacts::support` module docs): an attachment is
-///    bilateral, and handing its reaction over a frame late feeds back with the soft/rigid mass
-///    ratio as gain (a soft body attached to a light box on the ground would throw the box away
-///    within a few frames). An anchored body takes part in the substeps with its generalized
-///    inverse mass like a body touched only by soft bodies, and is written back the same way;
-///    rapier's contacts of the body, as they stood after rapier's step, are kept inside the
-///    substeps as unilateral constraints against immovable supports. While it stands on them and
-///    the soft load of the previous substep lies in their friction cone it is *held* (shock
-///    propagation): no soft impulse moves it, the supports take that load. Otherwise it moves with
-///    its mass, except that an impulse pressing it into its supports does not move it while it
-///    stands on them and moves it at most down to them otherwise, so the soft body cannot push it
-///    into them and a body an attachment lifts is pushed back down by what it lifts.
+/// 3. The dynamic bodies the soft bodies touched get the soft reaction written back: they
+///    took part in the substeps with their generalized inverse mass and get their final pose
+///    and velocity (`P₁` plus offset; the velocity of the last substep). A body that rapier's
+///    narrow phase reports in contact with other rigid colliders is *anchored* (`contacts::support`
+///    module docs): rapier's contacts of the body, as they stood after rapier's step, are
+///    kept inside the substeps as unilateral constraints against immovable supports. While
+///    it stands on them and the soft load of the previous substep lies in their friction cone
+///    it is *held* (shock propagation): no soft impulse moves it, the supports take that
+///    load. Otherwise it moves with its mass, except that an impulse pressing it into its
+///    supports does not move it while it stands on them and moves it at most down to them
+///    otherwise, so the soft body cannot push it into them and a body an attachment lifts is
+///    pushed back down by what it lifts. A body's rapier joints (impulse and multibody) are
+///    constraints inside the substeps too (`joints` module docs).
+///
+///    Why (measured alternatives: `docs/decisions/coupled-rigid-supports.md`): such a body
+///    used to be *supported*, infinitely heavy inside the substeps with the summed soft
+///    impulse handed to rapier as a force for its next step. That explicit hand-over feeds
+///    back with the soft/rigid mass ratio as gain: a 125 kg soft cube on a 1 kg box on the
+///    ground threw the box at about 370 m/s by the second frame (force −1.8 kN, −23 kN,
+///    +625 kN), and a soft body attached to a light box did the same (issue 3, when anchoring
+///    was first introduced for attached bodies only). A jointed body moved freely inside the
+///    substeps, and a box on a joint carrying an attached soft beam was dragged off its
+///    anchor by 0.05–0.6 m per 3 s (2 kg box, beams of 0.2–2 kg), growing linearly.
 ///
 /// Who integrates what: rapier integrates rigid bodies under gravity, rigid contacts and joints;
 /// the coupling integrates the soft bodies and the *reaction* of soft contacts and attachments on
-/// rigid bodies, which rapier sees at its next step as an already-moved pose and changed velocity
-/// (bodies touched only by soft bodies, anchored bodies) or as a force and torque acting over that
-/// step (supported bodies). Rapier steps first so that the soft bodies see where the rigid bodies
-/// really are this frame (kinematic platforms carry soft bodies without a frame of lag); the price
-/// is that a soft push on a rigid body reaches rigid–rigid contacts one frame later.
+/// rigid bodies, which rapier sees at its next step as an already-moved pose and changed
+/// velocity. Rapier steps first so that the soft bodies see where the rigid bodies really are
+/// this frame (kinematic platforms carry soft bodies without a frame of lag); the price is that a
+/// soft push on a rigid body reaches the rigid bodies it does not touch one frame later.
 ///
 /// Fast rigid bodies: rapier steps first, so a fast body may already stand beyond a thin
 /// soft body when the soft substeps run. rapier still integrates it (to `P₁`); the coupling
@@ -171,8 +169,6 @@ impl<'a> RapierContext<'a> {
 ///   but keeps rocking (`tests/heavy_box_on_deep_soft_bodies.rs`). The
 ///   pass costs about one more sweep over the whole soft body per iteration (SIMD lanes;
 ///   `tetpbd-bench --bin stacking`).
-/// * A heavy soft body on a stack of supported rigid bodies keeps a small rocking motion
-///   (a few cm/s), the one-frame lag between the soft load and rapier's answer.
 /// * The soft load pressing an anchored body onto its supports does not reach rapier: it
 ///   neither tips the body over nor weighs on a dynamic support below it (only the body's
 ///   own motion into a support is handed to that support, as an impulse). Whether its
@@ -181,16 +177,25 @@ impl<'a> RapierContext<'a> {
 ///   100 kg soft cube attached with 1e-5 m/N to the top of a 0.125 kg box on the ground
 ///   stays on it with the cube moved by up to 3 mm, rocking the box up to 1 cm off its
 ///   place in 10 s (`contacts::support` module docs).
-/// * The force and torque of a supported body's load stay in rapier's user force and torque
-///   of the body until the coupling takes them off after rapier's next step; calling
-///   `RigidBody::reset_forces`/`reset_torques` on it between two coupled steps leaves their
-///   opposite behind.
 /// * Rolling resistance is off by default and acts on the rigid fit of a whole body (its
 ///   centre of mass and mean angular velocity): a body with pinned particles is skipped,
 ///   a soft body lying over several colliders gets one couple per collider, and a dynamic
 ///   collider's share is estimated from its inverse inertia about the rotation axis only.
-/// * Joints are only enforced by rapier: inside the substeps a jointed dynamic body moves
-///   freely under soft reactions, and rapier pulls it back at the next step.
+/// * Joints inside the substeps: their limits and motors, and a single locked angular axis,
+///   are left to rapier's step; the joint reaction on a body that does not take part in the
+///   substeps (a chain's far end) reaches it through rapier a frame later.
+/// * Anchoring at extreme ratios (`tests/loads.rs`): a 0.3 m soft cube 1000× heavier than a
+///   0.3 m box it rests on flush (edges aligned) creeps off it at about 1 cm/s, one particle
+///   rattling at 0.15 m/s (the box moves 7 mm, turns 0.3°); on a larger box it rests. A
+///   rigid box 100× or more heavier than the soft slab it rests on is not carried when the
+///   slab rests on a light dynamic box rather than on fixed ground (the stacking pass needs
+///   an immovable support), and a rigid box 1000× lighter than the slab under it (1 g on
+///   1 kg) is pushed 7 cm and turned 10°.
+/// * Fast impacts (`impact` module docs): of 448 shots (balls of 0.1 and 0.2 m, boxes of 0.08
+///   and 0.2 m, 1 kg, at 50–300 m/s onto slabs of 1–4 cells, seven aim points), 12 still fail:
+///   the 0.2 m box at 200–300 m/s (through the slab or throwing it) and hits within 0.1 m of
+///   the slab's edge. A soft cube at 300 m/s onto a dynamic box on the ground reaches 13 cm
+///   into the box and lifts it at 3.8 m/s.
 #[derive(Clone, Debug)]
 pub struct Coupling {
     solver: Solver,
@@ -240,7 +245,9 @@ impl Coupling {
     }
 
     /// Advances rapier and every soft body of `world` by one frame (see the type docs for
-    /// the order). Settings are validated before anything moves.
+    /// the order). Settings and the soft bodies' surfaces are validated before anything
+    /// moves ([`CouplingError::SurfaceOutOfRange`]); a soft body without a `Surface` is
+    /// counted in [`CouplingStats::bodies_without_surface`].
     pub fn step(
         &mut self,
         world: &mut World,
@@ -271,6 +278,7 @@ impl Coupling {
         self.solver.settings.dt = dt;
         self.solver.settings.gravity = gravity;
         self.solver.settings.validate()?;
+        let without_surface = crate::validate::check_soft_bodies(world)?;
 
         self.frame.capture_start(ctx.bodies);
         let rigid_time = step_rapier(&mut ctx);
@@ -297,6 +305,8 @@ impl Coupling {
                 frame: &mut self.frame,
                 qp,
                 narrow_phase: &*ctx.narrow_phase,
+                impulse_joints: &*ctx.impulse_joints,
+                multibody_joints: &*ctx.multibody_joints,
                 default_collider: self.settings.default_collider,
                 margin: self.settings.margin,
                 max_depenetration_speed: self.settings.max_depenetration_speed,
@@ -322,6 +332,7 @@ impl Coupling {
         let mut stats = std::mem::take(&mut self.frame.stats);
         self.write_back(ctx.bodies, &mut stats);
         stats.soft = soft;
+        stats.bodies_without_surface = without_surface;
         if self.settings.soft_contacts.is_some() {
             stats.soft_contacts = *self.soft_contacts.stats();
         }

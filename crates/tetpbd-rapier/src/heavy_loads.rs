@@ -65,6 +65,7 @@ use tetpbd::{
 use crate::contacts::corner::{project_corners, CornerContact, CornerPass};
 use crate::contacts::particle::project_contacts;
 use crate::contacts::particle::ParticleContact;
+use crate::impact::Impact;
 use crate::rigid::body::{BodyKind, BodyProxy};
 use crate::rigid::collider::ColliderProxy;
 use nalgebra::Vector3;
@@ -297,6 +298,7 @@ fn project_on_frozen_surface(
                 s.colliders,
                 s.set,
                 s.max_push,
+                &mut Impact::new(f32::INFINITY),
             );
         }
         i = end;
@@ -314,6 +316,7 @@ fn project_on_frozen_surface(
                 s.colliders,
                 s.set,
                 CornerPass::Frozen,
+                &mut Impact::new(f32::INFINITY),
             );
         }
         i = end;

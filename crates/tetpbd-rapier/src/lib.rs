@@ -14,6 +14,10 @@
 //!   surface triangles).
 //! * Rigid points against soft surface triangles: rigid corners and small shapes do not slip
 //!   between the particles of a coarse soft body.
+//! * Triangle-mesh colliders of either winding, open or closed, with or without
+//!   pseudo-normals: an open mesh (or one wound inwards) is a two-sided sheet, a particle
+//!   kept on the side it came from; only a closed mesh wound outwards has an inside that
+//!   pushes a particle created in it out. A heightfield is solid below its surface.
 //! * Per-body collision properties (friction, restitution, rolling resistance, thickness)
 //!   and groups: the [`SoftCollider`] component; deformation damping: the
 //!   [`DeformationDamping`] component.
@@ -70,9 +74,13 @@ mod ccd;
 mod contacts;
 mod convert;
 mod coupling;
+mod depenetration;
 mod error;
 mod gather;
 mod heavy_loads;
+mod impact;
+mod joints;
+mod mesh_side;
 mod report;
 mod response;
 mod rigid;
@@ -81,6 +89,7 @@ mod settings;
 mod soft_collider;
 mod soft_soft;
 mod substep;
+mod validate;
 
 pub use attachments::{AttachTarget, Attachment, Attachments};
 pub use coupling::{Coupling, RapierContext};

@@ -74,6 +74,9 @@ pub struct CouplingStats {
     /// Wall time of the stacking passes and their velocity passes (part of the soft step's
     /// hook time).
     pub stacking_time: Duration,
+    /// Soft bodies (entities with `Particles`) stepped without a `Surface`: the solver moves
+    /// them but they collide with nothing (`validate` module docs).
+    pub bodies_without_surface: usize,
     /// Rigid bodies whose pose/velocity was written back.
     pub bodies_written: usize,
     /// Rigid bodies not written back because their result was not finite.

@@ -10,16 +10,19 @@ use crate::Coupling;
 #[derive(Clone, Debug, PartialEq)]
 pub struct CouplingSettings {
     /// Extra distance around soft bodies and colliders when candidates are gathered once per
-    /// frame, m (≥ 0). Contacts closer than the margin plus each body's motion over the frame
-    /// are evaluated in every substep.
+    /// frame, m (0 to [`CouplingSettings::MAX_MARGIN`]). Contacts closer than the margin plus
+    /// each body's motion over the frame are evaluated in every substep.
     pub margin: f32,
     /// Collision properties of soft bodies without a [`SoftCollider`] component.
     pub default_collider: SoftCollider,
-    /// Largest speed at which the overlap of a soft body created inside a collider (in its
-    /// first frame in the coupling) is pushed out, m/s (> 0). Such an overlap is resolved
-    /// over several substeps and frames instead of in one substep, so separation does not turn
-    /// into an explosion. Every other contact, impacts included, is resolved fully. A rigid
-    /// body created inside a soft one is not covered.
+    /// Largest speed at which an overlap of a soft body with a collider is pushed out, m/s
+    /// (> 0, at most [`CouplingSettings::MAX_DEPENETRATION_SPEED`]): a contact that starts
+    /// deeper than one substep's push at that speed (a body created inside a collider, a
+    /// surface given back to a body that sank, a teleport), in any frame. Such an overlap is
+    /// resolved over several substeps and frames instead of in one substep, and the body
+    /// does not keep the speed of the push (`depenetration` module docs), so separation does
+    /// not turn into an explosion or a hop. Impacts and ongoing contacts are resolved fully.
+    /// A rigid body created inside a soft one is not covered.
     pub max_depenetration_speed: f32,
     /// Mass ratio from which a dynamic rigid body resting on a soft body counts as heavy
     /// (≥ 0; `f32::INFINITY` turns the pass off). A soft body on an immovable support
@@ -69,17 +72,26 @@ impl Default for CouplingSettings {
 }
 
 impl CouplingSettings {
+    /// Largest [`CouplingSettings::margin`] accepted, m. The margin only widens the candidate
+    /// search; beyond a metre it gathers colliders no contact can reach within a frame.
+    pub const MAX_MARGIN: f32 = 1.0;
+
+    /// Largest [`CouplingSettings::max_depenetration_speed`] accepted, m/s.
+    pub const MAX_DEPENETRATION_SPEED: f32 = 100.0;
+
     /// Checks every field.
     pub fn validate(&self) -> Result<(), CouplingError> {
-        if !(self.margin.is_finite() && self.margin >= 0.0) {
+        if !(self.margin.is_finite() && (0.0..=Self::MAX_MARGIN).contains(&self.margin)) {
             return Err(CouplingError::BadSetting {
-                name: "margin (m)",
+                name: "margin (m, 0 to CouplingSettings::MAX_MARGIN)",
                 value: self.margin,
             });
         }
-        if !(self.max_depenetration_speed.is_finite() && self.max_depenetration_speed > 0.0) {
+        if !(self.max_depenetration_speed > 0.0
+            && self.max_depenetration_speed <= Self::MAX_DEPENETRATION_SPEED)
+        {
             return Err(CouplingError::BadSetting {
-                name: "max depenetration speed (m/s)",
+                name: "max depenetration speed (m/s, > 0, at most MAX_DEPENETRATION_SPEED)",
                 value: self.max_depenetration_speed,
             });
         }

@@ -80,6 +80,12 @@ impl SoftCollider {
     /// Default contact thickness, m.
     pub const DEFAULT_THICKNESS: f32 = 0.002;
 
+    /// Largest contact thickness [`SoftColliderBuilder::build`] accepts, m. The thickness is
+    /// a skin kept between a particle and every collider; a skin thicker than this is a
+    /// modelling error (give the body's mesh its real size instead), and a very thick one
+    /// makes every collider near the body a deep overlap.
+    pub const MAX_THICKNESS: f32 = 0.1;
+
     /// Collision groups: a collider is seen only when both groups accept each other.
     pub fn collision_groups(&self) -> InteractionGroups {
         self.collision_groups
@@ -258,7 +264,7 @@ impl SoftColliderBuilder {
         self
     }
 
-    /// Contact thickness, m.
+    /// Contact thickness, m (0 to [`SoftCollider::MAX_THICKNESS`]).
     pub fn thickness(mut self, t: f32) -> Self {
         self.inner.thickness = t;
         self
@@ -284,6 +290,12 @@ impl SoftColliderBuilder {
         }
         check_coefficient("rolling_resistance", c.rolling_resistance)?;
         check_coefficient("thickness", c.thickness)?;
+        if c.thickness > SoftCollider::MAX_THICKNESS {
+            return Err(CouplingError::BadCoefficient {
+                name: "thickness (m, must be <= SoftCollider::MAX_THICKNESS)",
+                value: c.thickness,
+            });
+        }
         Ok(c)
     }
 }

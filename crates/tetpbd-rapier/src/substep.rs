@@ -1,6 +1,7 @@
 //! The [`tetpbd::SubstepHook`] that runs the coupling inside the soft solver's substeps.
 
 use hecs::World;
+use rapier3d::dynamics::{ImpulseJointSet, MultibodyJointSet};
 use rapier3d::geometry::NarrowPhase;
 use rapier3d::pipeline::QueryPipeline;
 use tetpbd::{Particles, SubstepHook, Surface};
@@ -11,8 +12,11 @@ use crate::contacts::particle::{finish_substep, project_contacts, velocity_pass}
 use crate::contacts::support::{
     end_substep_supports, hold_supported, measure_clearance, project_supports,
 };
+use crate::depenetration::{cap_depenetration, settle_substeps};
 use crate::gather::{Frame, GatherInput};
 use crate::heavy_loads::{stacked_velocity_pass, stacking_pass, Stacking};
+use crate::impact::Impact;
+use crate::joints::project_joints;
 use crate::report::{ContactReport, SoftFeature};
 use crate::response::restitution::{end_episodes, restitution_pass};
 use crate::response::rolling::rolling_pass;
@@ -24,6 +28,8 @@ pub(crate) struct CouplingHook<'q, 'a> {
     pub frame: &'q mut Frame,
     pub qp: QueryPipeline<'a>,
     pub narrow_phase: &'a NarrowPhase,
+    pub impulse_joints: &'a ImpulseJointSet,
+    pub multibody_joints: &'a MultibodyJointSet,
     pub default_collider: SoftCollider,
     pub margin: f32,
     pub max_depenetration_speed: f32,
@@ -49,6 +55,8 @@ impl SubstepHook for CouplingHook<'_, '_> {
         let input = GatherInput {
             qp: &self.qp,
             narrow_phase: self.narrow_phase,
+            impulse_joints: self.impulse_joints,
+            multibody_joints: self.multibody_joints,
             default_collider: &self.default_collider,
             margin: self.margin,
         };
@@ -88,6 +96,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             stats,
             layers,
             pinned,
+            joints,
             ..
         } = &mut *self.frame;
         if layers.len() < soft.len() {
@@ -99,6 +108,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             else {
                 continue;
             };
+            let mut impact = Impact::new(s.reach);
             project_corners(
                 &mut corners[s.corners.clone()],
                 &contacts[s.contacts.clone()],
@@ -108,6 +118,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 colliders,
                 self.qp.colliders,
                 CornerPass::Crossing,
+                &mut impact,
             );
             stats.degenerate_contacts += project_contacts(
                 &mut contacts[s.contacts.clone()],
@@ -116,6 +127,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 colliders,
                 self.qp.colliders,
                 self.max_depenetration_speed * h,
+                &mut impact,
             );
             project_corners(
                 &mut corners[s.corners.clone()],
@@ -126,6 +138,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 colliders,
                 self.qp.colliders,
                 CornerPass::Ordinary,
+                &mut impact,
             );
             project_attachments(&mut attachments[s.attachments.clone()], p, bodies, frac, h);
             let mut stacking = Stacking {
@@ -155,6 +168,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             stats.stacking_time += t.elapsed();
         }
         project_supports(supports, bodies);
+        project_joints(joints, bodies);
     }
 
     fn end_substep(&mut self, world: &mut World, h: f32) {
@@ -169,6 +183,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             active_colliders,
             supports,
             stats,
+            depenetrating,
             ..
         } = &mut *self.frame;
         for b in bodies.iter_mut() {
@@ -218,6 +233,14 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 rolling,
                 h,
             );
+            cap_depenetration(
+                depenetrating,
+                s.entity,
+                &contacts[range.clone()],
+                p,
+                &s.v_cm_pre,
+                settle_substeps(h),
+            );
             finish_substep(&mut contacts[range], h, self.max_depenetration_speed * h);
         }
         end_episodes(episodes);
@@ -248,7 +271,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                     let pose = cp.pose(&frame.bodies);
                     let x = p.positions()[c.particle as usize];
                     let fb = c.has_normal.then_some(c.normal);
-                    if let Some(sp) = surface_point(shape, cp.rule, &pose, &x, fb) {
+                    if let Some(sp) = surface_point(shape, cp.rule, &pose, &x, fb, fb) {
                         if c.solve {
                             max_pen = max_pen.max(-sp.distance);
                         }

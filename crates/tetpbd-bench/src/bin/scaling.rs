@@ -2,7 +2,7 @@
 //! 1/60 s frame), for edges + volume and for vertex–face, on 1 and 2 threads.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown --per-frame]
+//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown --per-frame --no-energy-limit]
 //! ```
 //!
 //! With `--features parallel` the 1-thread and the 2-thread runs are *interleaved*: two
@@ -22,6 +22,9 @@
 //! order converges, e.g. to compare `--parts 1` with a partitioned order.
 //!
 //! `--set` measures one family set only (default both).
+//!
+//! `--no-energy-limit` turns [`tetpbd::SolverSettings::limit_correction_energy`] off (to
+//! measure its cost).
 //!
 //! `--parts P` builds the bodies cut into `P` slabs for the sweep order
 //! ([`tetpbd::SoftBodyBuilder::parts`]; default 0, the builder's choice).
@@ -103,6 +106,7 @@ fn body(
     built.spawn(&mut world);
     let solver = Solver::new(SolverSettings {
         substeps: 10,
+        limit_correction_energy: !flag("--no-energy-limit"),
         ..Default::default()
     })?;
     Ok(Body {

@@ -69,6 +69,7 @@ use tetpbd::{Particles, Surface};
 
 use crate::contacts::particle::ParticleContact;
 use crate::convert::{to_glam, to_na};
+use crate::impact::Impact;
 use crate::response::friction::{positional_friction, ContactStencil, Coulomb};
 use crate::rigid::body::{BodyKind, BodyProxy};
 use crate::rigid::collider::ColliderProxy;
@@ -134,6 +135,7 @@ pub(crate) fn project_corners(
     colliders: &[ColliderProxy],
     set: &ColliderSet,
     pass: CornerPass,
+    impact: &mut Impact,
 ) {
     if pass == CornerPass::Crossing {
         // Only the runs of moving colliders.
@@ -153,12 +155,15 @@ pub(crate) fn project_corners(
                     colliders,
                     set,
                     pass,
+                    impact,
                 );
             }
             i += run;
         }
     } else {
-        sweep_corners(corners, contacts, p, surface, bodies, colliders, set, pass);
+        sweep_corners(
+            corners, contacts, p, surface, bodies, colliders, set, pass, impact,
+        );
     }
 }
 
@@ -172,6 +177,7 @@ fn sweep_corners(
     colliders: &[ColliderProxy],
     set: &ColliderSet,
     pass: CornerPass,
+    impact: &mut Impact,
 ) {
     let crossing_only = pass == CornerPass::Crossing;
     for k in corners {
@@ -248,7 +254,7 @@ fn sweep_corners(
             continue;
         };
         let hit = Hit { v, n, c_val, beta };
-        push_out(k, p, idx, bodies, cp.body, &hit);
+        push_out(k, p, idx, bodies, cp.body, &hit, impact);
     }
 }
 
@@ -348,10 +354,22 @@ fn push_out(
     bodies: &mut [BodyProxy],
     body: Option<usize>,
     hit: &Hit,
+    impact: &mut Impact,
 ) {
-    let Hit { v, n, c_val, beta } = *hit;
+    let Hit { v, n, beta, .. } = *hit;
+    let mut c_val = hit.c_val;
     let w = idx.map(|i| p.inv_masses()[i]);
     let w_body = body.map_or(0.0, |bi| bodies[bi].inv_mass_pushed(&v, &n));
+    // Deeper than the surface takes locally: the rest meets the whole soft body (`impact`
+    // module docs).
+    if let Some((dl, excess)) = impact.take_excess(p, c_val, w_body, &(-n)) {
+        if let Some(bi) = body {
+            bodies[bi].apply_position_impulse(&(n * dl), &v);
+        }
+        k.sub_impulse -= n * dl;
+        k.lambda_n += dl;
+        c_val += excess;
+    }
     let denom: f32 = (0..3).map(|j| w[j] * beta[j] * beta[j]).sum::<f32>() + w_body;
     if denom.is_nan() || denom <= 0.0 {
         return;

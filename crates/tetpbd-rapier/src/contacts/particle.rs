@@ -19,13 +19,15 @@
 //! (a fast body, or a thin shape) takes the entry point and entry face's normal as `q` and
 //! `n` instead of the closest point, which may lie on the far side (`ccd` module docs).
 //!
-//! Overlap a soft body is created with (its first frame in the coupling, a particle already
-//! inside a collider) is not resolved at once: the contact tolerates an allowance, the
-//! starting penetration into the collider itself (the thickness skin is resolved as usual)
-//! less `max_depenetration_speed · h`, which shrinks by that much every
-//! substep (and carries over to the next frames), so the overlap is pushed out at a bounded
-//! speed instead of turning into an explosion. Every other contact, impacts included, has no
-//! allowance.
+//! Overlap is not resolved at once: a contact whose particle, at its first evaluation in a
+//! frame, already stood deeper than one substep's push at the substep start, against the
+//! collider where the collider stood then (a body created inside a collider, a surface given
+//! back to a body that sank, a teleport), tolerates an allowance: that starting depth (skin
+//! included) less `max_depenetration_speed · h`, which shrinks by that much every substep
+//! (and carries over to the next frames), so the overlap is pushed out at a bounded speed
+//! instead of turning into an explosion. Impacts (outside at the substep start) and
+//! colliders moving into a particle get no allowance. The body does not keep the speed of
+//! that push (`depenetration` module docs).
 //!
 //! The velocity pass then removes the separating normal velocity the projection gave each
 //! contact particle; restitution is applied to the whole body by [`crate::response::restitution`],
@@ -37,10 +39,11 @@ use rapier3d::geometry::ColliderSet;
 use tetpbd::Particles;
 
 use crate::ccd::swept_entry;
+use crate::impact::Impact;
 use crate::response::friction::{positional_friction, ContactStencil, Coulomb};
 use crate::rigid::body::{BodyKind, BodyProxy};
 use crate::rigid::collider::ColliderProxy;
-use crate::rigid::shape_query::surface_point;
+use crate::rigid::shape_query::{surface_point, InsideRule};
 
 /// A surface particle near a collider: an XPBD inequality contact re-evaluated every
 /// iteration of every substep.
@@ -64,11 +67,15 @@ pub(crate) struct ParticleContact {
     /// Penetration tolerated in this substep (pre-existing overlap beyond one substep's
     /// allowed push-out), m; see `CouplingSettings::max_depenetration_speed`.
     pub allowance: f32,
-    /// Whether `allowance` was decided: at the contact's first evaluation in the frame, or
-    /// at gathering for a pair already touching in the previous frame (no allowance).
+    /// Whether `allowance` was decided for the frame (at the contact's first evaluation; a
+    /// pair already touching in the previous frame starts from what was left of its
+    /// allowance).
     pub allowance_fresh: bool,
     pub sub_impulse: Vector3<f32>,
     pub impulse: Vector3<f32>,
+    /// For a thin mesh (`mesh_side` module docs): the side the particle belongs on in the
+    /// current substep (unit, world; from where it stood at the substep start), once decided.
+    pub side: Option<Vector3<f32>>,
 }
 
 /// One sweep over a soft body's particle contacts. Returns the number of degenerate
@@ -80,6 +87,7 @@ pub(crate) fn project_contacts(
     colliders: &[ColliderProxy],
     set: &ColliderSet,
     max_push: f32,
+    impact: &mut Impact,
 ) -> u64 {
     let mut degenerate = 0;
     for c in contacts {
@@ -91,9 +99,13 @@ pub(crate) fn project_contacts(
         let x = p.positions()[i];
         let pose = cp.pose(bodies);
         let fallback = c.has_normal.then_some(c.normal);
-        let closest = surface_point(shape, cp.rule, &pose, &x, fallback);
-        // Relative motion that entered the shape within the substep (`ccd` module docs).
         let moving = cp.body.is_some_and(|b| bodies[b].kind != BodyKind::Fixed);
+        if cp.rule == InsideRule::ThinMesh && c.side.is_none() {
+            let before = if moving { cp.prev_pose(bodies) } else { pose };
+            c.side = thin_side(shape, &before, &p.prev_positions()[i], fallback);
+        }
+        let closest = surface_point(shape, cp.rule, &pose, &x, fallback, c.side);
+        // Relative motion that entered the shape within the substep (`ccd` module docs).
         let swept = swept_entry(
             shape,
             &pose,
@@ -109,19 +121,22 @@ pub(crate) fn project_contacts(
         let (q, n) = (sp.point, sp.normal);
         let depth = c.thickness - sp.distance;
         if !c.allowance_fresh {
-            // First evaluation of this contact in the frame. If it is deeper than one substep
-            // may push out and was already this deep at the substep start (an overlap, not an
-            // impact), resolve only `max_push` of that pre-existing overlap per substep: the
+            // First evaluation of the contact in the frame. If it is deeper than one substep
+            // may push out and was already this deep at the substep start, against the
+            // collider where it stood then (an overlap, not an impact nor a collider moving
+            // into it), resolve only `max_push` of that pre-existing overlap per substep: the
             // allowance decays by `max_push` each substep (`finish_substep`).
             c.allowance_fresh = true;
             if depth > max_push {
                 let x0 = p.prev_positions()[i];
-                if let Some(s0) = surface_point(shape, cp.rule, &pose, &x0, Some(n)) {
-                    c.allowance = (-s0.distance - max_push).max(0.0);
+                let before = if moving { cp.prev_pose(bodies) } else { pose };
+                if let Some(s0) = surface_point(shape, cp.rule, &before, &x0, Some(n), c.side) {
+                    let overlap = c.thickness - s0.distance - max_push;
+                    c.allowance = c.allowance.max(overlap);
                 }
             }
         }
-        let c_val = -depth + c.allowance;
+        let mut c_val = -depth + c.allowance;
         if depth <= 0.0 {
             continue;
         }
@@ -133,6 +148,17 @@ pub(crate) fn project_contacts(
         c.depth = c.depth.max(depth);
         if !c.solve || c_val >= 0.0 {
             continue;
+        }
+        // An impact deeper than the surface can take locally within the substep meets the
+        // whole soft body (`impact` module docs).
+        let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_pushed(&q, &-n));
+        if let Some((dl, excess)) = impact.take_excess(p, c_val, w_b, &n) {
+            if let Some(b) = cp.body {
+                bodies[b].apply_position_impulse(&(-n * dl), &q);
+            }
+            c.lambda_n += dl;
+            c.sub_impulse += n * dl;
+            c_val += excess;
         }
         let w_p = p.inv_masses()[i];
         let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_pushed(&q, &-n));
@@ -250,6 +276,28 @@ pub(crate) fn velocity_pass(
     }
 }
 
+/// The side of a thin mesh at `pose` that the point `x0` stands on (unit, world, from the
+/// mesh towards it: `mesh_side` module docs); `fallback` when `x0` lies on the mesh.
+fn thin_side(
+    shape: &dyn rapier3d::parry::shape::Shape,
+    pose: &nalgebra::Isometry3<f32>,
+    x0: &Vector3<f32>,
+    fallback: Option<Vector3<f32>>,
+) -> Option<Vector3<f32>> {
+    let mesh = shape.as_trimesh()?;
+    let local = pose.inverse_transform_point(&Point3::from(*x0));
+    let proj = rapier3d::parry::query::PointQuery::project_local_point(
+        mesh,
+        crate::convert::to_glam(&local.coords),
+        false,
+    );
+    let d = local.coords - crate::convert::to_na(proj.point);
+    match d.try_normalize(1e-6) {
+        Some(n) => Some(pose.rotation * n),
+        None => fallback,
+    }
+}
+
 /// Resets the per-substep state of the contacts; the substep's impulses join the frame's.
 pub(crate) fn finish_substep(contacts: &mut [ParticleContact], h: f32, max_push: f32) {
     for c in contacts {
@@ -258,6 +306,7 @@ pub(crate) fn finish_substep(contacts: &mut [ParticleContact], h: f32, max_push:
         c.lambda_n = 0.0;
         c.lambda_t = 0.0;
         c.active = false;
+        c.side = None;
         c.allowance = (c.allowance - max_push).max(0.0);
     }
 }

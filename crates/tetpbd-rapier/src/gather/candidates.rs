@@ -24,8 +24,6 @@ struct SoftInFrame<'b> {
     p: &'b Particles,
     surface: &'b Surface,
     sc: SoftCollider,
-    /// Created this frame (not in `Frame::seen`).
-    newcomer: bool,
     /// Index of the body's first particle contact.
     c0: usize,
     /// How far a collider may be and still be reached within the frame, m.
@@ -63,7 +61,6 @@ impl Frame {
             Option<&Attachments>,
         )>() {
             let sc = sc.copied().unwrap_or(*input.default_collider);
-            let newcomer = self.seen.binary_search(&entity.to_bits().get()).is_err();
             let c0 = self.contacts.len();
             let k0 = self.corners.len();
             let a0 = self.attachments.len();
@@ -74,7 +71,6 @@ impl Frame {
                     p,
                     surface,
                     sc,
-                    newcomer,
                     c0,
                     reach,
                 };
@@ -90,9 +86,11 @@ impl Frame {
                 corners: k0..self.corners.len(),
                 attachments: a0..self.attachments.len(),
                 stacked: false,
+                reach: crate::impact::local_reach(p, surface),
             });
         }
-        self.anchor_attached_bodies(input);
+        self.anchor_supported_bodies(input);
+        self.gather_joints(input);
         self.stats.candidates = self.contacts.len();
         self.stats.corner_candidates = self.corners.len();
         self.stats.attachments = self.attachments.len();
@@ -210,8 +208,6 @@ impl Frame {
             }
             let key = (body.entity.to_bits().get(), handle.into_raw_parts(), i);
             let previous = self.touching.binary_search_by_key(&key, |t| t.0).ok();
-            // Allowance decided now unless the body is new (see `seen`).
-            let decided = previous.is_some() || !body.newcomer;
             self.contacts.push(ParticleContact {
                 particle: i,
                 collider: ci,
@@ -231,9 +227,10 @@ impl Frame {
                 // Touching in the previous frame: an ongoing contact, which keeps what is
                 // left of its overlap allowance (usually nothing).
                 allowance: previous.map_or(0.0, |k| self.touching[k].1),
-                allowance_fresh: decided,
+                allowance_fresh: false,
                 sub_impulse: Vector3::zeros(),
                 impulse: Vector3::zeros(),
+                side: None,
             });
         }
     }
@@ -284,14 +281,12 @@ impl Frame {
         }
     }
 
-    /// A supported body holding a soft body by an attachment is anchored: it takes part with
-    /// its own mass, its rigid contacts kept as constraints (`contacts::support` module docs).
-    fn anchor_attached_bodies(&mut self, input: &GatherInput<'_, '_>) {
+    /// Every supported body a soft body may touch is anchored: it takes part with its own
+    /// mass, its rigid contacts kept as constraints (`contacts::support` module docs; the
+    /// decision and its measured alternatives: `docs/decisions/coupled-rigid-supports.md`).
+    fn anchor_supported_bodies(&mut self, input: &GatherInput<'_, '_>) {
         let qp = input.qp;
-        for k in 0..self.attachments.len() {
-            let Some(b) = self.attachments[k].body else {
-                continue;
-            };
+        for b in 0..self.bodies.len() {
             if self.bodies[b].kind == BodyKind::Supported {
                 let first = self.supports.len();
                 gather_supports(

@@ -12,7 +12,7 @@ use std::collections::HashMap;
 
 use hecs::Entity;
 use nalgebra::{Isometry3, Vector3};
-use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
+use rapier3d::dynamics::{ImpulseJointSet, MultibodyJointSet, RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{Aabb, ColliderHandle, ColliderSet, NarrowPhase};
 use rapier3d::pipeline::QueryPipeline;
 
@@ -21,11 +21,12 @@ use crate::contacts::corner::CornerContact;
 use crate::contacts::particle::ParticleContact;
 use crate::contacts::support::Support;
 use crate::convert::{pose_to_glam, pose_to_na};
+use crate::joints::{joints_of, JointRun};
+use crate::mesh_side::MeshRules;
 use crate::report::CouplingStats;
 use crate::response::restitution::Episode;
 use crate::rigid::body::{BodyProxy, StartState};
 use crate::rigid::collider::ColliderProxy;
-use crate::rigid::shape_query::InsideRule;
 use crate::soft_collider::SoftCollider;
 use corner_points::Corners;
 
@@ -40,6 +41,9 @@ pub(crate) struct SoftEntry {
     pub attachments: std::ops::Range<usize>,
     /// Whether the stacking pass ran on the body in the current substep.
     pub stacked: bool,
+    /// How deep an impact its surface takes locally within a substep, m
+    /// (`impact` module docs).
+    pub reach: f32,
 }
 
 /// A particle–collider pair: `(entity bits, collider handle (index, generation), particle)`.
@@ -51,14 +55,15 @@ pub(crate) struct Frame {
     /// Particle–collider pairs in contact during the previous frame, sorted by
     /// `(entity bits, collider handle (index, generation), particle)`, with the overlap
     /// allowance they still had (m). A contact found in this frame whose pair is not here is
-    /// new: an overlap it starts with is pushed out at the bounded depenetration speed (see
-    /// `contacts::particle::project_contacts`); one that is here continues with its allowance.
+    /// new; one that is here continues with what was left of its overlap allowance (both
+    /// are bounded by the depenetration speed: `contacts::particle` module docs).
     pub touching: Vec<(PairKey, f32)>,
-    /// Soft bodies (entity bits) stepped in the previous frame, sorted. Only a body not in
-    /// this list (created this frame) gets an overlap allowance: an overlap it was created
-    /// with is pushed out at the bounded speed; any other penetration is resolved fully.
-    pub seen: Vec<u64>,
     pub start_poses: Vec<((u32, u32), StartState)>,
+    /// Soft bodies being pushed out of an overlap (`depenetration` module docs), kept
+    /// across frames.
+    pub depenetrating: Vec<crate::depenetration::Depenetrating>,
+    /// Inside rules of the triangle meshes seen (`mesh_side` module docs).
+    mesh_rules: MeshRules,
     pub soft: Vec<SoftEntry>,
     pub bodies: Vec<BodyProxy>,
     /// Proxy index of a rigid body handle (lookups only; cleared, capacity kept).
@@ -71,6 +76,10 @@ pub(crate) struct Frame {
     pub attachments: Vec<AttachRun>,
     /// Rigid contacts of anchored bodies (`contacts::support` module docs).
     pub supports: Vec<Support>,
+    /// Joints of the dynamic bodies taking part (`joints` module docs).
+    pub joints: Vec<JointRun>,
+    /// Scratch: the joints gathered so far (each is met from both of its bodies).
+    joint_keys: Vec<(bool, u32, u32)>,
     /// Force (N) and torque (N·m) added to bodies for rapier's next step (the load of the
     /// previous frame, `BodyProxy::load`), taken off again after that step.
     pub loads: Vec<(RigidBodyHandle, Vector3<f32>, Vector3<f32>)>,
@@ -101,6 +110,8 @@ pub(crate) struct Frame {
 pub(crate) struct GatherInput<'q, 'a> {
     pub qp: &'q QueryPipeline<'a>,
     pub narrow_phase: &'q NarrowPhase,
+    pub impulse_joints: &'q ImpulseJointSet,
+    pub multibody_joints: &'q MultibodyJointSet,
     pub default_collider: &'q SoftCollider,
     pub margin: f32,
 }
@@ -184,7 +195,7 @@ impl Frame {
             handle,
             body,
             local,
-            rule: InsideRule::of(co.shape()),
+            rule: self.mesh_rules.rule(handle, co.shape()),
             friction: co.friction(),
             friction_rule: co.friction_combine_rule(),
             restitution: co.restitution(),
@@ -223,9 +234,35 @@ impl Frame {
             }
         }
         self.touching.sort_unstable_by_key(|t| t.0);
-        self.seen.clear();
-        self.seen
-            .extend(self.soft.iter().map(|s| s.entity.to_bits().get()));
-        self.seen.sort_unstable();
+    }
+
+    /// The joints of the dynamic bodies taking part (`joints` module docs); the other body of
+    /// a joint gets a proxy if it has none.
+    pub(crate) fn gather_joints(&mut self, input: &GatherInput<'_, '_>) {
+        self.joints.clear();
+        self.joint_keys.clear();
+        let n = self.bodies.len();
+        for b in 0..n {
+            if !self.bodies[b].is_dynamic() {
+                continue;
+            }
+            let handle = self.bodies[b].handle;
+            let joints = joints_of(handle, input.impulse_joints, input.multibody_joints);
+            for (h1, h2, key, joint) in joints {
+                if self.joint_keys.contains(&key) {
+                    continue;
+                }
+                let (Some(p1), Some(p2)) = (
+                    self.body_proxy(h1, input.qp.bodies, input.narrow_phase),
+                    self.body_proxy(h2, input.qp.bodies, input.narrow_phase),
+                ) else {
+                    continue;
+                };
+                if let Some(run) = JointRun::new(joint, p1, p2) {
+                    self.joint_keys.push(key);
+                    self.joints.push(run);
+                }
+            }
+        }
     }
 }

@@ -7,9 +7,12 @@
 //!
 //! * a **heightfield** is solid below its surface: a point whose offset from its projection
 //!   points down (local −y) is inside;
-//! * a **triangle mesh** without pseudo-normals (not built with `TriMeshFlags::ORIENTED` or
-//!   `FIX_INTERNAL_EDGES`) is one-sided: a point behind the face it projects onto (against
-//!   the counter-clockwise winding normal) is inside. Oriented meshes use parry's answer.
+//! * a **triangle mesh** has an inside only when it is closed and wound outwards; any other
+//!   mesh (open, or wound inwards) is a thin sheet, and a point is inside it when it stands
+//!   on the other side of the sheet than the side it came from (`mesh_side` module docs). A
+//!   closed outward mesh without pseudo-normals (not built with `TriMeshFlags::ORIENTED` or
+//!   `FIX_INTERNAL_EDGES`) is solid behind the face a point projects onto (against its
+//!   counter-clockwise winding normal); with them parry answers.
 
 use nalgebra::{Isometry3, Point3, Vector3};
 use rapier3d::parry::query::PointQuery;
@@ -24,12 +27,16 @@ pub(crate) enum InsideRule {
     Solid,
     /// Below the heightfield's surface.
     HeightField,
-    /// Behind the projected triangle of a non-oriented mesh.
+    /// Behind the projected triangle of a closed, outward-wound mesh without pseudo-normals.
     OneSidedMesh,
+    /// A thin sheet (open or inward-wound mesh): inside when on the other side than the
+    /// point's reference side (`mesh_side` module docs).
+    ThinMesh,
 }
 
 impl InsideRule {
-    /// The rule of `shape`.
+    /// The rule of `shape`, a triangle mesh taken as closed and outward-wound (the coupling
+    /// checks that: `mesh_side::MeshRules`).
     pub fn of(shape: &dyn Shape) -> InsideRule {
         if shape.as_heightfield().is_some() {
             InsideRule::HeightField
@@ -54,13 +61,16 @@ pub(crate) struct SurfacePoint {
 }
 
 /// Projects `p` (world) onto `shape` placed at `pose`. `fallback` is the normal used when
-/// `p` lies exactly on the surface; without it such a point returns `None`.
+/// `p` lies exactly on the surface; without it such a point returns `None`. For a
+/// [`InsideRule::ThinMesh`], `side` (world) points to the side `p` belongs on (`fallback`,
+/// then the face's winding normal, when it is `None`).
 pub(crate) fn surface_point(
     shape: &dyn Shape,
     rule: InsideRule,
     pose: &Isometry3<f32>,
     p: &Vector3<f32>,
     fallback: Option<Vector3<f32>>,
+    side: Option<Vector3<f32>>,
 ) -> Option<SurfacePoint> {
     let local = pose.inverse_transform_point(&Point3::from(*p)).coords;
     let lp = to_glam(&local);
@@ -73,6 +83,20 @@ pub(crate) fn surface_point(
             let proj = shape.project_local_point(lp, false);
             let q = to_na(proj.point);
             (q, local.y < q.y)
+        }
+        InsideRule::ThinMesh => {
+            let mesh = shape.as_trimesh()?;
+            let (proj, _) = mesh.project_local_point_and_get_feature(lp);
+            let q = to_na(proj.point);
+            let reference = match side.or(fallback) {
+                Some(r) => pose.rotation.inverse() * r,
+                None => mesh
+                    .triangle(proj.subshape)
+                    .normal()
+                    .map(to_na)
+                    .unwrap_or_default(),
+            };
+            (q, (local - q).dot(&reference) < 0.0)
         }
         InsideRule::OneSidedMesh => {
             let mesh = shape.as_trimesh()?;
@@ -112,7 +136,7 @@ mod tests {
 
     fn query(shape: &SharedShape, p: Vector3<f32>) -> SurfacePoint {
         let rule = InsideRule::of(shape.as_ref());
-        surface_point(shape.as_ref(), rule, &Isometry3::identity(), &p, None).unwrap()
+        surface_point(shape.as_ref(), rule, &Isometry3::identity(), &p, None, None).unwrap()
     }
 
     #[test]
@@ -138,7 +162,7 @@ mod tests {
     }
 
     #[test]
-    fn unoriented_trimesh_is_one_sided() {
+    fn one_sided_rule_is_solid_behind_the_winding_normal() {
         let v = vec![
             Vector::new(-1.0, 0.0, -1.0),
             Vector::new(1.0, 0.0, -1.0),
@@ -156,13 +180,45 @@ mod tests {
     }
 
     #[test]
+    fn a_thin_mesh_keeps_a_point_on_the_side_it_came_from() {
+        let v = vec![
+            Vector::new(-1.0, 0.0, -1.0),
+            Vector::new(1.0, 0.0, -1.0),
+            Vector::new(1.0, 0.0, 1.0),
+            Vector::new(-1.0, 0.0, 1.0),
+        ];
+        for idx in [vec![[0, 2, 1], [0, 3, 2]], vec![[0, 1, 2], [0, 2, 3]]] {
+            let mesh =
+                SharedShape::trimesh_with_flags(v.clone(), idx, TriMeshFlags::empty()).unwrap();
+            let rule = crate::mesh_side::trimesh_rule(mesh.as_trimesh().unwrap());
+            assert_eq!(rule, InsideRule::ThinMesh);
+            let id = Isometry3::identity();
+            for (from, at, inside) in [
+                (0.1, 0.05, false),
+                (0.1, -0.05, true),
+                (-0.1, -0.05, false),
+                (-0.1, 0.05, true),
+            ] {
+                let side = Some(Vector3::new(0.0, from, 0.0));
+                let p = Vector3::new(0.2, at, 0.3);
+                let sp = surface_point(mesh.as_ref(), rule, &id, &p, None, side).unwrap();
+                assert_eq!(sp.distance < 0.0, inside, "from {from} to {at}: {sp:?}");
+                assert!(
+                    (sp.normal.y * from).signum() > 0.0,
+                    "normal towards the side it came from"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn a_point_on_the_surface_needs_a_fallback_normal() {
         let cuboid = SharedShape::cuboid(1.0, 1.0, 1.0);
         let rule = InsideRule::of(cuboid.as_ref());
         let p = Vector3::new(0.0, 1.0, 0.0);
         let id = Isometry3::identity();
-        assert!(surface_point(cuboid.as_ref(), rule, &id, &p, None).is_none());
-        let sp = surface_point(cuboid.as_ref(), rule, &id, &p, Some(Vector3::y())).unwrap();
+        assert!(surface_point(cuboid.as_ref(), rule, &id, &p, None, None).is_none());
+        let sp = surface_point(cuboid.as_ref(), rule, &id, &p, Some(Vector3::y()), None).unwrap();
         assert_eq!(sp.distance, 0.0);
         assert_eq!(sp.normal, Vector3::y());
     }

@@ -310,6 +310,29 @@ impl BodyProxy {
         n.dot(&self.inv_mass.component_mul(n)) + rn.dot(&(self.inv_inertia * rn))
     }
 
+    /// Generalized inverse mass `aᵀ I⁻¹ a` of a rotation about the unit axis `a` (world),
+    /// 1/(kg·m²); 0 for fixed and kinematic bodies.
+    pub fn inv_inertia_along(&self, a: &Vector3<f32>) -> f32 {
+        if self.kind != BodyKind::Dynamic {
+            return 0.0;
+        }
+        a.dot(&(self.inv_inertia * a))
+    }
+
+    /// Turns the body by the angular positional impulse `l` (kg·m²·rad: axis × Δλ) of a
+    /// joint (`joints` module docs); fixed and kinematic bodies do not move.
+    pub fn apply_angular_impulse(&mut self, l: &Vector3<f32>) {
+        if self.kind != BodyKind::Dynamic {
+            return;
+        }
+        let dtheta = self.inv_inertia * l;
+        let dq = Quaternion::from_parts(0.0, dtheta) * self.dq.into_inner() * 0.5;
+        self.dq = UnitQuaternion::new_normalize(self.dq.into_inner() + dq);
+        self.touched = true;
+        let frac = self.frac;
+        self.set_pose(frac);
+    }
+
     /// Applies a soft positional impulse `p` (kg·m: direction × Δλ) at the world point `q`.
     /// An anchored body ignores it when it does not move the body ([`Self::moves`]), and
     /// one pressing it into its supports moves it at most down to them.
