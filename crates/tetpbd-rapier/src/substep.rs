@@ -18,7 +18,7 @@ use crate::heavy_loads::{stacked_velocity_pass, stacking_pass, Stacking};
 use crate::impact::Impact;
 use crate::joints::project_joints;
 use crate::report::{ContactReport, SoftFeature};
-use crate::response::restitution::{end_episodes, restitution_pass};
+use crate::response::restitution::restitution_pass;
 use crate::response::rolling::rolling_pass;
 use crate::rigid::shape_query::surface_point;
 use crate::soft_collider::SoftCollider;
@@ -243,7 +243,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             );
             finish_substep(&mut contacts[range], h, self.max_depenetration_speed * h);
         }
-        end_episodes(episodes);
+        episodes.end_substep();
         for k in corners.iter_mut() {
             k.active = false;
             k.impulse += k.sub_impulse / h;

@@ -1,7 +1,8 @@
 //! A soft body taking part in a frame of soft–soft contacts.
 
-use hecs::Entity;
+use hecs::{Entity, World};
 use nalgebra::Vector3;
+use tetpbd::Particles;
 
 use crate::soft_collider::SoftCollider;
 
@@ -24,4 +25,52 @@ pub(crate) struct FrameBody {
     pub inv_mass: f32,
     /// `true` when some candidate refers to the body's slots.
     pub involved: bool,
+}
+
+impl FrameBody {
+    /// Velocity of the body's free particles' centre of mass, m/s
+    /// ([`tetpbd::Particles::free_velocity`]; zero when it cannot be read).
+    pub fn com_velocity(&self, world: &mut World) -> Vector3<f32> {
+        match world.query_one_mut::<&Particles>(self.entity) {
+            Ok(p) => p.free_velocity().map_or(Vector3::zeros(), |v| v.0),
+            Err(_) => Vector3::zeros(),
+        }
+    }
+}
+
+/// The normal velocity of body `a`'s centre of mass relative to body `b`'s along the unit
+/// normal `n` (m/s, > 0 separating).
+pub(crate) fn relative_normal_velocity(
+    world: &mut World,
+    a: &FrameBody,
+    b: &FrameBody,
+    n: &Vector3<f32>,
+) -> f32 {
+    (a.com_velocity(world) - b.com_velocity(world)).dot(n)
+}
+
+/// Changes the relative normal velocity of `a` against `b` along the unit normal `n` by `dv`
+/// (m/s) with opposite impulses on the two bodies, shared by their inverse masses `W`: `a`'s
+/// free particles all get `n dv W_a/(W_a+W_b)`, `b`'s `−n dv W_b/(W_a+W_b)` (momentum kept,
+/// no deformation added). Nothing when neither can move.
+pub(crate) fn exchange(
+    world: &mut World,
+    (a, b): (&FrameBody, &FrameBody),
+    n: &Vector3<f32>,
+    dv: f32,
+) {
+    let (wa, wb) = (a.inv_mass, b.inv_mass);
+    let wsum = wa + wb;
+    if wsum.is_nan() || wsum <= 0.0 {
+        return;
+    }
+    add_velocity(world, a.entity, n * (dv * wa / wsum));
+    add_velocity(world, b.entity, n * (-dv * wb / wsum));
+}
+
+/// Adds `dv` (m/s) to the velocity of every free particle of a body.
+fn add_velocity(world: &mut World, e: Entity, dv: Vector3<f32>) {
+    if let Ok(p) = world.query_one_mut::<&mut Particles>(e) {
+        p.add_free_velocity(&dv);
+    }
 }

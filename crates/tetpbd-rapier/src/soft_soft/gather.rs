@@ -148,13 +148,7 @@ impl Gather {
             if self_collide {
                 cache.ensure_rings();
             }
-            let pinned = p.inv_masses().iter().any(|w| *w <= 0.0);
-            let mass = p.total_mass();
-            let inv_mass = if pinned || mass.is_nan() || mass <= 0.0 {
-                0.0
-            } else {
-                1.0 / mass
-            };
+            let inv_mass = p.rigid_inv_mass();
             self.bodies.push(FrameBody {
                 entity: e,
                 cache: ci,

@@ -235,7 +235,9 @@ impl SubstepHook for SoftContacts {
         self.separation
             .remove_velocity(world, &self.gather.bodies, h);
         self.frame.velocity_pass(world, &self.gather);
-        self.restitution.apply(world, &self.gather, &self.frame);
+        let a_max = self.settings.max_acceleration;
+        self.restitution
+            .apply(world, &self.gather, &self.frame, a_max, h);
     }
 
     fn end_frame(&mut self, world: &mut World, _dt: f32) {

@@ -1,42 +1,38 @@
 //! Body-level restitution of soft–soft contacts: bodies in contact separate as wholes at no
-//! more than `e` times the speed at which they met (Poisson's hypothesis on the two centres
-//! of mass), `e` the combined restitution of their [`crate::SoftCollider`]s (0 by default).
+//! more than `e` times the speed at which they met, `e` the combined restitution of their
+//! [`crate::SoftCollider`]s (0 by default).
 //!
 //! The per-particle velocity pass removes the separating velocity a contact's projection
 //! gives its particles, but a stiff XPBD body also stores the impact in its constraints and
 //! springs back while still touching: a soft cube dropped on another soft body leaves it at
 //! about 60 % of its impact speed, and a pile of them scatters. So after each substep, for
-//! every body pair with contacts projected in it:
+//! every body pair with contacts projected in it, with
 //!
 //! ```text
-//! n     = normalize( Σ contact normals, oriented from b to a )
-//! v_rel = (v_cm,a − v_cm,b) · n
-//! v⁻    = −(v_cm,a − v_cm,b)⁻ · n      the approach speed before the substep in which the
-//!                                      pair's contact episode began (kept while it lasts)
-//! if v_rel > e v⁻:  a's velocities −= n (v_rel − e v⁻) W_a/(W_a+W_b),  b's += n (…) W_b/(W_a+W_b)
+//! n   = normalize( Σ contact normals, oriented from b to a )
+//! v_n = (v_cm,a − v_cm,b) · n          (> 0 separating)
 //! ```
 //!
-//! (`W`: 1/body mass, 0 for a body with a pinned particle; `v_cm` the velocity of a body's
-//! free particles' centre of mass, [`tetpbd::Particles::free_velocity`]). Momentum is
-//! conserved, every particle of a body gets the same change (no deformation is added), and
-//! only the normal part of the relative motion is touched: sliding and rolling are left to
-//! friction. An episode ends with the first substep in which the pair has no contact. With
-//! `e = 0` no approach speed is needed and none is measured.
+//! (`v_cm` the velocity of a body's free particles' centre of mass,
+//! [`tetpbd::Particles::free_velocity`]), the pair runs the same impact episode as a soft
+//! body against a collider (`response::restitution`, Poisson's hypothesis on the centres of
+//! mass): an approach faster than `2 a_max h` before the episode's first substep
+//! ([`crate::SoftContactSettings::max_acceleration`] standing in for gravity, which a bare
+//! solver's hook does not know) is an impact, bounced back at `e` times its approach speed
+//! once compression ends and capped there while the contact lasts. Any other contact, and
+//! every contact when `e = 0`, does not separate as a whole: `v_n` is capped at 0. The change
+//! is an opposite pair of impulses on the two bodies shared by `W` (1/body mass, 0 for a
+//! body with a pinned particle): momentum is conserved, every particle of a body gets the
+//! same change (no deformation is added), and only the normal part of the relative motion is
+//! touched (sliding and rolling are left to friction). With `e = 0` no approach speed is
+//! needed and none is measured.
 
-use hecs::{Entity, World};
+use hecs::World;
 use nalgebra::Vector3;
-use tetpbd::Particles;
 
+use crate::response::restitution::Episodes;
+use crate::soft_soft::body::{exchange, relative_normal_velocity};
 use crate::soft_soft::gather::{ContactFrame, Gather};
-
-/// The contact episode of a pair of soft bodies (entity bits, lower first).
-#[derive(Clone, Copy, Debug)]
-struct Episode {
-    key: (u64, u64),
-    /// Approach speed `v⁻` (m/s, ≥ 0) when the episode began.
-    approach: f32,
-    seen: bool,
-}
 
 /// State of the body-level restitution kept across substeps and frames.
 #[derive(Clone, Debug, Default)]
@@ -46,7 +42,7 @@ pub(crate) struct BodyRestitution {
     /// Per frame body: centre-of-mass velocity at the substep start (only when some pair
     /// has a restitution above 0).
     v_pre: Vec<Vector3<f32>>,
-    episodes: Vec<Episode>,
+    episodes: Episodes,
 }
 
 impl BodyRestitution {
@@ -58,14 +54,12 @@ impl BodyRestitution {
             return;
         }
         self.v_pre
-            .extend(g.bodies.iter().map(|b| com_velocity(world, b.entity)));
+            .extend(g.bodies.iter().map(|b| b.com_velocity(world)));
     }
 
-    /// Applies the body-level restitution after a substep.
-    pub fn apply(&mut self, world: &mut World, g: &Gather, frame: &ContactFrame) {
-        for ep in &mut self.episodes {
-            ep.seen = false;
-        }
+    /// Applies the body-level restitution after a substep of `h` (s); `a_max` (m/s²) sets
+    /// the impact threshold (module docs).
+    pub fn apply(&mut self, world: &mut World, g: &Gather, frame: &ContactFrame, a_max: f32, h: f32) {
         self.sums.clear();
         self.sums.resize(g.pairs.len(), Vector3::zeros());
         let mut any = false;
@@ -85,85 +79,45 @@ impl BodyRestitution {
             any = true;
         }
         if any {
+            let threshold = 2.0 * a_max * h;
             for k in 0..g.pairs.len() {
-                self.pair(world, g, k);
+                self.pair(world, g, k, threshold);
             }
         }
-        self.episodes.retain(|ep| ep.seen);
+        self.episodes.end_substep();
     }
 
     /// The restitution of pair `k` of the frame.
-    fn pair(&mut self, world: &mut World, g: &Gather, k: usize) {
+    fn pair(&mut self, world: &mut World, g: &Gather, k: usize, threshold: f32) {
         let (a, b) = g.pairs[k];
         let len = self.sums[k].norm();
         if len.is_nan() || len <= 1e-9 {
             return;
         }
         let n = self.sums[k] / len;
-        let (wa, wb) = (g.bodies[a].inv_mass, g.bodies[b].inv_mass);
-        let wsum = wa + wb;
-        if wsum.is_nan() || wsum <= 0.0 {
+        let (ba, bb) = (&g.bodies[a], &g.bodies[b]);
+        if ba.inv_mass + bb.inv_mass <= 0.0 {
             return;
         }
+        let v_n = relative_normal_velocity(world, ba, bb, &n);
         let e = g.pair_props[k].restitution;
-        let approach = if e > 0.0 {
-            let (ea, eb) = (g.bodies[a].entity, g.bodies[b].entity);
+        let impact = if e > 0.0 {
+            let key = (ba.entity.to_bits().get(), bb.entity.to_bits().get());
             let v_pre = (self.v_pre.get(a), self.v_pre.get(b));
-            let before = match v_pre {
-                (Some(va), Some(vb)) => (vb - va).dot(&n).max(0.0),
+            let approach = || match v_pre {
+                (Some(va), Some(vb)) => (va - vb).dot(&n),
                 _ => 0.0,
             };
-            self.episode(ea, eb, before)
+            self.episodes.impact(key, approach, threshold)
         } else {
-            0.0
+            None
         };
-        let va = com_velocity(world, g.bodies[a].entity);
-        let vb = com_velocity(world, g.bodies[b].entity);
-        let excess = (va - vb).dot(&n) - e * approach;
-        if excess.is_nan() || excess <= 0.0 {
-            return;
-        }
-        add_velocity(world, g.bodies[a].entity, n * (-excess * wa / wsum));
-        add_velocity(world, g.bodies[b].entity, n * (excess * wb / wsum));
-    }
-
-    /// The approach speed of the pair's episode, begun now with `before` if it is new.
-    fn episode(&mut self, a: Entity, b: Entity, before: f32) -> f32 {
-        let (ka, kb) = (a.to_bits().get(), b.to_bits().get());
-        let key = (ka.min(kb), ka.max(kb));
-        let k = match self.episodes.binary_search_by(|ep| ep.key.cmp(&key)) {
-            Ok(k) => k,
-            Err(k) => {
-                let ep = Episode {
-                    key,
-                    approach: before,
-                    seen: false,
-                };
-                self.episodes.insert(k, ep);
-                k
-            }
+        let dv = match impact {
+            Some(ep) => ep.change(v_n, e),
+            None => (v_n > 0.0).then_some(-v_n),
         };
-        self.episodes[k].seen = true;
-        self.episodes[k].approach
-    }
-}
-
-fn com_velocity(world: &mut World, e: Entity) -> Vector3<f32> {
-    match world.query_one_mut::<&Particles>(e) {
-        Ok(p) => p.free_velocity().map_or(Vector3::zeros(), |v| v.0),
-        Err(_) => Vector3::zeros(),
-    }
-}
-
-fn add_velocity(world: &mut World, e: Entity, dv: Vector3<f32>) {
-    if dv == Vector3::zeros() || !dv.iter().all(|c| c.is_finite()) {
-        return;
-    }
-    if let Ok(p) = world.query_one_mut::<&mut Particles>(e) {
-        for i in 0..p.len() {
-            if p.inv_masses()[i] > 0.0 {
-                p.velocities_mut()[i] += dv;
-            }
+        if let Some(dv) = dv.filter(|dv| !dv.is_nan()) {
+            exchange(world, (ba, bb), &n, dv);
         }
     }
 }

@@ -22,7 +22,8 @@ pub struct SoftContactSettings {
     /// Extra candidate distance on top of the motion bound, m (≥ 0).
     pub margin: f32,
     /// Acceleration assumed in the motion bound `|v| dt + ½ a dt²`, m/s² (≥ 0); should be at
-    /// least gravity.
+    /// least gravity. Also the acceleration behind the impact threshold `2 a h` of body-level
+    /// restitution (a slower approach rests and never bounces; `restitution` module docs).
     pub max_acceleration: f32,
     /// `S`: the largest relative normal speed at which a contact separates two surfaces,
     /// m/s (> 0). Bounds how fast deep overlaps are resolved (see the module docs).

@@ -251,6 +251,34 @@ impl Particles {
         v.iter().all(|x| x.is_finite()).then_some((v, mass as f32))
     }
 
+    /// Inverse mass of the body moved as one rigid whole, 1/kg: `1 / Σ mᵢ` (summed in f32,
+    /// in particle order); 0 when a particle is pinned (the body is held in place) or the
+    /// mass is not above 0.
+    pub fn rigid_inv_mass(&self) -> f32 {
+        if self.inv_masses.iter().any(|&w| w <= 0.0) {
+            return 0.0;
+        }
+        let mass = self.total_mass();
+        if mass > 0.0 {
+            1.0 / mass
+        } else {
+            0.0
+        }
+    }
+
+    /// Adds the velocity `dv` (m/s) to every free particle: a rigid velocity change of the
+    /// whole body that adds no deformation. Nothing when `dv` is zero or not finite.
+    pub fn add_free_velocity(&mut self, dv: &Vector3<f32>) {
+        if *dv == Vector3::zeros() || !dv.iter().all(|c| c.is_finite()) {
+            return;
+        }
+        for (v, &w) in self.velocities.iter_mut().zip(&self.inv_masses) {
+            if w > 0.0 {
+                *v += dv;
+            }
+        }
+    }
+
     /// Indices of the free particles (inverse mass > 0).
     fn free(&self) -> impl Iterator<Item = usize> + '_ {
         (0..self.len()).filter(|&i| self.inv_masses[i] > 0.0)
