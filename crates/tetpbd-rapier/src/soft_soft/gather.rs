@@ -184,7 +184,8 @@ impl Gather {
         )>() {
             let collider = *collider.unwrap_or(default);
             if collider.is_enabled() {
-                self.list.push((e.to_bits().get(), e, sc.is_some(), collider));
+                self.list
+                    .push((e.to_bits().get(), e, sc.is_some(), collider));
             }
         }
         self.list.sort_unstable_by_key(|l| l.0);

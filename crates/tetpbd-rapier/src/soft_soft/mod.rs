@@ -98,8 +98,8 @@ use hecs::World;
 use tetpbd::SubstepHook;
 
 use crate::error::CouplingError;
-use crate::soft_soft::gather::{ContactFrame, Gather};
 use crate::soft_collider::SoftCollider;
+use crate::soft_soft::gather::{ContactFrame, Gather};
 use crate::soft_soft::restitution::BodyRestitution;
 use crate::soft_soft::separation::Separation;
 #[cfg(doc)]

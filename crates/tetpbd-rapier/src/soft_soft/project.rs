@@ -235,7 +235,9 @@ fn project_one(
     // it does neither and is left to the neighbouring faces, and so is one behind the plane
     // that is grazing a side face of the same body.
     let touching = c.active || (c.prism_prev && inside_now) || crossed_inside(c, d, x, x_prev);
-    if !touching || (!c.active && d < 0.0 && flush_beside(candidates, i, &n, d, x, c.props.thickness)) {
+    if !touching
+        || (!c.active && d < 0.0 && flush_beside(candidates, i, &n, d, x, c.props.thickness))
+    {
         return Outcome::Done;
     }
     let c = &mut candidates[i];
@@ -387,12 +389,7 @@ impl ContactStencil for ParticleOnTriangle<'_> {
 }
 
 /// Coulomb friction of one contact just projected ([`crate::response::friction`]).
-fn friction(
-    c: &mut Candidate,
-    x: &mut [Vector3<f32>],
-    x_prev: &[Vector3<f32>],
-    w: &[f32],
-) {
+fn friction(c: &mut Candidate, x: &mut [Vector3<f32>], x_prev: &[Vector3<f32>], w: &[f32]) {
     let mut stencil = ParticleOnTriangle {
         x,
         x_prev,
