@@ -101,13 +101,13 @@ impl Gather {
         &self.caches[b.cache].cache
     }
 
-    /// Clears the previous frame, then gathers this frame's bodies and candidates.
+    /// Clears the previous frame, then gathers this frame's bodies and candidates, with the
+    /// settings `s` and the collider of bodies without one, `default`.
     pub fn run(
         &mut self,
         world: &mut World,
         dt: f32,
-        s: &SoftContactSettings,
-        default: &SoftCollider,
+        (s, default): (&SoftContactSettings, &SoftCollider),
         frame: &mut ContactFrame,
         sep: &mut Separation,
         stats: &mut SoftContactStats,

@@ -206,8 +206,7 @@ impl SubstepHook for SoftContacts {
         self.gather.run(
             world,
             dt,
-            &self.settings,
-            &self.default_collider,
+            (&self.settings, &self.default_collider),
             &mut self.frame,
             &mut self.separation,
             &mut self.stats,
