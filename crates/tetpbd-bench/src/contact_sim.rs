@@ -1,5 +1,5 @@
 //! The contact scenes in either engine: tetpbd bodies in a [`CoupledWorld`] (rigid ground
-//! through the coupling, soft–soft contacts through [`SoftContacts`]), or rapier's built-in
+//! through the coupling, soft–soft contacts by the coupling too, on by default), or rapier's built-in
 //! soft bodies in a [`PhysicsWorld`] with their default surface colliders.
 
 use std::error::Error;
@@ -12,9 +12,7 @@ use rapier3d::prelude::{
     SoftBodyCellModel, SoftBodyHandle, SoftBodySolver,
 };
 use tetpbd::{hecs, unique_edges, Particles, SoftBodyBuilder, SolverSettings};
-use tetpbd_rapier::{
-    CoupledWorld, CouplingSettings, DeformationDamping, SoftContactSettings, SoftContacts,
-};
+use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping};
 
 use crate::clock::thread_cpu_ms;
 use crate::contact_scene::{ContactScene, GROUND_HALF_EXTENTS};
@@ -129,15 +127,13 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, f64) {
 struct Ours {
     scene: CoupledWorld,
     bodies: Vec<hecs::Entity>,
-    /// Soft–soft contacts (more than one body).
-    contacts: Option<SoftContacts>,
 }
 
 /// tetpbd's side of `sc`: the coupled world (ground, frame [`DT`], `substeps` ×
 /// `iterations`, `self_weight` as `CouplingSettings::self_weight_stacking`) and one soft body
 /// per placement, edges and volumes at compliance 0, with `DeformationDamping` at `damping`
-/// 1/s when it is above 0. Soft–soft contacts are the caller's hook
-/// ([`SoftContacts`]): how a test steps the scene with a hook of its own.
+/// 1/s when it is above 0. Soft–soft contacts are the coupling's
+/// (`CouplingSettings::soft_contacts`, on by default).
 pub fn tetpbd_contact_world(
     sc: &ContactScene,
     damping: f32,
@@ -186,25 +182,14 @@ impl Ours {
         iterations: u32,
     ) -> Result<Ours, Box<dyn Error>> {
         let (scene, bodies) = tetpbd_contact_world(sc, damping, self_weight, substeps, iterations)?;
-        let contacts = match bodies.len() {
-            1 => None,
-            _ => Some(SoftContacts::new(SoftContactSettings::default())?),
-        };
-        Ok(Ours {
-            scene,
-            bodies,
-            contacts,
-        })
+        Ok(Ours { scene, bodies })
     }
 }
 
 impl ContactSim for Ours {
     fn step(&mut self) -> Result<(f64, f64), Box<dyn Error>> {
-        let (scene, contacts) = (&mut self.scene, &mut self.contacts);
-        let (r, ms, cpu) = timed(|| match contacts {
-            Some(c) => scene.step_with(c),
-            None => scene.step(),
-        });
+        let scene = &mut self.scene;
+        let (r, ms, cpu) = timed(|| scene.step());
         r?;
         Ok((ms, cpu))
     }

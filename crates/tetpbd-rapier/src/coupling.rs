@@ -20,6 +20,8 @@ use crate::error::CouplingError;
 use crate::gather::Frame;
 use crate::report::{ContactReport, CouplingStats};
 use crate::settings::CouplingSettings;
+use crate::soft_soft::settings::SoftContactSettings;
+use crate::soft_soft::SoftContacts;
 use crate::substep::CouplingHook;
 
 /// The user's rapier state, borrowed for one coupled step. Every field is the argument of
@@ -152,14 +154,14 @@ impl<'a> RapierContext<'a> {
 /// immovable support that carries a much heavier dynamic body, the *stacking pass*: its own
 /// constraints once more from the ground up with the supported particles held, and the
 /// heavy body's contacts with the surface frozen (`heavy_loads` module docs,
-/// [`CouplingSettings::stacking_mass_ratio`]). After each substep's velocity update: the
+/// [`CouplingSettings::stacking_mass_ratio`]). After each substep's velocity update (where
+/// the solver also damps the deformation of bodies with a [`tetpbd::DeformationDamping`]): the
 /// separating velocity a stacking pass gave a heavy body is removed, the per-particle
 /// separating velocity is removed, then restitution acts per (soft body,
 /// collider) impact episode on the body's centre of mass (`response::restitution` module docs), a
 /// rolling-resistance couple bounded by the substep's normal impulse opposes each body's
 /// rotation relative to every collider it touches (`response::rolling` module docs,
-/// [`crate::SoftCollider::rolling_resistance`]), and [`crate::DeformationDamping`] damps
-/// deformation of bodies that carry it.
+/// [`crate::SoftCollider::rolling_resistance`]).
 ///
 /// Why rolling resistance: sticking friction does no work on a rolling body and the
 /// deformation damping leaves rigid rotation alone, so without it a rounded soft body rocks
@@ -214,6 +216,7 @@ pub struct Coupling {
     settings: CouplingSettings,
     frame: Frame,
     reports: Vec<ContactReport>,
+    soft_contacts: SoftContacts,
 }
 
 impl Coupling {
@@ -226,6 +229,7 @@ impl Coupling {
             settings,
             frame: Frame::default(),
             reports: Vec::new(),
+            soft_contacts: SoftContacts::new(SoftContactSettings::default())?,
         })
     }
 
@@ -267,9 +271,9 @@ impl Coupling {
         self.step_with(world, ctx, &mut ())
     }
 
-    /// [`Coupling::step`] with another [`SubstepHook`] run inside the same substeps, after
-    /// the coupling's constraints at every point (e.g. [`crate::SoftContacts`] for soft–soft
-    /// contacts).
+    /// [`Coupling::step`] with another [`SubstepHook`] of the integrator's run inside the
+    /// same substeps, after the coupling's work (soft–rigid, then soft–soft contacts) at
+    /// every point.
     pub fn step_with(
         &mut self,
         world: &mut World,
@@ -321,13 +325,26 @@ impl Coupling {
                 self_weight_stacking: self.settings.self_weight_stacking,
                 reports: &mut self.reports,
             };
+            let mut off = ();
+            let soft_contacts: &mut dyn SubstepHook = match self.settings.soft_contacts {
+                Some(s) => {
+                    self.soft_contacts.set_settings(s)?;
+                    let default = self.settings.default_collider;
+                    self.soft_contacts.set_default_collider(default);
+                    &mut self.soft_contacts
+                }
+                None => &mut off,
+            };
             self.solver
-                .step_frame(world, dt, gravity, &mut (hook, extra))?
+                .step_frame(world, dt, gravity, &mut (hook, (soft_contacts, extra)))?
         };
         let mut stats = std::mem::take(&mut self.frame.stats);
         self.write_back(ctx.bodies, &mut stats);
         stats.soft = soft;
         stats.bodies_without_surface = without_surface;
+        if self.settings.soft_contacts.is_some() {
+            stats.soft_contacts = *self.soft_contacts.stats();
+        }
         stats.rigid_time = rigid_time;
         stats.total_time = start.elapsed();
         Ok(stats)

@@ -92,30 +92,13 @@ impl Impact {
         if excess.is_nan() || excess <= 0.0 {
             return None;
         }
-        let w_soft = *self.inv_mass.get_or_insert_with(|| inv_free_mass(p));
+        let w_soft = *self.inv_mass.get_or_insert_with(|| p.rigid_inv_mass());
         let dl = excess / (w_soft + w_body);
         if !(dl.is_finite() && dl > 0.0) {
             return None;
         }
         translate_free(p, &(soft_dir * (w_soft * dl)));
         Some((dl, excess))
-    }
-}
-
-/// Inverse of the free particles' total mass, 1/kg; 0 when a particle is pinned (the body
-/// is held in place) or there is no free mass.
-fn inv_free_mass(p: &Particles) -> f32 {
-    let mut mass = 0.0f32;
-    for (&w, &m) in p.inv_masses().iter().zip(p.masses()) {
-        if w <= 0.0 {
-            return 0.0;
-        }
-        mass += m;
-    }
-    if mass > 0.0 {
-        1.0 / mass
-    } else {
-        0.0
     }
 }
 

@@ -23,8 +23,9 @@
 //!   [`DeformationDamping`] component.
 //! * Attachments: the [`Attachments`] component.
 //! * Contact reports: [`Coupling::contacts`]; statistics: [`CouplingStats`].
-//! * Other hooks (e.g. soft–soft contacts) run in the same substeps through
-//!   [`Coupling::step_with`].
+//! * Soft–soft and self contacts: on by default ([`CouplingSettings::soft_contacts`]), with
+//!   each body's [`SoftCollider`]; [`SoftContacts`] runs them on a bare `tetpbd` solver.
+//! * Hooks of the integrator's own run in the same substeps through [`Coupling::step_with`].
 //!
 //! ```
 //! use nalgebra::Vector3;
@@ -53,8 +54,8 @@
 //! soft body and the contact candidates; `contacts` makes and projects the contacts against
 //! rigid bodies (`particle`: soft particles vs colliders, `corner`: rigid corners vs soft
 //! triangles, `support`: the rigid contacts of anchored bodies); `response` holds friction
-//! (one rule for every contact kind), restitution, rolling resistance and deformation
-//! damping; `rigid` the proxies of rapier bodies and colliders inside the substeps; `ccd`
+//! (one rule for every contact kind), restitution and rolling resistance (the deformation
+//! damping is the core's, run by its solver); `rigid` the proxies of rapier bodies and colliders inside the substeps; `ccd`
 //! the swept tests for fast bodies; `heavy_loads` the pass that carries heavy rigid bodies
 //! on soft ones; `attachments`; `soft_soft` the contacts between soft bodies; `substep` the
 //! order of the work in one substep; `coupling` the frame ([`Coupling::step`]).
@@ -94,12 +95,14 @@ pub use coupling::{Coupling, RapierContext};
 pub use error::CouplingError;
 pub use placement::RapierPlacement;
 pub use report::{ContactReport, CouplingStats, SoftFeature};
-pub use response::deformation_damping::DeformationDamping;
 pub use scene::CoupledWorld;
 pub use settings::CouplingSettings;
 pub use soft_collider::{SoftCollider, SoftColliderBuilder};
 pub use soft_soft::settings::{SelfCollision, SoftContactSettings, SoftContactStats};
 pub use soft_soft::SoftContacts;
+/// The deformation damping is a core component, run by the solver after every velocity
+/// update; re-exported here for code written against the coupling.
+pub use tetpbd::DeformationDamping;
 
 pub use rapier3d;
 pub use tetpbd;

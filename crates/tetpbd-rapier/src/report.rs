@@ -81,4 +81,7 @@ pub struct CouplingStats {
     pub bodies_written: usize,
     /// Rigid bodies not written back because their result was not finite.
     pub non_finite_bodies: usize,
+    /// What the soft–soft contacts did ([`crate::CouplingSettings::soft_contacts`]; all
+    /// zero when they are off).
+    pub soft_contacts: crate::SoftContactStats,
 }

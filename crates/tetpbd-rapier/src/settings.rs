@@ -2,6 +2,7 @@
 
 use crate::error::CouplingError;
 use crate::soft_collider::SoftCollider;
+use crate::soft_soft::settings::SoftContactSettings;
 #[cfg(doc)]
 use crate::Coupling;
 
@@ -43,6 +44,18 @@ pub struct CouplingSettings {
     /// velocity pass stay reserved for heavy loads. The sweep is one-way (the support acts
     /// as infinitely heavy), so leave it off for bodies that are not meant to rest.
     pub self_weight_stacking: bool,
+    /// Contacts between soft bodies and of a body with itself (`soft_soft` module docs of
+    /// [`crate::SoftContacts`]), run by [`Coupling::step`] in the same substeps after the
+    /// soft–rigid contacts; `None` turns them off. Thickness, friction and restitution come
+    /// from each body's [`SoftCollider`] (combine rule in its docs); these settings hold the
+    /// candidate search and the overlap-recovery speeds.
+    ///
+    /// On by default: bodies that touch must not pass through each other. A scene that has
+    /// no use for them pays almost nothing: with fewer than two enabled soft bodies and no
+    /// [`crate::SelfCollision`] nothing runs; otherwise, when no two bodies come near each
+    /// other, one copy of the surface particles and a sweep over the bodies' boxes per frame.
+    /// Turn them off for scenes whose soft bodies are known never to meet.
+    pub soft_contacts: Option<SoftContactSettings>,
 }
 
 impl Default for CouplingSettings {
@@ -53,6 +66,7 @@ impl Default for CouplingSettings {
             max_depenetration_speed: 2.0,
             stacking_mass_ratio: 10.0,
             self_weight_stacking: false,
+            soft_contacts: Some(SoftContactSettings::default()),
         }
     }
 }
@@ -86,6 +100,9 @@ impl CouplingSettings {
                 name: "stacking mass ratio",
                 value: self.stacking_mass_ratio,
             });
+        }
+        if let Some(s) = &self.soft_contacts {
+            s.validate()?;
         }
         Ok(())
     }

@@ -7,10 +7,18 @@ use crate::error::{check_coefficient, CouplingError};
 
 /// Collision properties of one soft body: a hecs component on the soft body's entity.
 ///
-/// A soft body without this component collides with [`SoftCollider::default`]. Friction and
+/// A soft body without this component collides with [`SoftCollider::default`] (in a
+/// [`crate::Coupling`]: [`crate::CouplingSettings::default_collider`]). Friction and
 /// restitution are combined with the collider's own coefficients by the stricter of the two
 /// combine rules, exactly as rapier combines two colliders
 /// ([`CoefficientCombineRule::combine`]).
+///
+/// Against another soft body ([`crate::SoftContacts`]) the same combine applies to both
+/// bodies' coefficients (static with static, dynamic with dynamic), the restitution acts on
+/// the two bodies' centres of mass, and the contact thickness is the sum of the two bodies'
+/// thicknesses (each keeps its own skin); a body colliding with itself
+/// ([`crate::SelfCollision`]) keeps twice its thickness between its own surfaces. Two soft
+/// bodies collide only when both are enabled and their collision groups accept each other.
 ///
 /// What counts as the inside of a rapier collider, which a soft particle is pushed out of:
 ///
@@ -131,11 +139,9 @@ impl SoftCollider {
         self.enabled = enabled;
     }
 
-    /// Combined (dynamic, static) friction against a collider.
+    /// Combined (dynamic, static) friction against a collider (one coefficient for both).
     pub(crate) fn combined_friction(&self, mu: f32, rule: CoefficientCombineRule) -> (f32, f32) {
-        let d = CoefficientCombineRule::combine(mu, self.friction, rule, self.friction_rule);
-        let s = CoefficientCombineRule::combine(mu, self.static_friction, rule, self.friction_rule);
-        (d.max(0.0), s.max(d).max(0.0))
+        combine_friction((mu, mu, rule), self.friction_pair())
     }
 
     /// Combined restitution against a collider.
@@ -143,6 +149,51 @@ impl SoftCollider {
         CoefficientCombineRule::combine(e, self.restitution, rule, self.restitution_rule)
             .clamp(0.0, 1.0)
     }
+
+    /// (dynamic, static, rule) of this body's friction.
+    fn friction_pair(&self) -> (f32, f32, CoefficientCombineRule) {
+        (self.friction, self.static_friction, self.friction_rule)
+    }
+
+    /// The contact properties of this soft body against another one (or itself, for self
+    /// collision): friction and restitution combined as rapier combines two colliders (the
+    /// stricter of the two rules, [`CoefficientCombineRule::combine`]; dynamic with dynamic,
+    /// static with static, the static never below the dynamic), and the thicknesses added:
+    /// each body keeps its own skin, so two bodies rest `δ_a + δ_b` apart.
+    pub(crate) fn against_soft(&self, other: &SoftCollider) -> SoftPair {
+        let (mu_d, mu_s) = combine_friction(other.friction_pair(), self.friction_pair());
+        SoftPair {
+            thickness: self.thickness + other.thickness,
+            mu_s,
+            mu_d,
+            restitution: self.combined_restitution(other.restitution, other.restitution_rule),
+        }
+    }
+}
+
+/// (dynamic, static) friction of two surfaces, each given as (dynamic, static, rule): the
+/// stricter rule combines dynamic with dynamic and static with static, and the static is
+/// never below the dynamic.
+fn combine_friction(
+    (da, sa, ra): (f32, f32, CoefficientCombineRule),
+    (db, sb, rb): (f32, f32, CoefficientCombineRule),
+) -> (f32, f32) {
+    let d = CoefficientCombineRule::combine(da, db, ra, rb).max(0.0);
+    let s = CoefficientCombineRule::combine(sa, sb, ra, rb);
+    (d, s.max(d))
+}
+
+/// Contact properties of a pair of soft bodies ([`SoftCollider::against_soft`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SoftPair {
+    /// Contact thickness `δ`, m.
+    pub thickness: f32,
+    /// Static friction coefficient.
+    pub mu_s: f32,
+    /// Dynamic friction coefficient.
+    pub mu_d: f32,
+    /// Restitution coefficient of the bodies' centres of mass, in `[0, 1]`.
+    pub restitution: f32,
 }
 
 /// Builds a [`SoftCollider`]; `build` validates every coefficient.
@@ -277,5 +328,40 @@ mod tests {
         assert!(s >= d);
         let e = soft.combined_restitution(1.0, CoefficientCombineRule::Max);
         assert!((e - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn two_soft_bodies_combine_like_two_colliders_and_add_their_thicknesses() {
+        let a = SoftColliderBuilder::new()
+            .friction(0.8)
+            .static_friction(1.0)
+            .restitution(0.5)
+            .thickness(0.003)
+            .build()
+            .unwrap();
+        let b = SoftColliderBuilder::new()
+            .friction(0.2)
+            .thickness(0.001)
+            .build()
+            .unwrap();
+        for (p, q) in [(a, b), (b, a)] {
+            let pair = p.against_soft(&q);
+            assert!((pair.thickness - 0.004).abs() < 1e-7);
+            assert!((pair.mu_d - 0.5).abs() < 1e-6 && (pair.mu_s - 0.6).abs() < 1e-6);
+            assert!((pair.restitution - 0.25).abs() < 1e-6);
+        }
+        // A body against a collider with its own coefficient gets what a soft body with that
+        // coefficient (static = dynamic) gets.
+        let (d, s) = a.combined_friction(0.2, CoefficientCombineRule::Average);
+        let pair = a.against_soft(&b);
+        assert_eq!((d, s), (pair.mu_d, pair.mu_s));
+        // The stricter rule wins between soft bodies too.
+        let min = SoftColliderBuilder::new()
+            .friction(0.1)
+            .friction_combine_rule(CoefficientCombineRule::Min)
+            .build()
+            .unwrap();
+        let pair = a.against_soft(&min);
+        assert!((pair.mu_d - 0.1).abs() < 1e-6 && (pair.mu_s - 0.1).abs() < 1e-6);
     }
 }

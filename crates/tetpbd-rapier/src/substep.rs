@@ -18,8 +18,7 @@ use crate::heavy_loads::{stacked_velocity_pass, stacking_pass, Stacking};
 use crate::impact::Impact;
 use crate::joints::project_joints;
 use crate::report::{ContactReport, SoftFeature};
-use crate::response::deformation_damping::{damp, DeformationDamping};
-use crate::response::restitution::{com_velocity, end_episodes, restitution_pass};
+use crate::response::restitution::restitution_pass;
 use crate::response::rolling::rolling_pass;
 use crate::rigid::shape_query::surface_point;
 use crate::soft_collider::SoftCollider;
@@ -67,7 +66,9 @@ impl SubstepHook for CouplingHook<'_, '_> {
         for s in &mut self.frame.soft {
             s.stacked = false;
             if let Ok(p) = world.query_one_mut::<&Particles>(s.entity) {
-                s.v_cm_pre = com_velocity(p).0;
+                s.v_cm_pre = p
+                    .free_velocity()
+                    .map_or(nalgebra::Vector3::zeros(), |v| v.0);
             }
         }
         let frac = frac(&substep);
@@ -187,18 +188,12 @@ impl SubstepHook for CouplingHook<'_, '_> {
         }
         end_substep_supports(supports, h);
         for s in soft.iter() {
-            let Ok((p, surface, damping, sc)) = world.query_one_mut::<(
-                &mut Particles,
-                &Surface,
-                Option<&DeformationDamping>,
-                Option<&SoftCollider>,
-            )>(s.entity) else {
+            let Ok((p, surface, sc)) =
+                world.query_one_mut::<(&mut Particles, &Surface, Option<&SoftCollider>)>(s.entity)
+            else {
                 continue;
             };
             let rolling = sc.unwrap_or(&self.default_collider).rolling_resistance();
-            if let Some(d) = damping {
-                damp(p, d.rate(), h);
-            }
             let range = s.contacts.clone();
             if s.stacked {
                 let t = std::time::Instant::now();
@@ -245,7 +240,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             );
             finish_substep(&mut contacts[range], h, self.max_depenetration_speed * h);
         }
-        end_episodes(episodes);
+        episodes.end_substep();
         for k in corners.iter_mut() {
             k.active = false;
             k.impulse += k.sub_impulse / h;

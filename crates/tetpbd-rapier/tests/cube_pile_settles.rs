@@ -21,9 +21,7 @@ use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 use soft_soft_common::penetration;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
-use tetpbd_rapier::{
-    CoupledWorld, CouplingSettings, DeformationDamping, SoftContactSettings, SoftContacts,
-};
+use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -97,7 +95,6 @@ struct Rest {
 
 fn run_pile(substeps: u32, damping: f32, at: &[Vector3<f32>]) -> Rest {
     let (mut w, bodies) = scene(substeps, damping, at);
-    let mut contacts = SoftContacts::new(SoftContactSettings::default()).expect("settings");
     let positions = |w: &CoupledWorld| -> Vec<Vec<Vector3<f32>>> {
         let get = |&e: &Entity| w.soft.get::<&Particles>(e).map(|p| p.positions().to_vec());
         bodies.iter().map(|e| get(e).expect("body")).collect()
@@ -110,7 +107,7 @@ fn run_pile(substeps: u32, damping: f32, at: &[Vector3<f32>]) -> Rest {
         inter: 0.0,
     };
     for f in 0..frames {
-        w.step_with(&mut contacts).expect("step");
+        w.step().expect("step");
         let x = positions(&w);
         let all = x.iter().flatten();
         assert!(all.clone().all(|p| p.iter().all(|c| c.is_finite())));
@@ -143,12 +140,11 @@ fn run_pile(substeps: u32, damping: f32, at: &[Vector3<f32>]) -> Rest {
 fn cube_falls_past_a_flush_neighbour_without_snagging() {
     let at = [Vector3::new(0.0, 0.502, 0.0), Vector3::new(1.0, 1.6, 0.0)];
     let (mut w, bodies) = scene(10, 0.0, &at);
-    let mut contacts = SoftContacts::new(SoftContactSettings::default()).expect("settings");
     let (mut sideways, mut worst_lag) = (0.0f32, 0.0f32);
     // The falling cube's bottom (1.1 m up) reaches the ground after √(2·1.1/g) = 0.47 s,
     // 28 frames; stop a few frames before.
     for f in 1..=24 {
-        w.step_with(&mut contacts).expect("step");
+        w.step().expect("step");
         let v = com_velocity(&w, bodies[1]);
         sideways = sideways.max((v.x * v.x + v.z * v.z).sqrt());
         // Free fall from rest: v_y = −g t (the substep integrator lags by well under 1 %).

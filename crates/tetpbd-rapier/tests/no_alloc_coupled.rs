@@ -26,7 +26,6 @@ use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{
     Attachments, CoupledWorld, CouplingSettings, SelfCollision, SoftColliderBuilder,
-    SoftContactSettings, SoftContacts,
 };
 
 /// Counts the allocations of the current thread while enabled, sorted by who made them.
@@ -259,15 +258,14 @@ fn soft_pile_steps_without_allocating() {
         .soft
         .insert_one(folded, SelfCollision)
         .expect("entity");
-    let mut soft = SoftContacts::new(SoftContactSettings::default()).expect("settings");
     for _ in 0..20 {
-        scene.step_with(&mut soft).expect("step");
+        scene.step().expect("step");
     }
     let frames = 30;
     let mut candidates = 0;
     let tally = counted(frames, || {
-        scene.step_with(&mut soft).expect("step");
-        candidates = candidates.max(soft.stats().candidates);
+        let stats = scene.step().expect("step");
+        candidates = candidates.max(stats.soft_contacts.candidates);
     });
     assert!(candidates > 0, "the pile has soft–soft contact candidates");
     check("pile", &tally, frames as u64);
@@ -289,14 +287,13 @@ fn self_weight_sweep_steps_without_allocating() {
             Vector3::new(0.1 * i as f32, 0.55 + 1.01 * i as f32, 0.0),
         );
     }
-    let mut soft = SoftContacts::new(SoftContactSettings::default()).expect("settings");
     for _ in 0..20 {
-        scene.step_with(&mut soft).expect("step");
+        scene.step().expect("step");
     }
     let frames = 30;
     let mut passes = 0;
     let tally = counted(frames, || {
-        passes += scene.step_with(&mut soft).expect("step").stacking_passes;
+        passes += scene.step().expect("step").stacking_passes;
     });
     assert!(passes > 0, "the self-weight sweep ran");
     check("self-weight", &tally, frames as u64);

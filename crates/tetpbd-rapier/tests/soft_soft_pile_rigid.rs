@@ -1,7 +1,7 @@
 //! A pile of nine soft cubes (4×4×4 cells) dropped in the layout of rapier's
 //! `fem_bench` "jelly pile" onto *rigid* ground, through the rigid coupling with
-//! [`SoftContacts`] passed as its extra hook (`CoupledWorld::step_with`). 60 Hz, 20
-//! substeps, deformation damping 5/s on the cubes (applied by the coupling).
+//! its soft–soft contacts (`CouplingSettings::soft_contacts`, on by default). 60 Hz, 20
+//! substeps, deformation damping 5/s on the cubes (applied by the solver).
 
 mod soft_soft_common;
 
@@ -11,9 +11,7 @@ use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 use soft_soft_common::penetration;
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
-use tetpbd_rapier::{
-    CoupledWorld, CouplingSettings, DeformationDamping, SoftContactSettings, SoftContacts,
-};
+use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping};
 
 #[test]
 fn nine_cubes_settle_on_rigid_ground() {
@@ -27,7 +25,6 @@ fn nine_cubes_settle_on_rigid_ground() {
         ..SolverSettings::default()
     };
     let mut s = CoupledWorld::new(solver, CouplingSettings::default()).expect("settings");
-    let mut contacts = SoftContacts::new(SoftContactSettings::default()).expect("settings");
     // fem_bench: ground cuboid 24 × 0.2 × 24 m with its top at y = 0.
     s.physics.insert(
         RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.1, 0.0)),
@@ -72,7 +69,7 @@ fn nine_cubes_settle_on_rigid_ground() {
     let mut peak = 0.0f32;
     let mut worst_pen = 0.0f32;
     for f in 0..300 {
-        let stats = s.step_with(&mut contacts).expect("step");
+        let stats = s.step().expect("step");
         assert_eq!(stats.soft.non_finite_resets, 0);
         let v = max_speed(&s);
         if f >= 270 {
@@ -89,7 +86,7 @@ fn nine_cubes_settle_on_rigid_ground() {
             }
         }
         if f % 60 == 59 {
-            let c = contacts.stats();
+            let c = stats.soft_contacts;
             println!(
                 "t {} s: max|v| {v:.4} m/s, soft contacts {}, rigid contacts {}, ground penetration {:.5} m, soft penetration {:.5} m",
                 (f + 1) / 60,

@@ -18,7 +18,7 @@
 //! | `body/` | the builder, the mesh generators and the components |
 //! | `constraints/` | one file per constraint (`edge.rs`, `vertex_face.rs`, `vertex_face_bounded.rs`, `volume.rs`) and the XPBD update (`xpbd.rs`) |
 //! | `solver/` | settings, the hook, the statistics, the systems, and `step.rs`, where a frame and each substep start |
-//! | `stabilisation/` | the angular-momentum conservation, the safety net's momentum restoration, the ground-up sweep for heavy loads |
+//! | `stabilisation/` | the rigid fit of a body, the angular-momentum conservation, the safety net's momentum restoration, the deformation damping, the ground-up sweep for heavy loads |
 //! | `kernels/` | the scalar and SIMD projections and the working copy of the particles they run on |
 //! | `parallel/` | the parallel sweeps (feature `parallel`), bit-identical to the serial ones |
 //! | `ordering/` | orders fixed at build time: colour classes, spatial renumbering, domain decomposition |
@@ -68,6 +68,8 @@ pub use solver::stats::{ErrorAccumulator, ErrorStats, FamilyStats, StepStats};
 pub use solver::step::Solver;
 pub use solver::systems;
 pub use stabilisation::ground_up_sweep::GroundUpSweep;
+pub use stabilisation::deformation_damping::DeformationDamping;
+pub use stabilisation::rigid_fit::RigidFit;
 
 /// The constraint math under its former name; the same module as [`constraints`].
 #[doc(hidden)]

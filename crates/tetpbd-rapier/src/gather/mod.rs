@@ -24,7 +24,7 @@ use crate::convert::{pose_to_glam, pose_to_na};
 use crate::joints::{joints_of, JointRun};
 use crate::mesh_side::MeshRules;
 use crate::report::CouplingStats;
-use crate::response::restitution::Episode;
+use crate::response::restitution::Episodes;
 use crate::rigid::body::{BodyProxy, StartState};
 use crate::rigid::collider::ColliderProxy;
 use crate::soft_collider::SoftCollider;
@@ -98,7 +98,7 @@ pub(crate) struct Frame {
     /// (`response::restitution::restitution_pass`).
     pub active_colliders: Vec<usize>,
     /// Impact episodes in progress (kept across frames).
-    pub episodes: Vec<Episode>,
+    pub episodes: Episodes,
     /// Frame length, s (the solver's, `begin_frame`).
     pub dt: f32,
     /// Magnitude of the frame's gravity, m/s².

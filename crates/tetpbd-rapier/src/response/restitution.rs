@@ -33,40 +33,79 @@ use crate::contacts::particle::ParticleContact;
 use crate::rigid::body::BodyProxy;
 use crate::rigid::collider::ColliderProxy;
 
-/// One impact episode of a (soft body, collider) pair.
+/// One impact episode of a pair in contact (a soft body and a collider, or two soft bodies).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Episode {
-    key: (u64, (u32, u32)),
+    key: (u64, u64),
+    /// `v⁻`, m/s (< 0 when approaching).
     approach: f32,
     compressing: bool,
     seen: bool,
 }
 
 impl Episode {
-    fn new(key: (u64, (u32, u32)), approach: f32, compressing: bool) -> Episode {
-        Episode {
-            key,
-            approach,
-            compressing,
-            seen: false,
+    /// The change of the relative normal velocity `v_n` (m/s, > 0 separating) that steps 2
+    /// and 3 of the module docs ask for in this substep, `e` the pair's restitution; `None`
+    /// when nothing is to change.
+    pub fn change(&mut self, v_n: f32, e: f32) -> Option<f32> {
+        let target = -e * self.approach;
+        if self.compressing {
+            if v_n < 0.0 {
+                return None;
+            }
+            self.compressing = false;
+            Some(target - v_n)
+        } else if v_n > target {
+            Some(target - v_n)
+        } else {
+            None
         }
     }
 }
 
-/// Centre-of-mass velocity and mass of the free particles of `p`.
-pub(crate) fn com_velocity(p: &Particles) -> (Vector3<f32>, f32) {
-    let mut m = 0.0;
-    let mut mv = Vector3::zeros();
-    for i in 0..p.len() {
-        if p.inv_masses()[i] > 0.0 {
-            m += p.masses()[i];
-            mv += p.velocities()[i] * p.masses()[i];
-        }
+/// The impact episodes of the pairs in contact, kept across substeps and frames (module
+/// docs); one rule for soft bodies against colliders and against each other.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct Episodes {
+    list: Vec<Episode>,
+}
+
+impl Episodes {
+    /// The episode of pair `key`, begun now with the approach speed `approach()` (m/s,
+    /// normal velocity before the substep, < 0 approaching) if it is new, marked as seen in
+    /// this substep; `None` when it is not an impact (approach slower than `threshold`,
+    /// m/s).
+    pub fn impact(
+        &mut self,
+        key: (u64, u64),
+        approach: impl FnOnce() -> f32,
+        threshold: f32,
+    ) -> Option<&mut Episode> {
+        let k = match self.list.binary_search_by(|ep| ep.key.cmp(&key)) {
+            Ok(k) => k,
+            Err(k) => {
+                let approach = approach();
+                let ep = Episode {
+                    key,
+                    approach,
+                    compressing: approach < -threshold,
+                    seen: false,
+                };
+                self.list.insert(k, ep);
+                k
+            }
+        };
+        let ep = &mut self.list[k];
+        ep.seen = true;
+        (ep.approach < -threshold).then_some(ep)
     }
-    if m > 0.0 {
-        (mv / m, m)
-    } else {
-        (Vector3::zeros(), 0.0)
+
+    /// Ends the substep: drops the episodes of pairs with no active contact in it.
+    pub fn end_substep(&mut self) {
+        self.list.retain(|ep| ep.seen);
+        for ep in self.list.iter_mut() {
+            ep.seen = false;
+        }
     }
 }
 
@@ -75,7 +114,7 @@ pub(crate) fn com_velocity(p: &Particles) -> (Vector3<f32>, f32) {
 /// the substep. `active` is scratch space (its capacity is reused across calls).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn restitution_pass(
-    episodes: &mut Vec<Episode>,
+    episodes: &mut Episodes,
     active: &mut Vec<usize>,
     entity: Entity,
     contacts: &mut [ParticleContact],
@@ -86,10 +125,9 @@ pub(crate) fn restitution_pass(
     colliders: &[ColliderProxy],
     threshold: f32,
 ) {
-    let (v_cm, mass) = com_velocity(p);
-    if mass <= 0.0 {
+    let Some((v_cm, mass)) = p.free_velocity() else {
         return;
-    }
+    };
     // A body with pinned particles is anchored to the world: its centre of mass takes no
     // share of the restitution impulse.
     let anchored = p.inv_masses().contains(&0.0);
@@ -103,34 +141,16 @@ pub(crate) fn restitution_pass(
             .body
             .map_or(Vector3::zeros(), |b| bodies[b].velocity_at(&q));
         let key = (entity.to_bits().get(), collider_key(cp.handle));
-        let k = match episodes.binary_search_by(|ep| ep.key.cmp(&key)) {
-            Ok(k) => k,
-            Err(k) => {
-                let vb_pre = cp
-                    .body
-                    .map_or(Vector3::zeros(), |b| bodies[b].velocity_at_pre(&q));
-                let approach = n.dot(&(v_cm_pre - vb_pre));
-                let compressing = approach < -threshold;
-                episodes.insert(k, Episode::new(key, approach, compressing));
-                k
-            }
+        let approach = || {
+            let vb_pre = cp
+                .body
+                .map_or(Vector3::zeros(), |b| bodies[b].velocity_at_pre(&q));
+            n.dot(&(v_cm_pre - vb_pre))
         };
-        let ep = &mut episodes[k];
-        ep.seen = true;
-        if ep.approach >= -threshold {
+        let Some(ep) = episodes.impact(key, approach, threshold) else {
             continue;
-        }
-        let v_n = n.dot(&(v_cm - vb));
-        let target = -e * ep.approach;
-        let dv = if ep.compressing {
-            if v_n < 0.0 {
-                continue;
-            }
-            ep.compressing = false;
-            target - v_n
-        } else if v_n > target {
-            target - v_n
-        } else {
+        };
+        let Some(dv) = ep.change(n.dot(&(v_cm - vb)), e) else {
             continue;
         };
         let w_soft = if anchored { 0.0 } else { 1.0 / mass };
@@ -167,12 +187,7 @@ fn bounce(
     if !j.is_finite() {
         return None;
     }
-    let dv_soft = n * (j * w_soft);
-    for i in 0..p.len() {
-        if p.inv_masses()[i] > 0.0 {
-            p.velocities_mut()[i] += dv_soft;
-        }
-    }
+    p.add_free_velocity(&(n * (j * w_soft)));
     if let Some(b) = body {
         bodies[b].apply_velocity_impulse(&(-n * j), q);
     }
@@ -232,14 +247,8 @@ pub(crate) fn active_colliders(
     active.dedup();
 }
 
-/// Drops the episodes of pairs with no active contact this substep; clears the marks.
-pub(crate) fn end_episodes(episodes: &mut Vec<Episode>) {
-    episodes.retain(|ep| ep.seen);
-    for ep in episodes.iter_mut() {
-        ep.seen = false;
-    }
-}
-
-fn collider_key(h: ColliderHandle) -> (u32, u32) {
-    h.into_raw_parts()
+/// A collider handle as one episode key half (index and generation).
+fn collider_key(h: ColliderHandle) -> u64 {
+    let (index, generation) = h.into_raw_parts();
+    (u64::from(index) << 32) | u64::from(generation)
 }

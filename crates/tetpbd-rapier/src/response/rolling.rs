@@ -3,7 +3,7 @@
 //!
 //! Why: a soft body is stiff enough to roll like a rigid one, and rolling with sticking
 //! friction does no work, so nothing in the contacts takes the energy of a rocking or
-//! rolling body; [`crate::DeformationDamping`] only damps deformation, not the rigid
+//! rolling body; [`tetpbd::DeformationDamping`] only damps deformation, not the rigid
 //! rotation. A blob dropped on its rounded belly then rocks for tens of seconds (0.01–0.07
 //! m/s after 10–15 s in the `asset_drop` example, see [`crate::Coupling`]). Real bodies stop
 //! because the contact patch deforms with hysteresis, which moves the normal force ahead of
@@ -16,7 +16,7 @@
 //! ```text
 //! J_n   = Σ λ_n / h                      normal impulse of the substep's contacts, N·s
 //! q     = mean contact point,  R = |q − x_cm|
-//! ω_rel = ω_body − ω_collider            ω_body from the body's rigid fit (I, L)
+//! ω_rel = ω_body − ω_collider            ω_body from the body's rigid fit (`Particles::rigid_fit`)
 //! β     = min(1, c_rr · J_n · R / |I ω_rel|)
 //! vᵢ   += (−β ω_rel) × (xᵢ − x_cm)        for every free particle
 //! ```
@@ -46,11 +46,10 @@
 //! by the resistance, but that was not settled.
 
 use nalgebra::Vector3;
-use tetpbd::Particles;
+use tetpbd::{Particles, RigidFit};
 
 use crate::contacts::corner::CornerContact;
 use crate::contacts::particle::ParticleContact;
-use crate::response::deformation_damping::RigidFit;
 use crate::response::restitution::active_colliders;
 use crate::rigid::body::BodyProxy;
 use crate::rigid::collider::ColliderProxy;
@@ -75,7 +74,7 @@ pub(crate) fn rolling_pass(
     if active.is_empty() {
         return;
     }
-    let Some(mut fit) = RigidFit::of(p) else {
+    let Some(mut fit) = p.rigid_fit() else {
         return;
     };
     for &ci in active.iter() {
@@ -86,28 +85,25 @@ pub(crate) fn rolling_pass(
         let w_collider = cp
             .body
             .map_or(Vector3::zeros(), |b| angular_velocity(&bodies[b]));
-        let w_rel = fit.omega - w_collider;
+        let w_rel = fit.angular_velocity - w_collider;
         let stop = stopping_impulse(&fit, &w_rel, cp.body.map(|b| &bodies[b]));
         let need = stop.norm();
-        let cap = coefficient * (lambda / h) * (q - fit.x_cm).norm();
+        let cap = coefficient * (lambda / h) * (q - fit.centre).norm();
         if need.is_nan() || need <= 0.0 || !cap.is_finite() {
             continue;
         }
         let beta = (cap / need).min(1.0);
-        let dw = fit
-            .inertia
-            .try_inverse()
-            .map_or(Vector3::zeros(), |inv| -(inv * stop) * beta);
+        let dw = -(fit.inverse_inertia * stop) * beta;
         if !dw.iter().all(|c| c.is_finite()) {
             continue;
         }
         for i in 0..p.len() {
             if p.inv_masses()[i] > 0.0 {
-                let r = p.positions()[i] - fit.x_cm;
+                let r = p.positions()[i] - fit.centre;
                 p.velocities_mut()[i] += dw.cross(&r);
             }
         }
-        fit.omega += dw;
+        fit.angular_velocity += dw;
         if let Some(b) = cp.body {
             apply_couple(&mut bodies[b], &(stop * beta), &q);
         }
@@ -157,10 +153,7 @@ fn stopping_impulse(
     if let Some(body) = body {
         let rigid = inv_inertia_about(body, &stop);
         if rigid > 0.0 {
-            let soft = fit
-                .inertia
-                .try_inverse()
-                .map_or(0.0, |inv| inv_inertia_along(&inv, &stop));
+            let soft = inv_inertia_along(&fit.inverse_inertia, &stop);
             if soft > 0.0 {
                 stop *= soft / (soft + rigid);
             }

@@ -15,6 +15,7 @@ use tetpbd::{Surface, Tetrahedra};
 use crate::convert::to_glam;
 
 /// Cached structures of one soft body, kept across frames while its mesh is unchanged.
+#[derive(Clone)]
 pub(crate) struct BodyCache {
     /// The surface triangles the cache was built from (particle indices), to detect changes.
     pub source_triangles: Vec<[u32; 3]>,

@@ -8,6 +8,7 @@ use rapier3d::parry::bounding_volume::Aabb;
 use tetpbd::{Particles, Surface, Tetrahedra};
 
 use crate::convert::{finite3, to_glam};
+use crate::soft_collider::{SoftCollider, SoftPair};
 use crate::soft_soft::body::FrameBody;
 use crate::soft_soft::bvh::{triangle_normal, BodyCache};
 use crate::soft_soft::separation::{Separation, Side};
@@ -23,6 +24,8 @@ pub(crate) struct Candidate {
     pub recovery: bool,
     /// Largest depth behind the triangle at which a regular candidate is active, m.
     pub depth_limit: f32,
+    /// Thickness, friction and restitution of the two bodies' contact.
+    pub props: SoftPair,
     /// Signed distance to the triangle's plane at the substep start, m.
     pub d_prev: f32,
     pub lambda_n: f32,
@@ -67,6 +70,7 @@ impl ContactFrame {
     }
 }
 
+#[derive(Clone)]
 struct CacheEntry {
     key: u64,
     seen: bool,
@@ -74,12 +78,14 @@ struct CacheEntry {
 }
 
 /// Caches kept across frames and the frame's bodies.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(crate) struct Gather {
     caches: Vec<CacheEntry>,
-    list: Vec<(u64, Entity, bool)>,
+    list: Vec<(u64, Entity, bool, SoftCollider)>,
     order: Vec<usize>,
     pub pairs: Vec<(usize, usize)>,
+    /// Contact properties of each pair of `pairs`.
+    pub pair_props: Vec<SoftPair>,
     deep_a: Vec<Vector3<f32>>,
     deep_b: Vec<Vector3<f32>>,
     /// Scratch of `refit`: whether a body's triangle / tetrahedron BVH is needed.
@@ -95,12 +101,13 @@ impl Gather {
         &self.caches[b.cache].cache
     }
 
-    /// Clears the previous frame, then gathers this frame's bodies and candidates.
+    /// Clears the previous frame, then gathers this frame's bodies and candidates, with the
+    /// settings `s` and the collider of bodies without one, `default`.
     pub fn run(
         &mut self,
         world: &mut World,
         dt: f32,
-        s: &SoftContactSettings,
+        (s, default): (&SoftContactSettings, &SoftCollider),
         frame: &mut ContactFrame,
         sep: &mut Separation,
         stats: &mut SoftContactStats,
@@ -109,11 +116,16 @@ impl Gather {
         sep.clear();
         self.bodies.clear();
         self.pairs.clear();
-        self.list_bodies(world);
+        self.pair_props.clear();
+        self.list_bodies(world, default);
+        if self.list.len() < 2 && !self.list.iter().any(|l| l.2) {
+            // Nothing can touch: no pair and no self collision.
+            return;
+        }
         let dt = if dt.is_finite() && dt > 0.0 { dt } else { 0.0 };
         let fall = 0.5 * s.max_acceleration * dt * dt;
         for li in 0..self.list.len() {
-            let (key, e, self_collide) = self.list[li];
+            let (key, e, self_collide, collider) = self.list[li];
             let Ok((p, surface, tets)) =
                 world.query_one_mut::<(&Particles, &Surface, &Tetrahedra)>(e)
             else {
@@ -136,13 +148,7 @@ impl Gather {
             if self_collide {
                 cache.ensure_rings();
             }
-            let pinned = p.inv_masses().iter().any(|w| *w <= 0.0);
-            let mass = p.total_mass();
-            let inv_mass = if pinned || mass.is_nan() || mass <= 0.0 {
-                0.0
-            } else {
-                1.0 / mass
-            };
+            let inv_mass = p.rigid_inv_mass();
             self.bodies.push(FrameBody {
                 entity: e,
                 cache: ci,
@@ -151,29 +157,36 @@ impl Gather {
                 lo,
                 hi,
                 self_collide,
+                collider,
                 inv_mass,
                 involved: false,
             });
         }
         stats.bodies = self.bodies.len();
-        self.broad_phase(s.margin + s.thickness);
+        self.broad_phase(s.margin);
         stats.body_pairs = self.pairs.len();
         self.refit(world, frame);
         self.pair_candidates(world, frame, s, sep, stats);
         stats.candidates = frame.candidates.len();
     }
 
-    /// Lists the soft bodies of `world` by entity bits and drops the caches of bodies gone.
-    fn list_bodies(&mut self, world: &mut World) {
+    /// Lists the enabled soft bodies of `world` by entity bits and drops the caches of bodies
+    /// gone.
+    fn list_bodies(&mut self, world: &mut World, default: &SoftCollider) {
         self.list.clear();
-        for (e, _, _, _, sc) in world.query_mut::<(
+        for (e, _, _, _, sc, collider) in world.query_mut::<(
             Entity,
             &Particles,
             &Surface,
             &Tetrahedra,
             Option<&SelfCollision>,
+            Option<&SoftCollider>,
         )>() {
-            self.list.push((e.to_bits().get(), e, sc.is_some()));
+            let collider = *collider.unwrap_or(default);
+            if collider.is_enabled() {
+                self.list
+                    .push((e.to_bits().get(), e, sc.is_some(), collider));
+            }
         }
         self.list.sort_unstable_by_key(|l| l.0);
         for c in &mut self.caches {
@@ -242,7 +255,7 @@ impl Gather {
                 .extend(frame.candidates[c1..].iter().filter_map(deep));
             let side_a = self.side(a, &self.deep_a, frame);
             let side_b = self.side(b, &self.deep_b, frame);
-            sep.add_pair(a, b, &side_a, &side_b, s.thickness);
+            sep.add_pair(a, b, &side_a, &side_b, self.pair_props[k].thickness);
         }
         for a in 0..self.bodies.len() {
             if self.bodies[a].self_collide {
@@ -273,26 +286,40 @@ impl Gather {
         self.bodies.partition_point(|b| b.offset + b.len <= slot)
     }
 
-    /// Sweep and prune along x over the motion-grown body AABBs (grown again by `pad`).
-    fn broad_phase(&mut self, pad: f32) {
+    /// Sweep and prune along x over the motion-grown body AABBs (grown again by `margin`
+    /// and the pair's thickness), keeping the pairs whose collision groups accept each other.
+    fn broad_phase(&mut self, margin: f32) {
         let bodies = &self.bodies;
+        let thickest = bodies
+            .iter()
+            .map(|b| b.collider.thickness())
+            .fold(0.0f32, f32::max);
         self.order.clear();
         self.order.extend(0..bodies.len());
         self.order
             .sort_unstable_by(|&i, &j| bodies[i].lo.x.total_cmp(&bodies[j].lo.x).then(i.cmp(&j)));
         for (ii, &i) in self.order.iter().enumerate() {
+            let reach = margin + bodies[i].collider.thickness() + thickest;
             for &j in &self.order[ii + 1..] {
-                if bodies[j].lo.x > bodies[i].hi.x + pad {
+                if bodies[j].lo.x > bodies[i].hi.x + reach {
                     break;
                 }
                 let (a, b) = (&bodies[i], &bodies[j]);
+                let pad = margin + a.collider.thickness() + b.collider.thickness();
                 let overlap = (0..3).all(|k| a.lo[k] <= b.hi[k] + pad && b.lo[k] <= a.hi[k] + pad);
-                if overlap {
+                let groups = a.collider.collision_groups();
+                if overlap && groups.test(b.collider.collision_groups()) {
                     self.pairs.push((i.min(j), i.max(j)));
                 }
             }
         }
         self.pairs.sort_unstable();
+        let bodies = &self.bodies;
+        self.pair_props.extend(
+            self.pairs
+                .iter()
+                .map(|&(a, b)| bodies[a].collider.against_soft(&bodies[b].collider)),
+        );
     }
 
     /// Refits the triangle BVH of every body in a pair or colliding with itself, and the
@@ -335,13 +362,14 @@ impl Gather {
         stats: &mut SoftContactStats,
     ) {
         let (ba, bb) = (&self.bodies[a], &self.bodies[b]);
+        let props = ba.collider.against_soft(&bb.collider);
         let cache_a = &self.caches[ba.cache].cache;
         let cache_b = &self.caches[bb.cache].cache;
         let own = a == b;
         let Ok(pb) = world.query_one_mut::<&Particles>(bb.entity) else {
             return;
         };
-        let pad = s.margin + s.thickness;
+        let pad = s.margin + props.thickness;
         let xb = &frame.x[bb.offset..bb.offset + bb.len];
         let found = &mut self.found;
         for k in 0..ba.len {
@@ -358,7 +386,7 @@ impl Gather {
                     let tri = cache_b.triangles[t].map(|v| (bb.offset as u32) + v);
                     frame
                         .candidates
-                        .push(candidate(slot as u32, tri, true, f32::MAX));
+                        .push(candidate(slot as u32, tri, props, f32::MAX));
                     stats.deep += 1;
                 }
                 continue;
@@ -378,17 +406,17 @@ impl Gather {
                 let Some(n) = triangle_normal(&pa, &pb_, &pc) else {
                     continue;
                 };
-                if (x0 - pa).dot(&n) < -s.thickness {
+                if (x0 - pa).dot(&n) < -props.thickness {
                     continue;
                 }
                 let tri_motion = tri
                     .iter()
                     .map(|&i| frame.motion[i as usize])
                     .fold(0.0f32, f32::max);
-                let depth_limit = m + tri_motion + 2.0 * s.thickness + s.margin;
-                frame
-                    .candidates
-                    .push(candidate(slot as u32, tri, false, depth_limit));
+                let depth_limit = m + tri_motion + 2.0 * props.thickness + s.margin;
+                let mut c = candidate(slot as u32, tri, props, depth_limit);
+                c.recovery = false;
+                frame.candidates.push(c);
             }
             let last = frame.candidates.len() as u32;
             for c in &mut frame.candidates[first as usize..] {
@@ -398,12 +426,15 @@ impl Gather {
     }
 }
 
-fn candidate(p: u32, tri: [u32; 3], recovery: bool, depth_limit: f32) -> Candidate {
+/// A candidate of particle slot `p` against triangle slots `tri`; a deep one (recovery)
+/// unless the caller clears `recovery`.
+fn candidate(p: u32, tri: [u32; 3], props: SoftPair, depth_limit: f32) -> Candidate {
     Candidate {
         p,
         tri,
-        recovery,
+        recovery: true,
         depth_limit,
+        props,
         d_prev: 0.0,
         lambda_n: 0.0,
         lambda_t: 0.0,

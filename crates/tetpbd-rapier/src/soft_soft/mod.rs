@@ -6,7 +6,8 @@
 //! A surface particle `p` of one body against a surface triangle `(a, b, c)` of another body
 //! (or of the same body, for bodies with the [`SelfCollision`] component), with the
 //! triangle's outward unit normal `n` and thickness `δ` (the seed's vertex–face constraint
-//! with a thickness):
+//! with a thickness; `δ`, the friction coefficients and the restitution come from the two
+//! bodies' [`crate::SoftCollider`]s, combined as its docs say):
 //!
 //! ```text
 //! C  = (p − q)·n − δ ≥ 0,   q = β_a a + β_b b + β_c c   (β: barycentric point of p on the triangle)
@@ -19,17 +20,18 @@
 //! (an inequality), every iteration of every substep. Friction is positional (Müller et al.
 //! 2020): the relative tangential displacement of `p` against `q` over the substep is removed
 //! while the tangential multiplier stays under `μ_s λ`, otherwise only up to `μ_d λ`. After
-//! each substep the separating normal velocity
-//! a contact's projection created is removed, and, with
-//! [`SoftContactSettings::inelastic`], so is the separating velocity of the two bodies'
-//! centres of mass (see `soft_restitution`), so impacts do not turn into bounces.
+//! each substep the separating normal velocity a contact's projection created is removed,
+//! and the separating velocity of the two bodies' centres of mass is capped at `e` times
+//! their approach speed (`restitution` module; `e` = 0 by default), so impacts do not turn
+//! into bounces.
 //!
 //! # Candidates (once per frame)
 //!
 //! Bodies are paired by a sweep over their AABBs (never all pairs). Each body keeps a parry
 //! BVH over its surface triangles, refitted every frame. Each particle has a *motion bound*
-//! `m = |v| dt + ½ a_max dt²` (`a_max` = [`SoftContactSettings::max_acceleration`]); a
-//! particle–triangle pair is a candidate when the particle's box grown by `m + margin + δ`
+//! `m = |v| dt + ½ a_max dt²` (`a_max` = [`SoftContactSettings::max_acceleration`]). Bodies
+//! whose [`crate::SoftCollider`] is disabled, and pairs whose collision groups do not accept
+//! each other, are left out. A particle–triangle pair is a candidate when the particle's box grown by `m + margin + δ`
 //! meets the triangle's box grown by its vertices' bounds. A candidate is kept only when the
 //! particle starts the frame on the outer side of the triangle's plane (`d₀ ≥ −δ`). It is
 //! active when the particle is less than the frame's relative motion behind the plane and
@@ -96,16 +98,22 @@ use hecs::World;
 use tetpbd::{FrameContext, SubstepContext, SubstepHook};
 
 use crate::error::CouplingError;
+use crate::soft_collider::SoftCollider;
 use crate::soft_soft::gather::{ContactFrame, Gather};
-use crate::soft_soft::restitution::body_restitution;
+use crate::soft_soft::restitution::BodyRestitution;
 use crate::soft_soft::separation::Separation;
 #[cfg(doc)]
 use settings::SelfCollision;
 use settings::{SoftContactSettings, SoftContactStats};
 
 /// Soft–soft and self collision of the `tetpbd` bodies of a world, run inside the soft
-/// solver's substeps (see the module docs of `soft_contact` for the constraint, the
-/// candidates and the deep-overlap bound).
+/// solver's substeps (see the module docs of `soft_soft` for the constraint, the
+/// candidates and the deep-overlap bound). Each body collides with its
+/// [`SoftCollider`] component, or [`SoftContacts::default_collider`] without one.
+///
+/// A [`crate::Coupling`] runs one itself ([`crate::CouplingSettings::soft_contacts`]); this
+/// type is the same contacts as a hook of its own, for soft bodies on a bare
+/// [`tetpbd::Solver`]:
 ///
 /// ```
 /// use tetpbd::{generators, Solver, SolverSettings, SoftBodyBuilder};
@@ -127,15 +135,14 @@ use settings::{SoftContactSettings, SoftContactStats};
 /// assert_eq!(contacts.stats().body_pairs, 1);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-///
-/// With the rigid coupling, chain it after the coupling's hook: `(coupling_hook, &mut
-/// contacts)` is itself a [`SubstepHook`].
+#[derive(Clone)]
 pub struct SoftContacts {
     settings: SoftContactSettings,
+    default_collider: SoftCollider,
     gather: Gather,
     frame: ContactFrame,
     separation: Separation,
-    pair_normals: Vec<nalgebra::Vector3<f32>>,
+    restitution: BodyRestitution,
     stats: SoftContactStats,
 }
 
@@ -145,10 +152,11 @@ impl SoftContacts {
         settings.validate()?;
         Ok(SoftContacts {
             settings,
+            default_collider: SoftCollider::default(),
             gather: Gather::default(),
             frame: ContactFrame::default(),
             separation: Separation::default(),
-            pair_normals: Vec::new(),
+            restitution: BodyRestitution::default(),
             stats: SoftContactStats::default(),
         })
     }
@@ -169,6 +177,18 @@ impl SoftContacts {
     pub fn stats(&self) -> &SoftContactStats {
         &self.stats
     }
+
+    /// The collision properties of bodies without a [`SoftCollider`] component
+    /// ([`SoftCollider::default`] unless set).
+    pub fn default_collider(&self) -> &SoftCollider {
+        &self.default_collider
+    }
+
+    /// Sets the collision properties of bodies without a [`SoftCollider`] component (from
+    /// the next frame on).
+    pub fn set_default_collider(&mut self, collider: SoftCollider) {
+        self.default_collider = collider;
+    }
 }
 
 impl std::fmt::Debug for SoftContacts {
@@ -186,7 +206,7 @@ impl SubstepHook for SoftContacts {
         self.gather.run(
             world,
             frame.dt(),
-            &self.settings,
+            (&self.settings, &self.default_collider),
             &mut self.frame,
             &mut self.separation,
             &mut self.stats,
@@ -194,8 +214,8 @@ impl SubstepHook for SoftContacts {
     }
 
     fn begin_substep(&mut self, world: &mut World, substep: SubstepContext) {
-        self.frame
-            .begin_substep(world, &self.gather, &self.settings);
+        self.frame.begin_substep(world, &self.gather);
+        self.restitution.begin_substep(world, &self.gather);
         self.separation.apply(
             world,
             &self.gather.bodies,
@@ -215,9 +235,9 @@ impl SubstepHook for SoftContacts {
         self.separation
             .remove_velocity(world, &self.gather.bodies, substep.h());
         self.frame.velocity_pass(world, &self.gather);
-        if self.settings.inelastic {
-            body_restitution(world, &self.gather, &self.frame, &mut self.pair_normals);
-        }
+        let a_max = self.settings.max_acceleration;
+        self.restitution
+            .apply(world, &self.gather, &self.frame, a_max, substep.h());
     }
 
     fn end_frame(&mut self, world: &mut World, _frame: FrameContext) {

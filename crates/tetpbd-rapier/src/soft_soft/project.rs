@@ -81,7 +81,7 @@ impl ContactFrame {
 
     /// Substep start: record each candidate's distance to its triangle's plane and reset
     /// its multipliers.
-    pub fn begin_substep(&mut self, world: &mut World, g: &Gather, s: &SoftContactSettings) {
+    pub fn begin_substep(&mut self, world: &mut World, g: &Gather) {
         if self.candidates.is_empty() {
             return;
         }
@@ -96,7 +96,7 @@ impl ContactFrame {
                     let inside = bw.iter().all(|&v| v >= -PRISM_TOLERANCE);
                     ((p - a).dot(&n), inside)
                 }
-                None => (s.thickness, false),
+                None => (c.props.thickness, false),
             };
             c.lambda_n = 0.0;
             c.lambda_t = 0.0;
@@ -134,7 +134,7 @@ impl ContactFrame {
             if candidates[i].recovery {
                 continue;
             }
-            match project_one(candidates, i, x, x_prev, w, s, steps) {
+            match project_one(candidates, i, x, x_prev, w, steps) {
                 Outcome::Degenerate => stats.degenerate += 1,
                 Outcome::Clamped => stats.clamps += 1,
                 Outcome::Done => {}
@@ -213,7 +213,6 @@ fn project_one(
     x: &mut [Vector3<f32>],
     x_prev: &[Vector3<f32>],
     w: &[f32],
-    s: &SoftContactSettings,
     (alpha_tilde, step, skin_step): (f32, f32, f32),
 ) -> Outcome {
     let c = &candidates[i];
@@ -236,7 +235,9 @@ fn project_one(
     // it does neither and is left to the neighbouring faces, and so is one behind the plane
     // that is grazing a side face of the same body.
     let touching = c.active || (c.prism_prev && inside_now) || crossed_inside(c, d, x, x_prev);
-    if !touching || (!c.active && d < 0.0 && flush_beside(candidates, i, &n, d, x, s.thickness)) {
+    if !touching
+        || (!c.active && d < 0.0 && flush_beside(candidates, i, &n, d, x, c.props.thickness))
+    {
         return Outcome::Done;
     }
     let c = &mut candidates[i];
@@ -252,7 +253,7 @@ fn project_one(
     };
     let q = a * bary[0] + b * bary[1] + t * bary[2];
     let dist = (xp - q).dot(&n);
-    let target = contact_target(c.d_prev, s.thickness, step, skin_step);
+    let target = contact_target(c.d_prev, c.props.thickness, step, skin_step);
     let cval = dist - target;
     if cval.is_nan() || cval >= 0.0 {
         return Outcome::Done;
@@ -280,7 +281,7 @@ fn project_one(
     c.n = n;
     c.bary = bary;
     c.wsum = wsum;
-    friction(c, x, x_prev, w, s);
+    friction(c, x, x_prev, w);
     let clamped = target < 0.0 && !c.clamped;
     if clamped {
         c.clamped = true;
@@ -388,13 +389,7 @@ impl ContactStencil for ParticleOnTriangle<'_> {
 }
 
 /// Coulomb friction of one contact just projected ([`crate::response::friction`]).
-fn friction(
-    c: &mut Candidate,
-    x: &mut [Vector3<f32>],
-    x_prev: &[Vector3<f32>],
-    w: &[f32],
-    s: &SoftContactSettings,
-) {
+fn friction(c: &mut Candidate, x: &mut [Vector3<f32>], x_prev: &[Vector3<f32>], w: &[f32]) {
     let mut stencil = ParticleOnTriangle {
         x,
         x_prev,
@@ -406,8 +401,8 @@ fn friction(
     };
     let coulomb = Coulomb {
         lambda_n: c.lambda_n,
-        mu_s: s.static_friction,
-        mu_d: s.dynamic_friction,
+        mu_s: c.props.mu_s,
+        mu_d: c.props.mu_d,
     };
     positional_friction(&mut stencil, &c.n, coulomb, &mut c.lambda_t);
 }

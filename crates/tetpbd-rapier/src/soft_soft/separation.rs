@@ -32,7 +32,7 @@ use hecs::World;
 use nalgebra::Vector3;
 use tetpbd::Particles;
 
-use crate::soft_soft::body::FrameBody;
+use crate::soft_soft::body::{exchange, relative_normal_velocity, FrameBody};
 use crate::soft_soft::bvh::BodyCache;
 use crate::soft_soft::settings::{SoftContactSettings, SoftContactStats};
 
@@ -154,19 +154,15 @@ impl Separation {
     pub fn remove_velocity(&self, world: &mut World, bodies: &[FrameBody], h: f32) {
         self.remove_shift_velocity(world, bodies, h);
         for pair in &self.pairs {
-            let (wa, wb) = (bodies[pair.a].inv_mass, bodies[pair.b].inv_mass);
-            let wsum = wa + wb;
-            if wsum.is_nan() || wsum <= 0.0 {
+            let (a, b) = (&bodies[pair.a], &bodies[pair.b]);
+            if a.inv_mass + b.inv_mass <= 0.0 {
                 continue;
             }
-            let va = com_velocity(world, &bodies[pair.a]);
-            let vb = com_velocity(world, &bodies[pair.b]);
-            let rel = (va - vb).dot(&pair.dir);
+            let rel = relative_normal_velocity(world, a, b, &pair.dir);
             if rel.is_nan() || rel >= 0.0 {
                 continue;
             }
-            add_velocity(world, &bodies[pair.a], pair.dir * (-rel * wa / wsum));
-            add_velocity(world, &bodies[pair.b], pair.dir * (rel * wb / wsum));
+            exchange(world, (a, b), &pair.dir, -rel);
         }
     }
 
@@ -180,28 +176,6 @@ impl Separation {
                 for v in p.velocities_mut() {
                     *v -= dv;
                 }
-            }
-        }
-    }
-}
-
-/// Mass-weighted mean velocity of a body, m/s (zero when it cannot be read).
-fn com_velocity(world: &mut World, b: &FrameBody) -> Vector3<f32> {
-    match world.query_one_mut::<&Particles>(b.entity) {
-        Ok(p) if p.total_mass() > 0.0 => p.linear_momentum() / p.total_mass(),
-        _ => Vector3::zeros(),
-    }
-}
-
-/// Adds `dv` (m/s) to the velocity of every free particle of a body.
-fn add_velocity(world: &mut World, b: &FrameBody, dv: Vector3<f32>) {
-    if dv == Vector3::zeros() || !dv.iter().all(|c| c.is_finite()) {
-        return;
-    }
-    if let Ok(p) = world.query_one_mut::<&mut Particles>(b.entity) {
-        for i in 0..p.len() {
-            if p.inv_masses()[i] > 0.0 {
-                p.velocities_mut()[i] += dv;
             }
         }
     }

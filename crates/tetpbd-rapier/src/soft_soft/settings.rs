@@ -10,17 +10,20 @@ use crate::SoftContacts;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SelfCollision;
 
-/// Settings of [`SoftContacts`]. Build with [`SoftContacts::new`] or
+/// Settings of soft–soft contacts ([`SoftContacts`], run by a [`crate::Coupling`] through
+/// [`crate::CouplingSettings::soft_contacts`]). Build with [`SoftContacts::new`] or
 /// [`SoftContacts::set_settings`], which validate them.
+///
+/// The thickness, friction and restitution of a contact are not settings: they come from the
+/// two bodies' [`crate::SoftCollider`] components (combine rule in its docs; defaults: 2 mm
+/// each, so 4 mm between two bodies, friction 0.5, restitution 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SoftContactSettings {
-    /// Contact thickness `δ`: the distance kept between a particle and another surface, m
-    /// (> 0). Sheets must be thicker than this.
-    pub thickness: f32,
     /// Extra candidate distance on top of the motion bound, m (≥ 0).
     pub margin: f32,
     /// Acceleration assumed in the motion bound `|v| dt + ½ a dt²`, m/s² (≥ 0); should be at
-    /// least gravity.
+    /// least gravity. Also the acceleration behind the impact threshold `2 a h` of body-level
+    /// restitution (a slower approach rests and never bounces; `restitution` module docs).
     pub max_acceleration: f32,
     /// `S`: the largest relative normal speed at which a contact separates two surfaces,
     /// m/s (> 0). Bounds how fast deep overlaps are resolved (see the module docs).
@@ -29,14 +32,6 @@ pub struct SoftContactSettings {
     /// contact skin `[0, δ)` of a surface (e.g. bodies created touching) is pushed to the
     /// full thickness, m/s (> 0). Small, so touching bodies do not pop apart.
     pub skin_speed: f32,
-    /// Body-level restitution 0: after every substep, bodies in contact stop separating as
-    /// wholes along their contact normal (see `soft_restitution`). Without it stiff bodies
-    /// spring back off each other at a large part of their impact speed.
-    pub inelastic: bool,
-    /// Static friction coefficient between soft bodies (≥ 0, dimensionless).
-    pub static_friction: f32,
-    /// Dynamic friction coefficient between soft bodies (≥ 0, dimensionless).
-    pub dynamic_friction: f32,
     /// Contact compliance, m/N (≥ 0; 0 = hard contact).
     pub compliance: f32,
 }
@@ -44,14 +39,10 @@ pub struct SoftContactSettings {
 impl Default for SoftContactSettings {
     fn default() -> Self {
         SoftContactSettings {
-            thickness: 0.005,
             margin: 0.01,
             max_acceleration: 20.0,
             max_separation_speed: 2.0,
             skin_speed: 0.1,
-            inelastic: true,
-            static_friction: 0.5,
-            dynamic_friction: 0.4,
             compliance: 0.0,
         }
     }
@@ -61,7 +52,6 @@ impl SoftContactSettings {
     /// Checks every field; the first bad one is returned.
     pub fn validate(&self) -> Result<(), CouplingError> {
         let fields = [
-            ("thickness (m)", self.thickness, false),
             ("margin (m)", self.margin, true),
             ("max_acceleration (m/s²)", self.max_acceleration, true),
             (
@@ -69,8 +59,7 @@ impl SoftContactSettings {
                 self.max_separation_speed,
                 false,
             ),
-            ("static_friction", self.static_friction, true),
-            ("dynamic_friction", self.dynamic_friction, true),
+            ("skin_speed (m/s)", self.skin_speed, false),
             ("compliance (m/N)", self.compliance, true),
         ];
         for (name, value, zero_ok) in fields {

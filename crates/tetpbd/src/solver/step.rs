@@ -12,7 +12,7 @@ use crate::solver::hook::{FrameContext, SubstepHook};
 use crate::solver::settings::SolverSettings;
 use crate::solver::stats::StepStats;
 use crate::solver::systems;
-use crate::stabilisation::correction_energy;
+use crate::stabilisation::{correction_energy, deformation_damping};
 
 /// Runs frames of the soft-body systems on a [`hecs::World`].
 ///
@@ -25,7 +25,7 @@ use crate::stabilisation::correction_energy;
 ///         project families in `order` on it, remove the rigid rotation of their
 ///         corrections (conserve_angular_momentum), limit the kinetic energy they add
 ///         (limit_correction_energy), copy back, then hook.project
-///     update velocities  v ← (x − x_prev) / h
+///     update velocities  v ← (x − x_prev) / h, then damp deformation (DeformationDamping)
 ///     hook.end_substep
 /// ```
 #[derive(Clone, Debug, Default)]
@@ -177,6 +177,7 @@ impl Solver {
         let u = systems::update_velocities(world, h, s.max_correction_speed);
         stats.non_finite_resets += u.non_finite_resets;
         stats.velocity_clamps += u.clamped;
+        deformation_damping::damp_deformation(world, h);
         stats.velocity_time += t.elapsed();
         let t = Instant::now();
         hook.end_substep(world, frame.substep(index, 0));

@@ -2,8 +2,8 @@
 //!
 //! [`crate::Solver`] calls them in this order every substep of length `h`:
 //! [`predict`], the family projections (`iterations` times, in
-//! [`crate::SolverSettings::order`]), [`update_velocities`]. They are public so that an
-//! integrator can build a different schedule.
+//! [`crate::SolverSettings::order`]), [`update_velocities`], [`damp_deformation`]. They are
+//! public so that an integrator can build a different schedule.
 
 use hecs::World;
 use nalgebra::Vector3;
@@ -21,6 +21,7 @@ use crate::kernels::particle_runs::{PredictRun, VelocityRun};
 use crate::kernels::slots::WorkAccess;
 use crate::kernels::working_copy::{self, CopyMode};
 use crate::solver::stats::{ErrorAccumulator, ErrorStats};
+pub use crate::stabilisation::deformation_damping::damp_deformation;
 
 /// Saves `x` as the substep start, applies gravity plus each body's
 /// [`ExternalAcceleration`] and the linear damping `v ← v · max(0, 1 − damping·h)` to free

@@ -11,10 +11,14 @@
 //! * [`ground_up`] — one more sweep ordered from a body's supports outwards, for heavy loads
 //!   on light bodies (its level order in [`ground_up_levels`]), offered as one call by
 //!   [`ground_up_sweep`] ([`crate::GroundUpSweep`]) to a hook such as a coupling's;
-//! * [`rigid_fit`] — the rigid fit of a field on a body's particles both momentum passes use.
+//! * [`deformation_damping`] — damping a body's velocities towards their rigid fit
+//!   ([`crate::DeformationDamping`], a component; run after every velocity update);
+//! * [`rigid_fit`] — the rigid fit of a field on a body's particles, the one every pass here
+//!   and the couplings use ([`crate::Particles::rigid_fit`]).
 
 pub(crate) mod angular_momentum;
 pub(crate) mod correction_energy;
+pub(crate) mod deformation_damping;
 pub(crate) mod ground_up;
 pub(crate) mod ground_up_levels;
 pub(crate) mod ground_up_sweep;

@@ -1,10 +1,14 @@
 //! The rigid fit of a field on a body's particles (centre of mass, inertia tensor,
-//! pseudo-inverse), the moments it is computed from, and the runs of particles that sum
-//! them: shared by the angular-momentum conservation and the safety net's momentum
-//! restoration, serial and parallel.
+//! pseudo-inverse), the one implementation of the idea: the angular-momentum conservation
+//! (whose sums the correction-energy limit shares) and the safety net's momentum
+//! restoration fit it to corrections and clamped velocities (serial and parallel, from the
+//! moments and runs of particles here), and
+//! [`Particles::rigid_fit`] fits it to a body's velocities for the deformation damping and
+//! for couplings (rolling resistance, restitution, soft–soft contacts).
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::body::particles::Particles;
 use crate::kernels::compensated::add_compensated;
 use crate::kernels::slots::Slot;
 use wide::f32x4;
@@ -96,8 +100,9 @@ impl Moments<f64> {
 /// `θ = I⁺ Σ mᵢ rᵢ × wᵢ` with `rᵢ = xᵢ − c` and `I = Σ mᵢ(|rᵢ|²𝟙 − rᵢrᵢᵀ)` (eigenvalues
 /// below [`INERTIA_CUTOFF`] of the largest taken as zero): the least-squares `θ` of
 /// `Σ mᵢ |wᵢ − θ × rᵢ|²` for the part of `w` without its mean. `None` without mass or when
-/// not finite. Used by the spin removal (`w` the corrections) and the safety net's momentum
-/// restoration (`crate::stabilisation::momentum_restoration`, `w` the velocity the clamp removed).
+/// not finite. Used by the spin removal (`w` the corrections), the safety net's momentum
+/// restoration (`crate::stabilisation::momentum_restoration`, `w` the velocity the clamp
+/// removed) and [`Particles::rigid_fit`] (`w` the velocities).
 pub(crate) fn rigid_fit(
     mass: f64,
     first: Vector3<f64>,
@@ -105,6 +110,24 @@ pub(crate) fn rigid_fit(
     moment: Vector3<f64>,
     total: Vector3<f64>,
 ) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    fit_sums(mass, first, second, moment, total).map(|f| (f.centre, f.theta))
+}
+
+/// [`rigid_fit`] with the inertia tensor and its pseudo-inverse.
+struct SumsFit {
+    centre: Vector3<f64>,
+    theta: Vector3<f64>,
+    inertia: Matrix3<f64>,
+    pseudo_inverse: Matrix3<f64>,
+}
+
+fn fit_sums(
+    mass: f64,
+    first: Vector3<f64>,
+    second: Matrix3<f64>,
+    moment: Vector3<f64>,
+    total: Vector3<f64>,
+) -> Option<SumsFit> {
     if !(mass.is_finite() && mass > 0.0) {
         return None;
     }
@@ -121,15 +144,152 @@ pub(crate) fn rigid_fit(
         return None;
     }
     let mut theta = Vector3::zeros();
+    let mut pseudo_inverse = Matrix3::zeros();
     for k in 0..3 {
         let l = eig.eigenvalues[k];
         if l > largest * INERTIA_CUTOFF {
             let u = eig.eigenvectors.column(k);
             theta += u * (u.dot(&b) / l);
+            pseudo_inverse += u * u.transpose() / l;
         }
     }
-    theta.iter().all(|v| v.is_finite()).then_some((c, theta))
+    theta.iter().all(|v| v.is_finite()).then_some(SumsFit {
+        centre: c,
+        theta,
+        inertia,
+        pseudo_inverse,
+    })
 }
+
+/// The rigid motion that best fits the velocities of a body's free particles (those with
+/// inverse mass > 0; pinned ones are left out): see [`Particles::rigid_fit`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RigidFit {
+    /// `M = Σ mᵢ`, kg.
+    pub mass: f32,
+    /// Centre of mass `c = Σ mᵢxᵢ / M`, m.
+    pub centre: Vector3<f32>,
+    /// Velocity of the centre of mass `v_c = Σ mᵢvᵢ / M`, m/s.
+    pub velocity: Vector3<f32>,
+    /// Inertia tensor about `c`, `I = Σ mᵢ(|rᵢ|²𝟙 − rᵢrᵢᵀ)` with `rᵢ = xᵢ − c`, kg·m².
+    pub inertia: Matrix3<f32>,
+    /// Pseudo-inverse `I⁺` of [`RigidFit::inertia`] (eigenvalues below 10⁻⁹ of the largest
+    /// taken as zero: a body collapsed onto a line or a point has no rotation about that
+    /// axis), 1/(kg·m²).
+    pub inverse_inertia: Matrix3<f32>,
+    /// Angular velocity `ω = I⁺ Σ mᵢ rᵢ × vᵢ`, rad/s.
+    pub angular_velocity: Vector3<f32>,
+}
+
+impl RigidFit {
+    /// Velocity of the fitted rigid motion at `x`: `v_c + ω × (x − c)`, m/s.
+    pub fn velocity_at(&self, x: &Vector3<f32>) -> Vector3<f32> {
+        self.velocity + self.angular_velocity.cross(&(x - self.centre))
+    }
+}
+
+impl Particles {
+    /// The rigid motion that best fits the velocities of the free particles: the `v_c`, `ω`
+    /// minimising `Σ mᵢ |vᵢ − v_c − ω × rᵢ|²` over the free particles (`rᵢ = xᵢ − c`), i.e.
+    ///
+    /// ```text
+    /// M = Σ mᵢ,  c = Σ mᵢxᵢ / M,  v_c = Σ mᵢvᵢ / M,
+    /// I = Σ mᵢ(|rᵢ|²𝟙 − rᵢrᵢᵀ),  ω = I⁺ Σ mᵢ rᵢ × vᵢ   (I⁺: pseudo-inverse, see RigidFit)
+    /// ```
+    ///
+    /// so `M v_c` and `I ω` are the free particles' linear and angular momentum about `c`.
+    /// Sums in f64 about the first free particle, in particle order (one pass); the same
+    /// inertia solve as the solver's angular-momentum conservation. `None` without free mass
+    /// or when a result is not finite.
+    pub fn rigid_fit(&self) -> Option<RigidFit> {
+        let o = self.origin()?;
+        let (mut mass, mut first, mut total) = (0.0f64, Vector3::zeros(), Vector3::zeros());
+        let (mut second, mut moment) = (Matrix3::<f64>::zeros(), Vector3::zeros());
+        for i in self.free() {
+            let m = f64::from(self.masses[i]);
+            let x = self.positions[i].cast::<f64>() - o;
+            let mv = self.velocities[i].cast::<f64>() * m;
+            mass += m;
+            first += x * m;
+            second += x * x.transpose() * m;
+            total += mv;
+            moment += x.cross(&mv);
+        }
+        let fit = fit_sums(mass, first, second, moment, total)?;
+        let velocity = total / mass;
+        let out = RigidFit {
+            mass: mass as f32,
+            centre: (fit.centre + o).cast::<f32>(),
+            velocity: velocity.cast::<f32>(),
+            inertia: fit.inertia.cast::<f32>(),
+            inverse_inertia: fit.pseudo_inverse.cast::<f32>(),
+            angular_velocity: fit.theta.cast::<f32>(),
+        };
+        let finite = out
+            .centre
+            .iter()
+            .chain(out.velocity.iter())
+            .all(|x| x.is_finite())
+            && out.inverse_inertia.iter().all(|x| x.is_finite());
+        finite.then_some(out)
+    }
+
+    /// The translational part of [`Particles::rigid_fit`] alone (one cheaper pass): the
+    /// velocity of the free particles' centre of mass `Σ mᵢvᵢ / Σ mᵢ` (m/s) and their mass
+    /// `Σ mᵢ` (kg), sums in f64. `None` without free mass or when not finite.
+    pub fn free_velocity(&self) -> Option<(Vector3<f32>, f32)> {
+        let (mut mass, mut total) = (0.0f64, Vector3::<f64>::zeros());
+        for i in self.free() {
+            let m = f64::from(self.masses[i]);
+            mass += m;
+            total += self.velocities[i].cast::<f64>() * m;
+        }
+        if !(mass.is_finite() && mass > 0.0) {
+            return None;
+        }
+        let v = (total / mass).cast::<f32>();
+        v.iter().all(|x| x.is_finite()).then_some((v, mass as f32))
+    }
+
+    /// Inverse mass of the body moved as one rigid whole, 1/kg: `1 / Σ mᵢ` (summed in f32,
+    /// in particle order); 0 when a particle is pinned (the body is held in place) or the
+    /// mass is not above 0.
+    pub fn rigid_inv_mass(&self) -> f32 {
+        if self.inv_masses.iter().any(|&w| w <= 0.0) {
+            return 0.0;
+        }
+        let mass = self.total_mass();
+        if mass > 0.0 {
+            1.0 / mass
+        } else {
+            0.0
+        }
+    }
+
+    /// Adds the velocity `dv` (m/s) to every free particle: a rigid velocity change of the
+    /// whole body that adds no deformation. Nothing when `dv` is zero or not finite.
+    pub fn add_free_velocity(&mut self, dv: &Vector3<f32>) {
+        if *dv == Vector3::zeros() || !dv.iter().all(|c| c.is_finite()) {
+            return;
+        }
+        for (v, &w) in self.velocities.iter_mut().zip(&self.inv_masses) {
+            if w > 0.0 {
+                *v += dv;
+            }
+        }
+    }
+
+    /// Indices of the free particles (inverse mass > 0).
+    fn free(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.len()).filter(|&i| self.inv_masses[i] > 0.0)
+    }
+
+    /// The first free particle's position in f64 (the fit's summation origin).
+    fn origin(&self) -> Option<Vector3<f64>> {
+        self.free().next().map(|i| self.positions[i].cast::<f64>())
+    }
+}
+
 /// The arrays of a run of particles the second pass of [`crate::stabilisation::angular_momentum::store_measured`] corrects.
 pub(crate) struct FixUp<'a> {
     /// Positions (stored), m.
