@@ -17,13 +17,11 @@
 //! * Triangle-mesh colliders of either winding, open or closed, with or without
 //!   pseudo-normals: an open mesh (or one wound inwards) is a two-sided sheet, a particle
 //!   kept on the side it came from; only a closed mesh wound outwards has an inside that
-//!   pushes a particle created in it out. A heightfield is solid below its surface.
+//!   pushes a particle created in it out. A heightfield is solid below its surface (see
+//!   [`SoftCollider`]).
 //! * Per-body collision properties (friction, restitution, rolling resistance, thickness)
 //!   and groups: the [`SoftCollider`] component; deformation damping: the
 //!   [`DeformationDamping`] component.
-//! * Triangle meshes without pseudo-normals are one-sided: their inside is behind each
-//!   face's counter-clockwise winding normal; heightfields are solid below their surface
-//!   (see [`SoftCollider`]).
 //! * Attachments: the [`Attachments`] component.
 //! * Contact reports: [`Coupling::contacts`]; statistics: [`CouplingStats`].
 //! * Other hooks (e.g. soft–soft contacts) run in the same substeps through
