@@ -112,8 +112,9 @@ impl<'a> RapierContext<'a> {
 ///    growing linearly. With the body's contacts and joints as constraints in the substeps
 ///    both hold (box moved ≤ 1 mm at 1:1–1000:1, anchors within 1 mm over 10 s at 10×) and
 ///    scenes without a touched dynamic body run none of it. Stepping rapier at the substep
-///    rate instead keeps the hand-over explicit, a substep late, and runs rapier's whole
-///    step ten times per frame.
+///    rate instead keeps the hand-over explicit, a substep late: it still threw the box at
+///    148 m/s and let the anchor drift 36 mm (2 kg beam) to 505 mm (20 kg) in 3 s, at 1.9–4.2×
+///    the frame time of a resting cube.
 ///
 /// Who integrates what: rapier integrates rigid bodies under gravity, rigid contacts and joints;
 /// the coupling integrates the soft bodies and the *reaction* of soft contacts and attachments on
