@@ -1,4 +1,4 @@
-//! Issue 6 diagnosis: soft edges + volume released from a mirrored start. Prints kinetic
+//! Diagnosis of a tangle: soft edges + volume released from a mirrored start. Prints kinetic
 //! energy, volume and momenta per frame, then the final state (per-tetrahedron volume ratios,
 //! edge stretch, surface self-crossings, best rigid fit). `RESTART=1` then zeroes the
 //! velocities and runs 600 more frames (`ITER`, `DAMP` override iterations and damping).

@@ -1,7 +1,7 @@
 //! `cargo run --release -p tetpbd-bench --bin error_vs_time [-- [--quick] [--out DIR]]`
 //!
 //! Error against run time, tetpbd next to rapier 0.36's built-in soft bodies, on the scenes of
-//! issue 5: a) a hanging beam settling to static equilibrium, b) a block squashed to 50 %
+//! four scenes: a) a hanging beam settling to static equilibrium, b) a block squashed to 50 %
 //! height and released, c) a soft cube dropped onto rigid ground, d) a pile of nine cubes
 //! (soft–soft contacts). Writes `docs/error-vs-time/` (results.csv, contacts.csv,
 //! squash_volume.csv, plot.png, plot.svg, contacts.png, contacts.svg, squash_volume.png,

@@ -1,6 +1,6 @@
 //! The references the runs are compared with: the exact answer of the hard models, and for
-//! the soft models issue 5's "converged reference of the same model and mesh (the same solver
-//! run with many more substeps until the answer stops changing at 1e-6)".
+//! the soft models a converged reference of the same model and mesh (the same solver
+//! run with many more substeps until the answer stops changing at 1e-6).
 //!
 //! A numerical reference doubles the substeps (one iteration each) from a start count up to a
 //! cap. The *change* of a doubling is the deviation ([`deviation`]: relative to the body size,

@@ -5,7 +5,7 @@ use tetpbd::constraint::signed_volume;
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::{unique_edges, TetMesh};
 
-/// Which scene of issue 5.
+/// Which scene of the report.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SceneKind {
     /// a) A beam pinned at one end, sagging under gravity to static equilibrium.
