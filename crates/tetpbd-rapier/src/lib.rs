@@ -17,7 +17,8 @@
 //! * Triangle-mesh colliders of either winding, open or closed, with or without
 //!   pseudo-normals: an open mesh (or one wound inwards) is a two-sided sheet, a particle
 //!   kept on the side it came from; only a closed mesh wound outwards has an inside that
-//!   pushes a particle created in it out. A heightfield is solid below its surface.
+//!   pushes a particle created in it out. A heightfield is solid below its surface (see
+//!   [`SoftCollider`]).
 //! * Per-body collision properties (friction, restitution, rolling resistance, thickness)
 //!   and groups: the [`SoftCollider`] component; deformation damping: the
 //!   [`DeformationDamping`] component.

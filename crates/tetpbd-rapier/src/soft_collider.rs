@@ -25,12 +25,13 @@ use crate::error::{check_coefficient, CouplingError};
 /// * solid shapes (ball, cuboid, capsule, cylinder, cone, convex polyhedron, compounds of
 ///   those, their rounded variants): parry's own inside;
 /// * a heightfield: everything below its surface (local −y);
-/// * a triangle mesh built with `TriMeshFlags::ORIENTED` or `FIX_INTERNAL_EDGES` (it has
-///   pseudo-normals): parry's inside of the closed, oriented mesh;
-/// * any other triangle mesh is **one-sided**: a particle behind the face it projects onto,
-///   against the face's counter-clockwise winding normal, is inside and is pushed out to the
-///   front. Wind such a mesh with its faces towards the soft bodies, or build it oriented;
-///   a soft body that reaches the back of a one-sided face is pushed through to its front.
+/// * a triangle mesh, of either winding, with or without pseudo-normals: a **two-sided
+///   sheet** unless it is closed and wound outwards — a particle is kept on the side of the
+///   sheet it stood on at the start of the substep, so a soft body rests on an open ground
+///   of two triangles wound either way and stays under an open ceiling;
+/// * a closed triangle mesh whose triangles all point out: solid, its inside decided by
+///   parry with pseudo-normals (`TriMeshFlags::ORIENTED` or `FIX_INTERNAL_EDGES`) and by the
+///   face a point projects onto without them; a particle created inside it is pushed out.
 ///
 /// ```
 /// use tetpbd_rapier::SoftColliderBuilder;

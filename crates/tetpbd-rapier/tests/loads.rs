@@ -99,7 +99,7 @@ fn check(what: &str, r: Rest) {
 
 #[test]
 fn heavy_soft_body_on_light_box_stays_put() {
-    // The report: a 0.5 m soft cube of 4³ cells, 125 kg, on a 0.5 m box of 1 kg.
+    // A 0.5 m soft cube of 4³ cells, 125 kg, on a 0.5 m box of 1 kg: equal sizes, 125:1.
     check("125 kg on 1 kg", soft_on_box(0.5, 4, 1000.0, 0.5, 0));
 }
 

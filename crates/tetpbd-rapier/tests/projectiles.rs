@@ -23,7 +23,19 @@ struct Shot {
 
 /// Shoots a 1 kg rigid `shape` (half height `half`) straight down at `speed` from 0.5 m at
 /// `(x, z)` onto a 1 × 0.2 × 1 m slab of 8 × `layers` × 8 cells on the ground; 1 s.
-fn shoot(shape: SharedShape, half: f32, speed: f32, layers: u32, [x, z]: [f32; 2]) -> Shot {
+fn shoot(shape: SharedShape, half: f32, speed: f32, layers: u32, at: [f32; 2]) -> Shot {
+    shoot_ccd(shape, half, speed, layers, at, false)
+}
+
+/// [`shoot`] with rapier's CCD of the projectile on or off.
+fn shoot_ccd(
+    shape: SharedShape,
+    half: f32,
+    speed: f32,
+    layers: u32,
+    [x, z]: [f32; 2],
+    ccd: bool,
+) -> Shot {
     let mut s = scene();
     ground(&mut s);
     let at = Vector3::new(0.0, 0.1, 0.0);
@@ -39,7 +51,8 @@ fn shoot(shape: SharedShape, half: f32, speed: f32, layers: u32, [x, z]: [f32; 2
     let (ball, _) = s.physics.insert(
         RigidBodyBuilder::dynamic()
             .translation(Vector::new(x, 0.5, z))
-            .linvel(Vector::new(0.0, -speed, 0.0)),
+            .linvel(Vector::new(0.0, -speed, 0.0))
+            .ccd_enabled(ccd),
         ColliderBuilder::new(shape).mass(1.0),
     );
     let mut shot = Shot {
@@ -86,13 +99,23 @@ fn check(what: &str, speed: f32, shot: Shot) {
 }
 
 #[test]
-fn the_ball_of_the_report_stays_on_the_slab() {
+fn a_small_ball_at_200_m_s_off_centre_stays_on_a_two_cell_slab() {
     let shot = shoot(SharedShape::ball(0.05), 0.05, 200.0, 2, [0.03, 0.02]);
     // A central hit: the slab (200 kg) takes the shot's momentum (1 kg × 200 m/s); bouncing
     // back off the ground with all of it, it could rise v²/2g with v = 1 m/s.
     let rise = 1.0 / (2.0 * 9.81) + 0.01;
     assert!(shot.slab_rise < rise, "slab thrown: {shot:?}");
     check("1 kg ball r 0.05 m at 200 m/s", 200.0, shot);
+}
+
+#[test]
+fn balls_at_200_m_s_stay_on_a_two_cell_slab_with_rigid_ccd_on_or_off() {
+    for (radius, aim) in [(0.05f32, [0.03f32, 0.02]), (0.1, [0.0, 0.0])] {
+        for ccd in [false, true] {
+            let shot = shoot_ccd(SharedShape::ball(radius), radius, 200.0, 2, aim, ccd);
+            check(&format!("ball r {radius} m, CCD {ccd}"), 200.0, shot);
+        }
+    }
 }
 
 #[test]

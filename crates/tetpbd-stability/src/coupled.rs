@@ -47,6 +47,8 @@ pub struct CoupledCase {
     pub kind: CaseKind,
     /// Runs the case under a configuration.
     pub run: fn(&Config) -> CoupledOutcome,
+    /// Runs the same scene with rapier 0.36's own soft bodies instead, where they apply.
+    pub rapier: Option<fn() -> CoupledOutcome>,
 }
 
 fn scene(substeps: u32) -> Result<CoupledWorld, String> {
@@ -140,7 +142,7 @@ fn run(
 }
 
 /// A case's outcome, or its setup error as a clean outcome.
-fn guarded(r: Result<CoupledOutcome, String>) -> CoupledOutcome {
+pub(crate) fn guarded(r: Result<CoupledOutcome, String>) -> CoupledOutcome {
     r.unwrap_or_else(|e| CoupledOutcome {
         error: Some(e),
         ..CoupledOutcome::default()
@@ -350,48 +352,59 @@ pub fn coupled_cases() -> Vec<CoupledCase> {
             description: "a 1000 kg rigid box on a 1 kg soft slab (2 × 0.2 × 2 m, one cell thick, top at 0.2 m) on the ground, 3 s: the box's bottom stays between the ground and 0.25 m, the box ends below 0.05 m/s and the slab's peak speed stays below 5 m/s",
             kind: CaseKind::Fast,
             run: heavy_rigid_on_light_soft,
+            rapier: None,
         },
         CoupledCase {
             name: "rigid 1000 kg on soft 1 kg, 20 × 5",
             description: "the same with 20 substeps of 5 iterations",
             kind: CaseKind::Fast,
             run: heavy_rigid_on_light_soft_20x5,
+            rapier: None,
         },
         CoupledCase {
             name: "soft 1 kg on rigid 1000 kg",
             description: "a 1 kg soft cube on a free 1000 kg plank on the ground, 3 s: rests on it (lowest particle on the plank, final speed < 0.05 m/s)",
             kind: CaseKind::Fast,
             run: |c| guarded(light_soft_on_heavy_plank(c)),
+            rapier: None,
         },
         CoupledCase {
             name: "rigid ball at 100 m/s",
             description: "a 0.1 m rigid ball (CCD on) at 100 m/s onto a soft slab one cell (0.2 m) thick on the ground, 2 s: the ball's centre never reaches the slab's lower half while over the slab",
             kind: CaseKind::Fast,
             run: |c| guarded(ball_at(c, 100.0)),
+            rapier: None,
         },
         CoupledCase {
             name: "rigid ball at 30 m/s",
             description: "the same at 30 m/s",
             kind: CaseKind::Fast,
             run: |c| guarded(ball_at(c, 30.0)),
+            rapier: None,
         },
         CoupledCase {
             name: "created half in the ground",
             description: "a 1 m soft cube created half inside the ground, 3 s: pushed out (lowest particle above −2 cm) with peak speed < 20 m/s",
             kind: CaseKind::Fast,
             run: created_in_the_ground,
+            rapier: None,
         },
         CoupledCase {
             name: "created half in the ground, safety net 5 m/s",
             description: "the same with `max_correction_speed = 5 m/s`",
             kind: CaseKind::Fast,
             run: created_in_the_ground_net,
+            rapier: None,
         },
         CoupledCase {
             name: "resting, 100,000 frames",
             description: "a 0.5 m soft cube resting on the ground for 100,000 frames (28 min simulated): final speed < 1 mm/s, centre-of-mass drift < 1 mm after settling, kinetic energy never above 10 × its settled value",
             kind: CaseKind::Long,
             run: |c| guarded(resting_100k_frames(c)),
+            rapier: None,
         },
     ]
+    .into_iter()
+    .chain(crate::coupled_robust::robust_cases())
+    .collect()
 }

@@ -11,11 +11,14 @@
 mod cases;
 mod config;
 mod coupled;
+mod coupled_rapier;
+mod coupled_robust;
 mod report;
 mod run;
 
 pub use cases::{all_cases, Case, CaseKind};
 pub use config::{Config, ConstraintSet};
 pub use coupled::{coupled_cases, CoupledCase, CoupledOutcome};
+pub use coupled_rapier::rapier_comparison;
 pub use report::markdown;
 pub use run::{run_scene, run_scene_observed, FrameView, Outcome, Scene, Start};

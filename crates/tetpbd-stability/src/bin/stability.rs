@@ -258,6 +258,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         writeln!(doc, "- *{}*: {}.", case.name, case.description)?;
     }
     writeln!(doc)?;
+    doc.push_str(&tetpbd_stability::rapier_comparison(&coupled, |n| {
+        println!("rapier: {n}")
+    }));
     doc.push_str(include_str!("findings.md"));
     std::fs::write(&out, &doc)?;
     for (title, passed, total) in totals {
