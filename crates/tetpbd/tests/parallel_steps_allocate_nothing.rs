@@ -46,7 +46,7 @@ static GLOBAL: Counting = Counting;
 /// Allocations in 10 steps (after a first one) of a large hanging cube and a partitioned
 /// one, with `parallel`, on a pool of two threads: run inside it, or given to the solver
 /// and stepped from this thread (where rayon's queue that hands each pass to the pool
-/// allocates a block now and then, and each step spawns its kept-awake helpers).
+/// allocates a block now and then).
 fn allocations_in_steps(parallel: ParallelSettings, given: bool) -> u64 {
     let pool = Arc::new(
         rayon::ThreadPoolBuilder::new()

@@ -74,13 +74,3 @@ pub(crate) fn on_pool_thread() -> bool {
         None => rayon::current_thread_index().is_some(),
     }
 }
-
-/// Runs `f` on this thread with a scope whose spawned jobs run on the step's pool (with no
-/// pool given: rayon's global pool, this thread being in none); returns once they are all
-/// done.
-pub(crate) fn in_place_scope<'scope, R>(f: impl FnOnce(&rayon::Scope<'scope>) -> R) -> R {
-    match pool() {
-        Some(pool) => pool.in_place_scope(f),
-        None => rayon::in_place_scope(f),
-    }
-}

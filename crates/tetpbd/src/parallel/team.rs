@@ -69,11 +69,11 @@ thread_local! {
 }
 
 /// Runs `f` on this thread with the step pool's other threads waiting for jobs from
-/// [`post`] (moving off this thread's core if `move_off`). On a pool of one thread, just
-/// runs `f`.
+/// [`post`] (moving off this thread's core if `move_off`). On a pool of one thread, or from
+/// a thread that is not one of the pool's, just runs `f`.
 pub(crate) fn with_team<T>(move_off: bool, f: impl FnOnce() -> T) -> T {
     let helpers = crate::parallel::context::threads().saturating_sub(1);
-    if helpers == 0 {
+    if helpers == 0 || !crate::parallel::context::on_pool_thread() {
         return f();
     }
     let team = Team {
@@ -90,24 +90,11 @@ pub(crate) fn with_team<T>(move_off: bool, f: impl FnOnce() -> T) -> T {
         move_off,
     };
     let mut step = OnThisThread(Some(f), None);
-    if crate::parallel::context::on_pool_thread() {
-        // The helpers are rayon jobs beside this one (no allocation).
-        let step_ref = &mut step;
-        rayon::join(|| step_ref.run(&team), || fan_helpers(&team, helpers));
-    } else {
-        // This thread is not one of the pool's: the helpers are spawned into it (one small
-        // allocation each), and the scope waits for them after the step.
-        let team = &team;
-        crate::parallel::context::in_place_scope(|scope| {
-            for _ in 0..helpers {
-                scope.spawn(move |_| help(team));
-            }
-            step.run(team);
-        });
-    }
+    let step_ref = &mut step;
+    rayon::join(|| step_ref.run(&team), || fan_helpers(&team, helpers));
     match step.1 {
         Some(out) => out,
-        // The first closure of `join` (and the scope's closure) always runs, on this thread.
+        // The first closure of `join` always runs (on this thread).
         None => unreachable!("with_team's step did not run"),
     }
 }
@@ -115,11 +102,10 @@ pub(crate) fn with_team<T>(move_off: bool, f: impl FnOnce() -> T) -> T {
 /// The step and its result, moved into the first closure of `rayon::join`.
 struct OnThisThread<F, T>(Option<F>, Option<T>);
 
-// SAFETY: `with_team` moves it into `rayon::join` only from a worker thread of the pool
-// (`on_pool_thread`), and there `rayon::join` runs its first closure on the calling thread
-// ("It will begin by executing closure A (on the current thread)", rayon's docs); the other
-// path runs it directly inside `in_place_scope`'s closure, on this thread. So neither the step
-// nor its result changes thread.
+// SAFETY: `with_team` moves it into `rayon::join` only from a worker thread of the step's
+// pool (`on_pool_thread`), and there `rayon::join` runs its first closure on the calling
+// thread ("It will begin by executing closure A (on the current thread)", rayon's docs), so
+// neither the step nor its result changes thread.
 unsafe impl<F, T> Send for OnThisThread<F, T> {}
 
 impl<F: FnOnce() -> T, T> OnThisThread<F, T> {

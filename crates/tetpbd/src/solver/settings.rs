@@ -86,8 +86,9 @@ pub struct ParallelSettings {
     /// long hook), so the spinning is bounded, but while a step runs it holds every core of
     /// the pool. Worth turning on for large bodies (≳ 50k tetrahedra) when the simulation
     /// has the pool's cores to itself: it saves the wake-up of the sleeping threads at each
-    /// of the dozens of passes of a frame. When the stepping thread is outside the pool,
-    /// starting the helpers costs one small allocation per helper per step.
+    /// of the dozens of passes of a frame. Takes effect only when the step runs on one of
+    /// the pool's threads (called inside `pool.install(..)`); a step called from another
+    /// thread hands each pass to the pool as by default.
     pub keep_helpers_awake: bool,
     /// Linux only, and only with [`ParallelSettings::keep_helpers_awake`]: a helper that finds
     /// itself on the stepping thread's core narrows its own CPU mask to the other cores it
