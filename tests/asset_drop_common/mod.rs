@@ -1,5 +1,5 @@
 //! The scene of the `asset_drop` example, shared by `tests/asset_drop.rs` and
-//! `tests/issue_3_blob_comes_to_rest.rs`: a committed OBJ asset tetrahedralized with
+//! `tests/rolling_blob_comes_to_rest.rs`: a committed OBJ asset tetrahedralized with
 //! `tetpbd-io` and dropped on a fixed ground cuboid (top at y = 0) at 60 Hz, 10 substeps,
 //! density 300 kg/m³, stiff edges and volume, deformation damping 5/s.
 #![allow(dead_code)]

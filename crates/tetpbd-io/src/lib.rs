@@ -10,9 +10,8 @@
 //!   [`write_msh`]).
 //! * [`drop_unreferenced_vertices`] removes vertices no tetrahedron uses (Gmsh files often
 //!   hold surface or geometry nodes), which [`tetpbd::SoftBodyBuilder`] would reject.
-//! * Surface meshes in (feature `mesher`, on by default; it brings rapier3d through
-//!   `tetpbd-rapier`, and `tobj`): a closed triangle [`SurfaceMesh`] from an OBJ file or
-//!   arrays is filled with tetrahedra by parry's `volume_mesh` ([`TetrahedralizeBuilder`],
+//! * Surface meshes in (feature `mesher`, on by default; it brings `parry3d` and `tobj`): a
+//!   closed triangle [`SurfaceMesh`] from an OBJ file or arrays is filled with tetrahedra by parry's `volume_mesh` ([`TetrahedralizeBuilder`],
 //!   cell size in m), and a fine render mesh is embedded in the tetrahedra and moved with
 //!   them ([`Skin`], barycentric skinning). Errors are [`SurfaceError`] and [`SkinError`].
 //!   [`shapes`] generates the sample assets under `examples/assets/`.
@@ -44,6 +43,8 @@
 
 mod compact;
 mod error;
+#[cfg(feature = "mesher")]
+mod glam;
 mod gmsh;
 mod gmsh22;
 mod gmsh_binary;

@@ -1,12 +1,12 @@
 //! Barycentric skinning: points of a fine render mesh embedded in the tetrahedra of a
 //! coarse simulation mesh, moved with it every frame.
 
+use crate::glam::to_glam;
 use nalgebra::{Matrix3, Vector3};
-use tetpbd_rapier::convert::to_glam;
-use tetpbd_rapier::rapier3d::parry::bounding_volume::Aabb;
-use tetpbd_rapier::rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy};
-use tetpbd_rapier::rapier3d::parry::query::PointQuery;
-use tetpbd_rapier::rapier3d::parry::shape::Tetrahedron;
+use parry3d::bounding_volume::Aabb;
+use parry3d::partitioning::{Bvh, BvhBuildStrategy};
+use parry3d::query::PointQuery;
+use parry3d::shape::Tetrahedron;
 
 use crate::mesher_error::SkinError;
 use crate::tetrahedralize::builder_volume;

@@ -1,12 +1,10 @@
 //! Filling a closed triangle surface with tetrahedra (parry's `volume_mesh`).
 
+use crate::glam::{to_glam, to_na};
 use nalgebra::Vector3;
+use parry3d::transformation::{volume_mesh, MeshEnclosure, VolumeMeshParameters};
 use tetpbd::constraint::signed_volume;
 use tetpbd::{SoftBodyBuilder, TetMesh};
-use tetpbd_rapier::convert::{to_glam, to_na};
-use tetpbd_rapier::rapier3d::parry::transformation::{
-    volume_mesh, MeshEnclosure, VolumeMeshParameters,
-};
 
 use crate::mesher_error::SurfaceError;
 use crate::surface::SurfaceMesh;

@@ -9,32 +9,32 @@ use rapier3d::math::{AngularInertia, Pose, Rotation, Vector};
 
 /// glam vector → nalgebra vector.
 #[inline]
-pub fn to_na(v: Vector) -> Vector3<f32> {
+pub(crate) fn to_na(v: Vector) -> Vector3<f32> {
     Vector3::new(v.x, v.y, v.z)
 }
 
 /// nalgebra vector → glam vector.
 #[inline]
-pub fn to_glam(v: &Vector3<f32>) -> Vector {
+pub(crate) fn to_glam(v: &Vector3<f32>) -> Vector {
     Vector::new(v.x, v.y, v.z)
 }
 
 /// glam rotation → nalgebra unit quaternion.
 #[inline]
-pub fn rot_to_na(r: Rotation) -> UnitQuaternion<f32> {
+pub(crate) fn rot_to_na(r: Rotation) -> UnitQuaternion<f32> {
     UnitQuaternion::new_normalize(Quaternion::new(r.w, r.x, r.y, r.z))
 }
 
 /// nalgebra unit quaternion → glam rotation.
 #[inline]
-pub fn rot_to_glam(r: &UnitQuaternion<f32>) -> Rotation {
+pub(crate) fn rot_to_glam(r: &UnitQuaternion<f32>) -> Rotation {
     let q = r.quaternion();
     Rotation::from_xyzw(q.i, q.j, q.k, q.w)
 }
 
 /// glam pose → nalgebra isometry.
 #[inline]
-pub fn pose_to_na(p: &Pose) -> Isometry3<f32> {
+pub(crate) fn pose_to_na(p: &Pose) -> Isometry3<f32> {
     Isometry3::from_parts(
         Translation3::from(to_na(p.translation)),
         rot_to_na(p.rotation),
@@ -43,13 +43,13 @@ pub fn pose_to_na(p: &Pose) -> Isometry3<f32> {
 
 /// nalgebra isometry → glam pose.
 #[inline]
-pub fn pose_to_glam(p: &Isometry3<f32>) -> Pose {
+pub(crate) fn pose_to_glam(p: &Isometry3<f32>) -> Pose {
     Pose::from_parts(to_glam(&p.translation.vector), rot_to_glam(&p.rotation))
 }
 
 /// rapier's symmetric world inverse inertia → nalgebra matrix.
 #[inline]
-pub fn inertia_to_na(i: &AngularInertia) -> Matrix3<f32> {
+pub(crate) fn inertia_to_na(i: &AngularInertia) -> Matrix3<f32> {
     Matrix3::new(
         i.m11, i.m12, i.m13, //
         i.m12, i.m22, i.m23, //
@@ -59,7 +59,7 @@ pub fn inertia_to_na(i: &AngularInertia) -> Matrix3<f32> {
 
 /// `true` when every component is finite.
 #[inline]
-pub fn finite3(v: &Vector3<f32>) -> bool {
+pub(crate) fn finite3(v: &Vector3<f32>) -> bool {
     v.iter().all(|c| c.is_finite())
 }
 

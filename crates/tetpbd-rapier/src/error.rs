@@ -9,6 +9,10 @@ use rapier3d::dynamics::RigidBodyHandle;
 pub enum CouplingError {
     /// A soft-body solver setting is invalid.
     Solver(tetpbd::SettingsError),
+    /// A soft body's state was not finite at the start of a substep; the solver restored it
+    /// and finished the step ([`tetpbd::StepError::NonFiniteState`] names the body, particle
+    /// and value).
+    NonFiniteState(tetpbd::StepError),
     /// A coupling setting is out of range.
     BadSetting {
         /// The field's name.
@@ -36,6 +40,15 @@ pub enum CouplingError {
     /// A particle index is out of range for its soft body.
     ParticleOutOfRange {
         /// The index.
+        index: u32,
+        /// Number of particles of the body.
+        len: usize,
+    },
+    /// A soft body's `Surface` names a particle its `Particles` do not hold.
+    SurfaceOutOfRange {
+        /// The soft body.
+        entity: hecs::Entity,
+        /// The largest particle index of the surface.
         index: u32,
         /// Number of particles of the body.
         len: usize,
@@ -71,6 +84,7 @@ impl fmt::Display for CouplingError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             CouplingError::Solver(e) => write!(f, "soft-body solver settings: {e}"),
+            CouplingError::NonFiniteState(e) => write!(f, "soft-body state: {e}"),
             CouplingError::BadSetting { name, value } => {
                 write!(f, "coupling setting `{name}` is out of range: {value}")
             }
@@ -87,6 +101,11 @@ impl fmt::Display for CouplingError {
             CouplingError::ParticleOutOfRange { index, len } => {
                 write!(f, "particle {index} out of range ({len} particles)")
             }
+            CouplingError::SurfaceOutOfRange { entity, index, len } => write!(
+                f,
+                "the surface of soft body {entity:?} names particle {index}, \
+                 but the body has {len} particles"
+            ),
             CouplingError::AttachmentOutOfRange { index, len } => {
                 write!(f, "attachment {index} out of range ({len} attachments)")
             }
@@ -105,6 +124,15 @@ impl fmt::Display for CouplingError {
 }
 
 impl std::error::Error for CouplingError {}
+
+impl From<tetpbd::StepError> for CouplingError {
+    fn from(e: tetpbd::StepError) -> Self {
+        match e {
+            tetpbd::StepError::Settings(e) => CouplingError::Solver(e),
+            e => CouplingError::NonFiniteState(e),
+        }
+    }
+}
 
 impl From<tetpbd::SettingsError> for CouplingError {
     fn from(e: tetpbd::SettingsError) -> Self {

@@ -14,9 +14,16 @@
 //!   surface triangles).
 //! * Rigid points against soft surface triangles: rigid corners and small shapes do not slip
 //!   between the particles of a coarse soft body.
+//! * Triangle-mesh colliders of either winding, open or closed, with or without
+//!   pseudo-normals: an open mesh (or one wound inwards) is a two-sided sheet, a particle
+//!   kept on the side it came from; only a closed mesh wound outwards has an inside that
+//!   pushes a particle created in it out. A heightfield is solid below its surface.
 //! * Per-body collision properties (friction, restitution, rolling resistance, thickness)
 //!   and groups: the [`SoftCollider`] component; deformation damping: the
 //!   [`DeformationDamping`] component.
+//! * Triangle meshes without pseudo-normals are one-sided: their inside is behind each
+//!   face's counter-clockwise winding normal; heightfields are solid below their surface
+//!   (see [`SoftCollider`]).
 //! * Attachments: the [`Attachments`] component.
 //! * Contact reports: [`Coupling::contacts`]; statistics: [`CouplingStats`].
 //! * Other hooks (e.g. soft–soft contacts) run in the same substeps through
@@ -45,47 +52,54 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
+//! Where things are in the source: `gather` collects once per frame the colliders near each
+//! soft body and the contact candidates; `contacts` makes and projects the contacts against
+//! rigid bodies (`particle`: soft particles vs colliders, `corner`: rigid corners vs soft
+//! triangles, `support`: the rigid contacts of anchored bodies); `response` holds friction
+//! (one rule for every contact kind), restitution, rolling resistance and deformation
+//! damping; `rigid` the proxies of rapier bodies and colliders inside the substeps; `ccd`
+//! the swept tests for fast bodies; `heavy_loads` the pass that carries heavy rigid bodies
+//! on soft ones; `attachments`; `soft_soft` the contacts between soft bodies; `substep` the
+//! order of the work in one substep; `coupling` the frame ([`Coupling::step`]).
+//!
 //! Bad input is rejected with a [`CouplingError`] naming what is wrong; conditions that can
 //! only be seen during a step (an attachment whose body was removed, a point parry gives no
 //! normal for) are skipped and counted in [`CouplingStats`].
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-mod attachment;
-mod bodies;
-mod contact;
-pub mod convert;
-mod corner;
-mod corner_points;
+mod attachments;
+mod ccd;
+mod contacts;
+mod convert;
 mod coupling;
-mod damping;
+mod depenetration;
 mod error;
-mod frame;
-mod hook;
-mod material;
+mod gather;
+mod heavy_loads;
+mod impact;
+mod joints;
+mod mesh_side;
 mod report;
-mod restitution;
-mod rolling;
+mod response;
+mod rigid;
 mod scene;
-mod shape_query;
-mod soft_bvh;
-mod soft_contact;
-mod soft_gather;
-mod soft_project;
-mod soft_restitution;
-mod soft_separation;
-mod stacking;
-mod support;
-mod sweep;
+mod settings;
+mod soft_collider;
+mod soft_soft;
+mod substep;
+mod validate;
 
-pub use attachment::{AttachTarget, Attachment, Attachments};
-pub use coupling::{Coupling, CouplingSettings, RapierContext};
-pub use damping::DeformationDamping;
+pub use attachments::{AttachTarget, Attachment, Attachments};
+pub use coupling::{Coupling, RapierContext};
 pub use error::CouplingError;
-pub use material::{SoftCollider, SoftColliderBuilder};
 pub use report::{ContactReport, CouplingStats, SoftFeature};
+pub use response::deformation_damping::DeformationDamping;
 pub use scene::CoupledWorld;
-pub use soft_contact::{SelfCollision, SoftContactSettings, SoftContactStats, SoftContacts};
+pub use settings::CouplingSettings;
+pub use soft_collider::{SoftCollider, SoftColliderBuilder};
+pub use soft_soft::settings::{SelfCollision, SoftContactSettings, SoftContactStats};
+pub use soft_soft::SoftContacts;
 
 pub use rapier3d;
 pub use tetpbd;

@@ -68,12 +68,15 @@ pub struct CouplingStats {
     /// Contact evaluations skipped because parry gave no usable normal (point exactly on the
     /// surface with no previous normal).
     pub degenerate_contacts: u64,
-    /// Stacking passes run (one per stacked soft body and iteration; `stacking` module
+    /// Stacking passes run (one per stacked soft body and iteration; `heavy_loads` module
     /// docs, [`crate::CouplingSettings::stacking_mass_ratio`]).
     pub stacking_passes: u64,
     /// Wall time of the stacking passes and their velocity passes (part of the soft step's
     /// hook time).
     pub stacking_time: Duration,
+    /// Soft bodies (entities with `Particles`) stepped without a `Surface`: the solver moves
+    /// them but they collide with nothing (`validate` module docs).
+    pub bodies_without_surface: usize,
     /// Rigid bodies whose pose/velocity was written back.
     pub bodies_written: usize,
     /// Rigid bodies not written back because their result was not finite.

@@ -5,9 +5,10 @@ use hecs::World;
 use rapier3d::pipeline::PhysicsWorld;
 use tetpbd::{SolverSettings, SubstepHook};
 
-use crate::coupling::{Coupling, CouplingSettings, RapierContext};
+use crate::coupling::{Coupling, RapierContext};
 use crate::error::CouplingError;
 use crate::report::CouplingStats;
+use crate::settings::CouplingSettings;
 
 /// Everything of a coupled scene in one value. Fields are public: insert rigid bodies into
 /// `physics`, spawn soft bodies into `soft`, then call [`CoupledWorld::step`].

@@ -1,9 +1,8 @@
 //! Rapier collider shapes → triangles, through parry's `to_trimesh` tessellations.
 
-use nalgebra::Vector3;
+use nalgebra::{Isometry3, Vector3};
 use rapier3d::math::Vector;
 use rapier3d::parry::shape::{Shape, SupportMap, TypedShape};
-use tetpbd_rapier::convert::{pose_to_na, to_na};
 
 use crate::mesh::TriangleMesh;
 
@@ -16,7 +15,7 @@ const HALF_SPACE_EXTENT: f32 = 50.0;
 
 fn from_parry(vertices: Vec<Vector>, triangles: Vec<[u32; 3]>) -> TriangleMesh {
     TriangleMesh {
-        positions: vertices.into_iter().map(to_na).collect(),
+        positions: vertices.into_iter().map(Vector3::from).collect(),
         triangles,
     }
 }
@@ -29,7 +28,7 @@ fn support_map_mesh(shape: &dyn SupportMap) -> TriangleMesh {
         rapier3d::parry::shape::Ball::new(1.0).to_trimesh(AROUND, POLE_TO_POLE);
     let positions = sphere
         .into_iter()
-        .map(|d| to_na(shape.local_support_point(d)))
+        .map(|d| Vector3::from(shape.local_support_point(d)))
         .collect();
     TriangleMesh {
         positions,
@@ -95,12 +94,12 @@ pub fn shape_mesh(shape: &dyn Shape) -> Option<TriangleMesh> {
         }
         TypedShape::TriMesh(s) => from_parry(s.vertices().to_vec(), s.indices().to_vec()),
         TypedShape::Triangle(s) => from_parry(vec![s.a, s.b, s.c], vec![[0, 1, 2]]),
-        TypedShape::HalfSpace(s) => half_space_mesh(to_na(s.normal)),
+        TypedShape::HalfSpace(s) => half_space_mesh(Vector3::from(s.normal)),
         TypedShape::Compound(c) => {
             let mut all = TriangleMesh::default();
             for (pose, part) in c.shapes() {
                 if let Some(m) = shape_mesh(part.as_ref()) {
-                    all.append(m.transformed(&pose_to_na(pose)));
+                    all.append(m.transformed(&Isometry3::from(*pose)));
                 }
             }
             all

@@ -2,9 +2,9 @@
 //! [`SceneView`], what a scene lends to take one.
 
 use hecs::World;
+use nalgebra::Isometry3;
 use rapier3d::prelude::{ColliderSet, RigidBodySet};
 use tetpbd::{Particles, Surface};
-use tetpbd_rapier::convert::pose_to_na;
 use tetpbd_rapier::CoupledWorld;
 
 use crate::mesh::TriangleMesh;
@@ -108,7 +108,7 @@ impl Snapshot {
                 items.push(Item {
                     kind,
                     name: format!("rigid{}", handle.into_raw_parts().0),
-                    mesh: mesh.transformed(&pose_to_na(collider.position())),
+                    mesh: mesh.transformed(&Isometry3::from(*collider.position())),
                 });
             }
         }

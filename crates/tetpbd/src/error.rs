@@ -225,3 +225,63 @@ impl fmt::Display for StateError {
 }
 
 impl std::error::Error for StateError {}
+
+/// Why a [`crate::Solver`] step failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepError {
+    /// The settings are invalid; nothing was stepped.
+    Settings(SettingsError),
+    /// A particle's position or velocity was not finite at the start of a substep (written by
+    /// the caller, e.g. through [`crate::Particles::positions_mut`], or by a hook). The step
+    /// ran to its end with every such particle restored: its position put back to its last
+    /// finite value (its substep start, the state one substep before it was overwritten; its
+    /// rest position if that too is not finite) and a non-finite velocity set to zero. This
+    /// names the first one found (lowest body, then particle index).
+    NonFiniteState {
+        /// The body.
+        entity: hecs::Entity,
+        /// Particle index within the body.
+        particle: usize,
+        /// `"position"` or `"velocity"`.
+        what: &'static str,
+        /// The value found.
+        value: [f32; 3],
+        /// Particles restored in the step, over all bodies (each counted once per substep in
+        /// which it was found; [`crate::StepStats::non_finite_restored`] has the same count).
+        restored: u64,
+    },
+}
+
+impl fmt::Display for StepError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StepError::Settings(e) => write!(f, "bad solver settings: {e}"),
+            StepError::NonFiniteState {
+                entity,
+                particle,
+                what,
+                value,
+                restored,
+            } => write!(
+                f,
+                "{what} of particle {particle} of body {entity:?} is not finite ({value:?}); \
+                 restored to its last finite state ({restored} particle restorations)"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for StepError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            StepError::Settings(e) => Some(e),
+            StepError::NonFiniteState { .. } => None,
+        }
+    }
+}
+
+impl From<SettingsError> for StepError {
+    fn from(e: SettingsError) -> Self {
+        StepError::Settings(e)
+    }
+}

@@ -56,9 +56,10 @@ pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeC
 pub use body::generators;
 pub use body::mesh::{Surface, Tetrahedra};
 pub use body::particles::{ExternalAcceleration, Particles};
-pub use error::{BuildError, SettingsError, StateError};
+pub use error::{BuildError, SettingsError, StateError, StepError};
 pub use ordering::ColourClasses;
 pub use solver::hook::SubstepHook;
+pub use solver::non_finite::Restored;
 pub use solver::settings::{ParallelSettings, SolverSettings};
 pub use solver::stats::{ErrorAccumulator, ErrorStats, FamilyStats, StepStats};
 pub use solver::step::Solver;

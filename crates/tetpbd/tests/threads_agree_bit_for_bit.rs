@@ -180,6 +180,7 @@ fn run_free_mirrored(threads: usize) -> Vec<[u32; 3]> {
         let mut solver = Solver::new(SolverSettings {
             substeps: 3,
             max_correction_speed: Some(5.0),
+            limit_correction_energy: false,
             ..Default::default()
         })
         .unwrap();

@@ -2,7 +2,7 @@
 //! 1/60 s frame), for edges + volume and for vertex–face, on 1 and 2 threads.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown --per-frame --keep-helpers-awake --move-helpers-off --given-pool]
+//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown --per-frame --no-energy-limit --keep-helpers-awake --move-helpers-off --given-pool]
 //! ```
 //!
 //! `--keep-helpers-awake` and `--move-helpers-off` turn on
@@ -29,6 +29,9 @@
 //! order converges, e.g. to compare `--parts 1` with a partitioned order.
 //!
 //! `--set` measures one family set only (default both).
+//!
+//! `--no-energy-limit` turns [`tetpbd::SolverSettings::limit_correction_energy`] off (to
+//! measure its cost).
 //!
 //! `--parts P` builds the bodies cut into `P` slabs for the sweep order
 //! ([`tetpbd::SoftBodyBuilder::parts`]; default 0, the builder's choice).
@@ -117,6 +120,7 @@ fn body(
             move_helpers_off_step_core: flag("--move-helpers-off"),
             ..Default::default()
         },
+        limit_correction_energy: !flag("--no-energy-limit"),
         ..Default::default()
     })?;
     Ok(Body {

@@ -82,7 +82,8 @@ impl Tetrahedra {
     /// (or is zero against) their rest volume.
     pub fn count_inverted(&self, positions: &[Vector3<f32>]) -> usize {
         (0..self.len())
-            .filter(|&t| self.volume_at(t, positions) * self.rest_volumes[t] <= 0.0)
+            // A non-finite volume counts as inverted (NaN compares false).
+            .filter(|&t| !(self.volume_at(t, positions) * self.rest_volumes[t] > 0.0))
             .count()
     }
 }

@@ -184,7 +184,7 @@ impl Particles {
         Ok(())
     }
 
-    /// Total mass of the free (unpinned) particles, kg.
+    /// Total mass of all particles, pinned ones included, kg.
     pub fn total_mass(&self) -> f32 {
         self.masses.iter().sum()
     }

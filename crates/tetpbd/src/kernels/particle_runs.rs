@@ -1,6 +1,7 @@
 //! The per-particle passes of a substep over a run of particles — prediction and velocity
 //! update — shared by the serial systems and the parallel passes.
 
+use crate::solver::non_finite::{self, RestoredRun};
 use nalgebra::Vector3;
 
 use crate::kernels::compensated::add_compensated;
@@ -12,19 +13,29 @@ pub(crate) struct PredictRun<'a> {
     pub velocities: &'a mut [Vector3<f32>],
     pub inv_masses: &'a [f32],
     pub residuals: &'a mut [Vector3<f32>],
+    pub rest_positions: &'a [Vector3<f32>],
 }
 
 impl PredictRun<'_> {
-    /// [`predict`](crate::systems::predict) on these particles, with acceleration `a` and damping factor `keep`.
-    pub fn predict(self, a: Vector3<f32>, h: f32, keep: f32) {
+    /// [`predict`](crate::systems::predict) on these particles, with acceleration `a` and
+    /// damping factor `keep`; a non-finite particle is restored first
+    /// ([`crate::solver::non_finite`]).
+    pub fn predict(self, a: Vector3<f32>, h: f32, keep: f32) -> RestoredRun {
         let PredictRun {
             positions,
             prev_positions,
             velocities,
             inv_masses,
             residuals,
+            rest_positions,
         } = self;
+        let mut restored = RestoredRun::default();
         for i in 0..positions.len() {
+            if !non_finite::is_finite(&positions[i], &velocities[i]) {
+                let (x, v) = (&mut positions[i], &mut velocities[i]);
+                let (prev, rest) = (prev_positions[i], rest_positions[i]);
+                non_finite::restore(&mut restored, i, x, v, prev, rest);
+            }
             prev_positions[i] = positions[i];
             residuals[i] = Vector3::zeros();
             if inv_masses[i] > 0.0 {
@@ -32,6 +43,7 @@ impl PredictRun<'_> {
             }
             add_compensated(&mut positions[i], &mut residuals[i], velocities[i] * h);
         }
+        restored
     }
 }
 

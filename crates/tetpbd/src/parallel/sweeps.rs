@@ -59,9 +59,14 @@ pub(crate) fn particles_worth_it(len: usize) -> bool {
 }
 
 /// [`crate::systems::predict`] of one body, in runs of particles.
-pub(crate) fn predict(run: PredictRun<'_>, a: Vector3<f32>, h: f32, keep: f32) {
+pub(crate) fn predict(
+    run: PredictRun<'_>,
+    a: Vector3<f32>,
+    h: f32,
+    keep: f32,
+) -> crate::solver::non_finite::RestoredRun {
     let n = run.positions.len();
-    let w = run.inv_masses;
+    let (w, rest) = (run.inv_masses, run.rest_positions);
     let shared = (
         Shared::new(run.positions),
         Shared::new(run.prev_positions),
@@ -73,12 +78,12 @@ pub(crate) fn predict(run: PredictRun<'_>, a: Vector3<f32>, h: f32, keep: f32) {
             positions: x,
             prev_positions: xp,
             velocities: v,
-            inv_masses: &w[i],
+            inv_masses: &w[i.clone()],
+            rest_positions: &rest[i.clone()],
             residuals: r,
         };
-        run.predict(a, h, keep);
-        Nothing
-    });
+        run.predict(a, h, keep).offset(i.start)
+    })
 }
 
 /// [`crate::systems::update_velocities`] of one body, in runs of particles (the counts are
@@ -247,11 +252,16 @@ pub(crate) fn vertex_face(
 /// block of [`crate::stabilisation::rigid_fit::BLOCK`] particles, each block's f32 sums written to its entry of
 /// `blocks` (the caller folds them in block order, as the serial path does, so the result
 /// does not depend on the thread count).
-pub(crate) fn store_measuring(run: StoreRun<'_>, o: Vector3<f32>, blocks: &mut [Moments<f32>]) {
+pub(crate) fn store_measuring(
+    run: StoreRun<'_>,
+    origins: [Vector3<f32>; 2],
+    blocks: &mut [Moments<f32>],
+    spin: bool,
+) {
     let n = run.slots.len();
     let (x, r) = (Shared::new(run.positions), Shared::new(run.residuals));
-    let out = Shared::new(blocks);
-    let (slots, xp, m) = (run.slots, run.prev_positions, run.masses);
+    let (out, s) = (Shared::new(blocks), Shared::new(run.slots));
+    let (xp, v, m) = (run.prev_positions, run.velocities, run.masses);
     run_phases(
         1,
         1,
@@ -261,37 +271,51 @@ pub(crate) fn store_measuring(run: StoreRun<'_>, o: Vector3<f32>, blocks: &mut [
                 let i = b * BLOCK..((b + 1) * BLOCK).min(n);
                 // SAFETY: `run_phases` hands each unit, so each block of particles and its
                 // entry of `blocks`, to one call only.
-                let (x, r, out) =
-                    unsafe { (x.run(i.clone()), r.run(i.clone()), out.run(b..b + 1)) };
+                let (x, r, s, out) = unsafe {
+                    (
+                        x.run(i.clone()),
+                        r.run(i.clone()),
+                        s.run(i.clone()),
+                        out.run(b..b + 1),
+                    )
+                };
                 let block = StoreRun {
-                    slots: &slots[i.clone()],
+                    slots: s,
                     positions: x,
                     residuals: r,
                     prev_positions: &xp[i.clone()],
+                    velocities: &v[i.clone()],
                     masses: &m[i],
                 };
-                out[0] = block.store_measuring(o);
+                out[0] = if spin {
+                    block.store_measuring::<true>(origins)
+                } else {
+                    block.store_measuring::<false>(origins)
+                };
             }
             Nothing
         },
     );
 }
 
-/// [`crate::stabilisation::rigid_fit::rotate_back`] in runs of particles.
-pub(crate) fn rotate_back(
-    positions: &mut [Vector3<f32>],
-    residuals: &mut [Vector3<f32>],
-    prev_positions: &[Vector3<f32>],
+/// [`crate::stabilisation::rigid_fit::FixUp::apply`] in runs of particles.
+pub(crate) fn fix_up(
+    fix: rigid_fit::FixUp<'_>,
     origin_centre: [Vector3<f32>; 2],
     theta: Vector3<f32>,
+    scale: f32,
 ) {
-    let n = positions
-        .len()
-        .min(residuals.len())
-        .min(prev_positions.len());
-    let shared = (Shared::new(positions), Shared::new(residuals));
+    let n = fix.positions.len();
+    let (xp, before) = (fix.prev_positions, fix.before);
+    let shared = (Shared::new(fix.positions), Shared::new(fix.residuals));
     for_runs(n, PARTICLE_CHUNK, &shared, |i, (x, r)| {
-        rigid_fit::rotate_back(x, r, &prev_positions[i], origin_centre, theta);
+        rigid_fit::FixUp {
+            positions: x,
+            residuals: r,
+            prev_positions: &xp[i.clone()],
+            before: &before[i],
+        }
+        .apply(origin_centre, theta, scale);
         Nothing
     });
 }

@@ -5,6 +5,7 @@
 //! (`Solver::substep`).
 
 pub(crate) mod hook;
+pub(crate) mod non_finite;
 pub(crate) mod settings;
 pub(crate) mod stats;
 pub(crate) mod step;

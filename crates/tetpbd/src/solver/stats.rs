@@ -84,16 +84,25 @@ pub struct StepStats {
     /// Particles whose state became non-finite during the step and were reset to their
     /// substep start with zero velocity (a safety net; 0 in every healthy run).
     pub non_finite_resets: u64,
+    /// Particles found not finite at the start of a substep (written by the caller or a
+    /// hook) and restored to their last finite state; the step then returns
+    /// [`crate::StepError::NonFiniteState`].
+    pub non_finite_restored: u64,
     /// Particle velocity updates clamped by
     /// [`crate::SolverSettings::max_correction_speed`] (summed over substeps; the momentum
     /// restoration that follows a body's clamps is not counted separately).
     pub velocity_clamps: u64,
+    /// Body iterations in which the families' corrections would have added more kinetic
+    /// energy than their compliant constraints released, and were limited
+    /// ([`crate::SolverSettings::limit_correction_energy`]).
+    pub energy_limited: u64,
     /// Time in prediction (gravity, damping, integration).
     pub predict_time: Duration,
     /// Time in the velocity update.
     pub velocity_time: Duration,
     /// Time removing the rigid rotation of the families' corrections
-    /// ([`crate::SolverSettings::conserve_angular_momentum`]), including the copy back from
+    /// ([`crate::SolverSettings::conserve_angular_momentum`]) and limiting their energy
+    /// ([`crate::SolverSettings::limit_correction_energy`]), including the copy back from
     /// the working copy that it takes over (then not in [`StepStats::copy_time`]).
     pub spin_time: Duration,
     /// Time copying the particles into the projections' working copy and back, once per

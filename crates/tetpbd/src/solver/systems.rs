@@ -28,9 +28,20 @@ use crate::solver::stats::{ErrorAccumulator, ErrorStats};
 ///
 /// Pinned particles (inverse mass 0) keep their velocity: one set by the user moves them
 /// kinematically.
-pub fn predict(world: &mut World, h: f32, gravity: Vector3<f32>, damping: f32) {
+///
+/// A particle whose position or velocity is not finite when prediction reads it is restored
+/// first (see [`crate::solver::non_finite`]) and reported in the result.
+pub fn predict(
+    world: &mut World,
+    h: f32,
+    gravity: Vector3<f32>,
+    damping: f32,
+) -> crate::solver::non_finite::Restored {
     let keep = (1.0 - damping * h).max(0.0);
-    for (p, extra) in world.query_mut::<(&mut Particles, Option<&ExternalAcceleration>)>() {
+    let mut restored = crate::solver::non_finite::Restored::default();
+    for (entity, p, extra) in
+        world.query_mut::<(hecs::Entity, &mut Particles, Option<&ExternalAcceleration>)>()
+    {
         let a = gravity + extra.map_or(Vector3::zeros(), |e| e.0);
         let Particles {
             positions,
@@ -38,6 +49,7 @@ pub fn predict(world: &mut World, h: f32, gravity: Vector3<f32>, damping: f32) {
             velocities,
             inv_masses,
             residuals,
+            rest_positions,
             ..
         } = p;
         let run = PredictRun {
@@ -46,14 +58,22 @@ pub fn predict(world: &mut World, h: f32, gravity: Vector3<f32>, damping: f32) {
             velocities,
             inv_masses,
             residuals,
+            rest_positions,
         };
         #[cfg(feature = "parallel")]
-        if crate::parallel::sweeps::particles_worth_it(run.positions.len()) {
-            crate::parallel::sweeps::predict(run, a, h, keep);
-            continue;
+        let r = if crate::parallel::sweeps::particles_worth_it(run.positions.len()) {
+            crate::parallel::sweeps::predict(run, a, h, keep)
+        } else {
+            run.predict(a, h, keep)
+        };
+        #[cfg(not(feature = "parallel"))]
+        let r = run.predict(a, h, keep);
+        restored.count += r.count;
+        if let (None, Some((i, what, value))) = (restored.first, r.first) {
+            restored.first = Some((entity, i, what, value));
         }
-        run.predict(a, h, keep);
     }
+    restored
 }
 
 /// Sets every multiplier λ to zero (start of a substep).

@@ -50,103 +50,125 @@
 //! order). Cost: the copy back from the working copy, which this pass takes over, measures
 //! the corrections on the way, plus one more pass to apply `θ`.
 
-use hecs::World;
 use nalgebra::Vector3;
 
 use crate::body::particles::Particles;
-use crate::stabilisation::rigid_fit::{rotate_back, Moments, StoreRun, BLOCK};
+use crate::stabilisation::rigid_fit::{FixUp, Moments, StoreRun, BLOCK};
 
-/// Copies every swept body's working copy back ([`crate::kernels::working_copy::store`]) and removes the
-/// rigid-rotation part of the corrections the families made on it since it was loaded (the
-/// copy in the slots, `Particles` still holding the positions before the families).
-pub(crate) fn store_bodies_without_spin(world: &mut World) {
-    crate::kernels::working_copy::for_each_swept(world, store_without_spin);
-}
-
-/// [`store_bodies_without_spin`] for one body. A free body is stored and measured in one
-/// pass, then corrected in a second; a body with a pinned particle is only stored.
-fn store_without_spin(p: &mut Particles) {
+/// Copies a body's working copy back ([`crate::kernels::working_copy::store`]), removes the rigid-rotation
+/// part of the corrections the families made on it since it was loaded (the copy in the
+/// slots, `Particles` still holding the positions before the families) when `spin` is set
+/// and the body has no pinned particle, and keeps what is left from adding kinetic energy
+/// beyond `budget` ([`crate::stabilisation::correction_energy`]; `budget` is called only when the corrections would add
+/// energy at all). Returns `true` when the energy limit scaled the corrections' velocity.
+/// One pass stores and measures; a second, only when there is a rotation to remove or an
+/// energy limit to apply, corrects.
+pub(crate) fn store_measured(
+    p: &mut Particles,
+    h: f32,
+    spin: bool,
+    budget: impl FnOnce(f32, f64, f64) -> f64,
+) -> bool {
     let n = p.positions.len();
-    if n == 0 || p.work.0.len() != n || p.inv_masses.contains(&0.0) {
+    if n == 0 || p.work.0.len() != n {
         crate::kernels::working_copy::store(p);
-        return;
+        return false;
     }
+    let spin = spin && !p.inv_masses.contains(&0.0);
     // Raw moments about the first particle's start `o` (small numbers, little
     // cancellation), summed in f32 over blocks of `BLOCK` particles and in f64 across blocks,
     // in block order (the same sums for any thread count).
-    let o = p.prev_positions[0];
+    let (o, v0) = (p.prev_positions[0], p.velocities[0]);
     let mut sums = Moments::<f64>::default();
     let Particles {
         positions,
         prev_positions,
+        velocities,
         residuals,
         masses,
         work,
         ..
     } = p;
     let run = StoreRun {
-        slots: &work.0,
+        slots: &mut work.0,
         positions,
         residuals,
         prev_positions,
+        velocities,
         masses,
     };
     #[cfg(feature = "parallel")]
-    if crate::parallel::sweeps::particles_worth_it(n) {
+    let parallel = crate::parallel::sweeps::particles_worth_it(n);
+    #[cfg(not(feature = "parallel"))]
+    let parallel = false;
+    if parallel {
+        #[cfg(feature = "parallel")]
         BLOCKS.with_borrow_mut(|blocks| {
             blocks.clear();
             blocks.resize(n.div_ceil(BLOCK), Moments::default());
-            crate::parallel::sweeps::store_measuring(run, o, blocks);
+            crate::parallel::sweeps::store_measuring(run, [o, v0], blocks, spin);
             for block in blocks.iter() {
                 sums.fold(block);
             }
         });
-        return finish(sums, positions, residuals, prev_positions, o);
+    } else {
+        let StoreRun {
+            slots,
+            positions,
+            residuals,
+            prev_positions,
+            velocities,
+            masses,
+        } = run;
+        for start in (0..n).step_by(BLOCK) {
+            let r = start..(start + BLOCK).min(n);
+            let block = StoreRun {
+                slots: &mut slots[r.clone()],
+                positions: &mut positions[r.clone()],
+                residuals: &mut residuals[r.clone()],
+                prev_positions: &prev_positions[r.clone()],
+                velocities: &velocities[r.clone()],
+                masses: &masses[r],
+            };
+            let block = if spin {
+                block.store_measuring::<true>([o, v0])
+            } else {
+                block.store_measuring::<false>([o, v0])
+            };
+            sums.fold(&block);
+        }
     }
-    let StoreRun {
-        slots,
+    let (c, theta) = if spin {
+        sums.fit().unwrap_or((Vector3::zeros(), Vector3::zeros()))
+    } else {
+        (Vector3::zeros(), Vector3::zeros())
+    };
+    let scale = crate::stabilisation::correction_energy::velocity_scale(&sums, c, theta, h, budget);
+    if theta == Vector3::zeros() && scale == 1.0 {
+        return false;
+    }
+    // Δᵢ −= θ × rᵢ = rᵢ × θ, with rᵢ = x̄ᵢ − o − c; then the velocity of (1 − s) Δᵢ taken out.
+    let (theta, c) = (theta.cast::<f32>(), c.cast::<f32>());
+    let Particles {
+        positions,
+        prev_positions,
+        residuals,
+        work,
+        ..
+    } = p;
+    let fix = FixUp {
         positions,
         residuals,
         prev_positions,
-        masses,
-    } = run;
-    for start in (0..n).step_by(BLOCK) {
-        let r = start..(start + BLOCK).min(n);
-        let block = StoreRun {
-            slots: &slots[r.clone()],
-            positions: &mut positions[r.clone()],
-            residuals: &mut residuals[r.clone()],
-            prev_positions: &prev_positions[r.clone()],
-            masses: &masses[r],
-        }
-        .store_measuring(o);
-        sums.fold(&block);
-    }
-    finish(sums, positions, residuals, prev_positions, o);
-}
-
-/// Solves for `θ` from the sums and applies `Δᵢ −= θ × rᵢ` to the stored positions.
-fn finish(
-    sums: Moments<f64>,
-    positions: &mut [Vector3<f32>],
-    residuals: &mut [Vector3<f32>],
-    prev_positions: &[Vector3<f32>],
-    o: Vector3<f32>,
-) {
-    let Some((c, theta)) = sums.fit() else {
-        return;
+        before: &work.0,
     };
-    if theta == Vector3::zeros() {
-        return;
-    }
-    // Δᵢ −= θ × rᵢ = rᵢ × θ, with rᵢ = x̄ᵢ − o − c.
-    let (theta, c) = (theta.cast::<f32>(), c.cast::<f32>());
     #[cfg(feature = "parallel")]
-    if crate::parallel::sweeps::particles_worth_it(positions.len()) {
-        crate::parallel::sweeps::rotate_back(positions, residuals, prev_positions, [o, c], theta);
-        return;
+    if parallel {
+        crate::parallel::sweeps::fix_up(fix, [o, c], theta, scale);
+        return scale < 1.0;
     }
-    rotate_back(positions, residuals, prev_positions, [o, c], theta);
+    fix.apply([o, c], theta, scale);
+    scale < 1.0
 }
 
 #[cfg(feature = "parallel")]

@@ -7,6 +7,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::kernels::compensated::add_compensated;
 use crate::kernels::slots::Slot;
+use wide::f32x4;
 
 /// Eigenvalues of the inertia tensor below this fraction of the largest count as zero.
 const INERTIA_CUTOFF: f64 = 1e-9;
@@ -18,20 +19,38 @@ pub(crate) const BLOCK: usize = 256;
 #[derive(Clone, Copy, Default)]
 pub(crate) struct Moments<T: nalgebra::Scalar + Copy> {
     /// Σ m.
-    mass: T,
+    pub(crate) mass: T,
     /// Σ m x̄.
-    first: Vector3<T>,
+    pub(crate) first: Vector3<T>,
     /// Σ m x̄ x̄ᵀ as `[xx, yy, zz, xy, xz, yz]`.
-    second: [T; 6],
+    pub(crate) second: [T; 6],
     /// Σ m x̄ × Δ.
-    torque: Vector3<T>,
+    pub(crate) torque: Vector3<T>,
     /// Σ m Δ.
-    push: Vector3<T>,
+    pub(crate) push: Vector3<T>,
+    /// Σ m v·Δ (`v` the predicted velocity relative to the first particle's).
+    pub(crate) work: T,
+    /// Σ m |Δ|².
+    pub(crate) square: T,
+    /// Σ m x̄ × v.
+    pub(crate) momentum_moment: Vector3<T>,
+    /// Σ m v.
+    pub(crate) momentum: Vector3<T>,
+    /// The largest inverse mass, 1/kg.
+    pub(crate) inv_mass: T,
 }
 
 impl Moments<f32> {
     #[inline(always)]
-    fn add(&mut self, m: f32, x: Vector3<f32>, d: Vector3<f32>) {
+    fn add<const SPIN: bool>(&mut self, m: f32, x: Vector3<f32>, d: Vector3<f32>, v: Vector3<f32>) {
+        let mv = v * m;
+        self.work += mv.dot(&d);
+        self.square += m * d.norm_squared();
+        if !SPIN {
+            return;
+        }
+        self.momentum_moment += x.cross(&mv);
+        self.momentum += mv;
         let mx = x * m;
         self.mass += m;
         self.first += mx;
@@ -56,6 +75,11 @@ impl Moments<f64> {
         }
         self.torque += b.torque.cast::<f64>();
         self.push += b.push.cast::<f64>();
+        self.work += f64::from(b.work);
+        self.square += f64::from(b.square);
+        self.momentum_moment += b.momentum_moment.cast::<f64>();
+        self.momentum += b.momentum.cast::<f64>();
+        self.inv_mass = self.inv_mass.max(f64::from(b.inv_mass));
     }
 
     /// [`rigid_fit`] of the corrections these sums measured: the centre of mass and `θ`.
@@ -106,49 +130,94 @@ pub(crate) fn rigid_fit(
     }
     theta.iter().all(|v| v.is_finite()).then_some((c, theta))
 }
-/// `xᵢ += (x̄ᵢ − o − c) × θ` (compensated) for a run of particles, `[o, c]` the sums'
-/// origin and the centre of mass relative to it.
-pub(crate) fn rotate_back(
-    positions: &mut [Vector3<f32>],
-    residuals: &mut [Vector3<f32>],
-    prev_positions: &[Vector3<f32>],
-    [o, c]: [Vector3<f32>; 2],
-    theta: Vector3<f32>,
-) {
-    for ((x, r), xb) in positions.iter_mut().zip(residuals).zip(prev_positions) {
-        add_compensated(x, r, (xb - o - c).cross(&theta));
+/// The arrays of a run of particles the second pass of [`crate::stabilisation::angular_momentum::store_measured`] corrects.
+pub(crate) struct FixUp<'a> {
+    /// Positions (stored), m.
+    pub positions: &'a mut [Vector3<f32>],
+    /// Rounding residuals (stored), m.
+    pub residuals: &'a mut [Vector3<f32>],
+    /// Substep starts, m.
+    pub prev_positions: &'a [Vector3<f32>],
+    /// The slots, holding the positions and residuals before the families.
+    pub before: &'a [Slot],
+}
+
+impl FixUp<'_> {
+    /// `xᵢ += (x̄ᵢ − o − c) × θ` (compensated), `[o, c]` the sums' origin and the centre of
+    /// mass relative to it; then, with `s < 1`, the residual loses `(1 − s)` of the
+    /// correction `xᵢ + rᵢ − (xᵢ + rᵢ)_before`, so the velocity update sees `s` of it.
+    pub(crate) fn apply(self, [o, c]: [Vector3<f32>; 2], theta: Vector3<f32>, scale: f32) {
+        let FixUp {
+            positions,
+            residuals,
+            prev_positions,
+            before,
+        } = self;
+        let rotate = theta != Vector3::zeros();
+        for (((x, r), xb), b) in positions
+            .iter_mut()
+            .zip(residuals)
+            .zip(prev_positions)
+            .zip(before)
+        {
+            if rotate {
+                add_compensated(x, r, (xb - o - c).cross(&theta));
+            }
+            if scale < 1.0 {
+                let [a, b0, c0, _] = b.xw.to_array();
+                let [ra, rb, rc, _] = b.r.to_array();
+                let d = (*x - Vector3::new(a, b0, c0)) + (*r - Vector3::new(ra, rb, rc));
+                *r -= d * (1.0 - scale);
+            }
+        }
     }
 }
 
 /// The arrays of a run of particles the measuring copy back reads and writes.
 pub(crate) struct StoreRun<'a> {
-    /// The working copy (after the families).
-    pub slots: &'a [Slot],
+    /// The working copy: after the families on entry, the state before them on return.
+    pub slots: &'a mut [Slot],
     /// Positions: before the families on entry, the slots' on return, m.
     pub positions: &'a mut [Vector3<f32>],
     /// Rounding residuals, likewise, m.
     pub residuals: &'a mut [Vector3<f32>],
     /// Substep starts, m.
     pub prev_positions: &'a [Vector3<f32>],
+    /// Velocities predicted for the substep, m/s.
+    pub velocities: &'a [Vector3<f32>],
     /// Lumped masses, kg.
     pub masses: &'a [f32],
 }
 
 impl StoreRun<'_> {
-    /// Copies the slots back and returns the moments of the corrections (one block: f32,
-    /// in particle order), `x̄` taken about `o`.
-    pub(crate) fn store_measuring(self, o: Vector3<f32>) -> Moments<f32> {
+    /// Copies the slots back, leaves the state before the families in them (for the second
+    /// pass of [`crate::stabilisation::angular_momentum::store_measured`]) and returns the moments of the corrections (one block:
+    /// f32, in particle order), `x̄` taken about `o` and `v` relative to `v0`.
+    /// Without `SPIN` only the energy sums (`work`, `square`, `inv_mass`) are taken.
+    pub(crate) fn store_measuring<const SPIN: bool>(
+        self,
+        [o, v0]: [Vector3<f32>; 2],
+    ) -> Moments<f32> {
         let mut m = Moments::<f32>::default();
-        for (i, slot) in self.slots.iter().enumerate() {
-            let [a, b, c, _] = slot.xw.to_array();
+        for (i, slot) in self.slots.iter_mut().enumerate() {
+            let [a, b, c, w] = slot.xw.to_array();
             let [ra, rb, rc, _] = slot.r.to_array();
             let (x, r) = (Vector3::new(a, b, c), Vector3::new(ra, rb, rc));
+            let (x0, r0) = (self.positions[i], self.residuals[i]);
             // The correction as the velocity update will see it: position plus rounding
             // residual (see `systems::add_compensated`); at rest most of it is residual.
-            let d = (x - self.positions[i]) + (r - self.residuals[i]);
-            m.add(self.masses[i], self.prev_positions[i] - o, d);
+            let d = (x - x0) + (r - r0);
+            m.add::<SPIN>(
+                self.masses[i],
+                self.prev_positions[i] - o,
+                d,
+                self.velocities[i] - v0,
+            );
+            m.inv_mass = m.inv_mass.max(w);
             self.positions[i] = x;
             self.residuals[i] = r;
+            slot.xw = f32x4::new([x0.x, x0.y, x0.z, w]);
+            slot.r = f32x4::new([r0.x, r0.y, r0.z, 0.0]);
         }
         m
     }

@@ -1,0 +1,14 @@
+//! Where contacts against rigid bodies are made: the constraints between soft bodies and
+//! rapier colliders, projected every iteration of every substep.
+//!
+//! * [`particle`]: a soft surface particle against a collider (parry point projection).
+//! * [`corner`]: a rigid corner or support point against a soft surface triangle.
+//! * [`support`]: the rigid contacts of a body anchored by an attachment.
+//!
+//! The candidates come from [`crate::gather`] once per frame; friction is
+//! [`crate::response::friction`], restitution and rolling resistance act on whole bodies in
+//! [`crate::response`].
+
+pub(crate) mod corner;
+pub(crate) mod particle;
+pub(crate) mod support;

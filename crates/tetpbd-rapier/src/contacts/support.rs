@@ -1,0 +1,266 @@
+//! Rigid supports of an *anchored* body inside the soft substeps.
+//!
+//! A dynamic body that rapier reports in contact with other rigid colliders is normally
+//! *supported*: infinitely heavy inside the substeps, its summed soft reaction handed to
+//! rapier as a force for its next step (`rigid::body` module docs). That is an explicit coupling
+//! with a frame of lag, stable for contacts, which mostly press a body onto its supports. An
+//! attachment is two-way and bilateral: rapier moves the body by the reaction, the body drags
+//! the attached soft body along, whose reaction moves the body further. The gain of that loop
+//! is the mass ratio soft/rigid, so a light body holding a heavy soft body would diverge
+//! within a few frames.
+//!
+//! A supported body that carries an attachment is therefore *anchored*: it takes part in the
+//! substeps with its generalized inverse mass like a body touched only by soft bodies
+//! (implicit, two-way, the same projections), and rapier's contacts of the body, as they
+//! stood after rapier's step, are kept inside the substeps as unilateral XPBD constraints
+//! against an immovable other side: `C = n·(x − y) − min(0, C₁) ≥ 0` for the body's material
+//! point `x` of each contact point, `y` the other collider's point and `n` the contact normal
+//! towards the body; `C₁` is the value at rapier's end pose, so an overlap rapier left is
+//! neither pushed out nor deepened here. The body is then written back like any body that
+//! took part (pose and velocity), without being pushed into its supports.
+//!
+//! Gauss–Seidel alone would let a heavy soft body sink into a light anchored body: each soft
+//! projection moves mostly the body, the support moves it back, and the soft penetration
+//! stays. So, as in shock propagation, an anchored body is *held* by its supports in a
+//! substep when it stands on them (its clearance, the smallest support constraint value, at
+//! most 1 µm) and the soft positional impulses on it in the previous substep, summed, lie
+//! in their friction cone: pressing it into them (along their mean normal), their
+//! tangential part at most μ times their normal part (μ the smallest coefficient of its
+//! supports). A held body keeps its offset of the previous substep (it follows rapier's
+//! path only) and no soft impulse moves it: the soft side takes the whole correction. Its
+//! supports would take that load (a fixed ground cancels it), so it is not handed to rapier
+//! either: a soft load handed to a light body a frame late is what made it unstable. The
+//! cost: such a load neither tips the body nor weighs on a dynamic support below it.
+//!
+//! A body that is not held moves with its generalized inverse mass under every soft impulse, except
+//! that one pressing it into its supports (more than 60° against their mean normal) does not move
+//! it while it stands on them, and moves it at most down to them otherwise (its clearance, measured
+//! at every iteration and followed by its centre of mass). The soft load is then shared as Newton's
+//! third law has it: a body that an attachment lifts off its supports is pushed back down by the
+//! soft body it lifts, rather than staying immovable against it while the attachment moves it up.
+//! (Never moving the body under a pressing impulse, whatever its pose, would let a light box
+//! holding a heavy soft cube by a compliant attachment do work on the cube each time the spring
+//! lifts it.) The friction cone decides from the load alone, whether the soft side moved: a soft
+//! body pulling an anchored box sideways harder than its supports' friction can hold moves it, and
+//! one pulling it up off them lifts it.
+//!
+//! The reaction of a dynamic support to the body's own motion into it is summed over the
+//! frame and applied to it as an impulse (its velocity at rapier's next step); a fixed or
+//! kinematic support takes none.
+//!
+//! The supports carry static friction (rapier's combined coefficient): the tangential motion
+//! of a contact point over a substep is undone up to μ times the substep's normal impulse.
+//!
+//! Limits: the contact points are those of rapier's manifolds, computed at the start of its
+//! step and read as points of each collider's own frame; for a part of a compound shape that
+//! reading is not checked (the part's pose in the compound is not applied). Only rapier's
+//! active contacts count: a support the body only comes to touch inside the substeps is
+//! not there. The clearance leaves out the body's turn since it was measured, and the
+//! decision to hold a body lags its load by a substep (in a frame's first substep, whose
+//! previous load is not kept, a body standing on its supports is held). The friction cone
+//! is that of the whole body, not of each contact, and ignores the body's weight; the
+//! moment of the load is not looked at (a held body does not tip).
+//!
+//! Guarded by `tests/attachment_to_body_with_contacts.rs`: a soft cube attached to the top
+//! of a light box on the ground stays on it, bounded in speed and energy, with a rigid pin
+//! and with a compliant attachment.
+
+use nalgebra::{Point3, Vector3};
+use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
+use rapier3d::geometry::{ColliderSet, NarrowPhase};
+
+use crate::convert::{pose_to_na, to_glam, to_na};
+use crate::rigid::body::BodyProxy;
+
+/// One contact point of an anchored body with a rigid support.
+#[derive(Clone, Debug)]
+pub(crate) struct Support {
+    /// The anchored body's proxy.
+    pub body: usize,
+    /// The contact point on the body, in the body's frame, m.
+    local: Vector3<f32>,
+    /// The contact point on the support (world, at rapier's end pose), m.
+    point: Vector3<f32>,
+    /// Unit contact normal from the support towards the body (world).
+    pub normal: Vector3<f32>,
+    /// Lowest value the constraint may take, m (≤ 0).
+    floor: f32,
+    /// Friction coefficient of the contact (rapier's combined one).
+    pub friction: f32,
+    /// The support's body when it is dynamic, and its world centre of mass, m.
+    other: Option<(RigidBodyHandle, Vector3<f32>)>,
+    /// Positional impulse on the anchored body in the current substep, kg·m.
+    sub: Vector3<f32>,
+    /// Impulse on the anchored body over the frame, N·s.
+    impulse: Vector3<f32>,
+}
+
+/// Appends the contact points of proxy `b` (an anchored body) with other rigid colliders.
+pub(crate) fn gather_supports(
+    out: &mut Vec<Support>,
+    b: usize,
+    proxy: &BodyProxy,
+    bodies: &RigidBodySet,
+    colliders: &ColliderSet,
+    narrow_phase: &NarrowPhase,
+) {
+    let Some(rb) = bodies.get(proxy.handle) else {
+        return;
+    };
+    let end = proxy.frame_poses().1;
+    for &ch in rb.colliders() {
+        let Some(co) = colliders.get(ch) else {
+            continue;
+        };
+        let in_body = co.position_wrt_parent().map(pose_to_na).unwrap_or_default();
+        for pair in narrow_phase.contact_pairs_with(ch) {
+            if !pair.has_any_active_contact() {
+                continue;
+            }
+            let first = pair.collider1 == ch;
+            let other_handle = if first {
+                pair.collider2
+            } else {
+                pair.collider1
+            };
+            let Some(other) = colliders.get(other_handle) else {
+                continue;
+            };
+            let other_pose = pose_to_na(other.position());
+            let other_body = other
+                .parent()
+                .and_then(|h| bodies.get(h).map(|o| (h, o)))
+                .filter(|(_, o)| o.is_dynamic())
+                .map(|(h, o)| (h, to_na(o.center_of_mass())));
+            for m in pair.manifolds() {
+                if m.data.solver_contacts.is_empty() {
+                    continue;
+                }
+                let n1 = to_na(m.data.normal);
+                let normal = if first { -n1 } else { n1 };
+                for pt in &m.points {
+                    let (ours, theirs) = if first {
+                        (pt.local_p1, pt.local_p2)
+                    } else {
+                        (pt.local_p2, pt.local_p1)
+                    };
+                    let local = in_body * Point3::from(to_na(ours));
+                    let point = other_pose * Point3::from(to_na(theirs));
+                    let c_end = normal.dot(&((end * local) - point));
+                    out.push(Support {
+                        body: b,
+                        local: local.coords,
+                        point: point.coords,
+                        normal,
+                        floor: c_end.min(0.0),
+                        friction: m.data.friction,
+                        other: other_body,
+                        sub: Vector3::zeros(),
+                        impulse: Vector3::zeros(),
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// Measures each anchored body's clearance above its supports at its current pose: the
+/// smallest support constraint value (m; ≤ 0 where it stands on them).
+pub(crate) fn measure_clearance(supports: &[Support], bodies: &mut [BodyProxy]) {
+    for s in supports {
+        bodies[s.body].set_clearance(f32::INFINITY);
+    }
+    for s in supports {
+        let body = &mut bodies[s.body];
+        let x = (body.pose * Point3::from(s.local)).coords;
+        let c = s.normal.dot(&(x - s.point)) - s.floor;
+        if !c.is_nan() {
+            body.lower_clearance(c);
+        }
+    }
+}
+
+/// Starts a substep of the anchored bodies: measures their clearance and decides which are
+/// held on their supports ([`BodyProxy::hold`]).
+pub(crate) fn hold_supported(supports: &[Support], bodies: &mut [BodyProxy]) {
+    measure_clearance(supports, bodies);
+    let mut last = usize::MAX;
+    for s in supports {
+        if s.body != last {
+            bodies[s.body].hold();
+            last = s.body;
+        }
+    }
+}
+
+/// One sweep over the supports: keeps each anchored body's contact points out of its
+/// supports (the support immovable), with static Coulomb friction on the point's motion
+/// over the substep (as the particle contacts, `contacts::particle` module docs).
+pub(crate) fn project_supports(supports: &mut [Support], bodies: &mut [BodyProxy]) {
+    for s in supports {
+        let body = &mut bodies[s.body];
+        let x = (body.pose * Point3::from(s.local)).coords;
+        let c = s.normal.dot(&(x - s.point)) - s.floor;
+        if c.is_nan() || c >= 0.0 {
+            continue;
+        }
+        let w = body.inv_mass_at(&x, &s.normal);
+        if w.is_nan() || w <= 0.0 {
+            continue;
+        }
+        let p = s.normal * (-c / w);
+        body.apply_support_impulse(&p, &x);
+        s.sub += p;
+        // Friction: undo the tangential motion of the point over the substep, up to
+        // μ times the normal impulse of the substep.
+        let x = (body.pose * Point3::from(s.local)).coords;
+        let moved = x - (body.prev * Point3::from(s.local)).coords;
+        let slide = moved - s.normal * s.normal.dot(&moved);
+        let len = slide.norm();
+        if len.is_nan() || len <= 1e-9 {
+            continue;
+        }
+        let t = slide / len;
+        let w = body.inv_mass_at(&x, &t);
+        if w.is_nan() || w <= 0.0 {
+            continue;
+        }
+        let normal = s.normal.dot(&s.sub);
+        let tangential = (s.sub - s.normal * normal).norm();
+        let room = (s.friction * normal - tangential).max(0.0);
+        let dl = (len / w).min(room);
+        if dl > 0.0 {
+            let p = -t * dl;
+            body.apply_support_impulse(&p, &x);
+            s.sub += p;
+        }
+    }
+}
+
+/// Ends a substep of `h` seconds: the substep's positional impulses become impulses.
+pub(crate) fn end_substep_supports(supports: &mut [Support], h: f32) {
+    for s in supports {
+        s.impulse += s.sub / h;
+        s.sub = Vector3::zeros();
+    }
+}
+
+/// The dynamic support of `s` and the impulse (N·s) and angular impulse about its centre of
+/// mass (N·m·s) it takes over the frame (the reaction of the anchored body's push).
+pub(crate) fn support_reaction(
+    s: &Support,
+) -> Option<(RigidBodyHandle, Vector3<f32>, Vector3<f32>)> {
+    let (h, com) = s.other?;
+    let j = -s.impulse;
+    (j != Vector3::zeros()).then(|| (h, j, (s.point - com).cross(&j)))
+}
+
+/// Applies a support's reaction to its rapier body; `false` when it is not finite.
+pub(crate) fn apply_reaction(body: &mut RigidBody, j: &Vector3<f32>, l: &Vector3<f32>) -> bool {
+    if !(j.iter().chain(l.iter()).all(|c| c.is_finite())) {
+        return false;
+    }
+    body.apply_impulse(to_glam(j), true);
+    body.apply_torque_impulse(to_glam(l), true);
+    true
+}

@@ -1,0 +1,82 @@
+//! An anchored body against its supports (`contacts::support` module docs): when it
+//! stands on them, whether a push presses it into them, and when they hold it.
+
+use nalgebra::Vector3;
+
+use super::{BodyKind, BodyProxy, TOUCH};
+
+impl BodyProxy {
+    /// Makes a supported body *anchored* (`contacts::support` module docs): it takes part with its
+    /// generalized inverse mass, except while its supports hold it ([`Self::hold`]) and
+    /// against impulses pressing it into supports it stands on; `normal` is their mean
+    /// contact normal (towards the body), `friction` their smallest friction coefficient.
+    /// It is written back every frame, which also keeps rapier from putting it to sleep:
+    /// left at rapier's result in a frame where the soft body only pressed it into its
+    /// supports, a light box holding a heavy soft body diverges within seconds.
+    pub fn anchor(&mut self, normal: Vector3<f32>, friction: f32) {
+        if self.kind == BodyKind::Supported {
+            self.friction = friction;
+            self.kind = BodyKind::Dynamic;
+            self.touched = true;
+            self.support_normal = normal.try_normalize(1e-6).unwrap_or_default();
+        }
+    }
+
+    /// Records an anchored body's clearance `gap` (m) above its supports at its current pose.
+    pub fn set_clearance(&mut self, gap: f32) {
+        self.clearance = (gap, self.com());
+    }
+
+    /// Lowers the recorded clearance to `gap` (m) if it is smaller.
+    pub fn lower_clearance(&mut self, gap: f32) {
+        self.clearance.0 = self.clearance.0.min(gap);
+    }
+
+    /// The anchored body's clearance above its supports now, m: the last measured one plus
+    /// the motion of its centre of mass along their mean normal since (its turn is left out).
+    pub(super) fn clearance(&self) -> f32 {
+        let (gap, com) = self.clearance;
+        gap + self.support_normal.dot(&(self.com() - com))
+    }
+
+    /// `true` for an anchored body.
+    pub(super) fn is_anchored(&self) -> bool {
+        self.kind == BodyKind::Dynamic && self.support_normal != Vector3::zeros()
+    }
+
+    /// Whether an impulse along `push` presses an anchored body into its supports (more
+    /// than 60° against their mean normal).
+    pub(super) fn presses(&self, push: &Vector3<f32>) -> bool {
+        self.support_normal.dot(push) < -0.5 * push.norm()
+    }
+
+    /// Whether a soft impulse along `push` moves the body: not on an anchored body that is
+    /// held, nor when it presses an anchored body that stands on its supports.
+    pub(super) fn moves(&self, push: &Vector3<f32>) -> bool {
+        !self.is_anchored() || !(self.held || (self.presses(push) && self.clearance() <= TOUCH))
+    }
+
+    /// Starts a substep of an anchored body, its clearance measured at its new pose: it is
+    /// *held* when it stands on its supports and the soft impulses of the previous substep,
+    /// summed, lie in their friction cone (pressing it into them, their tangential part at
+    /// most μ times their normal part). A held body keeps its offset from the previous
+    /// substep (it moves along rapier's path only) and soft impulses do not move it.
+    pub fn hold(&mut self) {
+        let n = self.support_normal;
+        let load = self.soft_load.1;
+        let press = -n.dot(&load);
+        self.held = self.is_anchored()
+            && self.clearance() <= TOUCH
+            && press >= 0.0
+            && (load + n * press).norm() <= self.friction * press;
+        if self.held {
+            self.dx = self.dx_sub;
+            self.dq = self.dq_sub;
+            self.dv = Vector3::zeros();
+            self.dw = Vector3::zeros();
+            let frac = self.frac;
+            self.set_pose(frac);
+            self.record_substep_start();
+        }
+    }
+}

@@ -1,0 +1,474 @@
+//! Rigid bodies inside the soft substeps: one proxy per body a soft body touches.
+//!
+//! rapier has already advanced every body from its start pose `P₀` (velocity `v₀`) to its
+//! end pose `P₁` (velocity `v₁`) when the soft substeps run. Inside substep `k`, at
+//! `t = (k+1)·h`, a body stands at its *base* pose composed with an *offset* that the soft
+//! contacts and attachments build up: a centre-of-mass translation `dx` and a rotation `dq`,
+//! each moving on with its own velocity (`dv`, `dω`), as XPBD integrates a rigid body (Müller
+//! et al. 2020). Fixed and kinematic bodies never get an offset (infinite mass).
+//!
+//! The base of a kinematic body is the linear interpolation `P₀ → P₁`. The base of a
+//! dynamic body spreads rapier's velocity change `a·dt = v₁ − v₀` (gravity, rigid contacts,
+//! joints) evenly over the substeps, integrated like the soft particles (symplectic Euler):
+//! in the substep ending at `t` its velocity is `v₀ + a·t` and `c(t) = c₀ + v₀t + ½a·t(t + h)`;
+//! the rotation is interpolated. A heavy body resting on a soft one is then pushed by its
+//! weight a little every substep instead of hitting the soft body with a frame's worth of
+//! gravity at once, and the soft impulse balances exactly `m·g·dt` per frame at rest. The end
+//! position differs from rapier's `c₀ + v₁dt` by `½a·dt(dt − h)`; only bodies a soft body
+//! actually touched are written back.
+//!
+//! A dynamic body in contact with other rigid colliders is *supported*: infinitely heavy
+//! inside the substeps, its summed soft reaction handed to rapier as a force for its next
+//! step. One that also carries an attachment is *anchored* (`contacts::support` module docs): it
+//! takes part with its mass, except while its supports hold it against the soft load and
+//! against impulses pressing it into supports it stands on.
+
+use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
+
+mod anchored;
+
+use crate::convert::{inertia_to_na, pose_to_glam, to_glam, to_na};
+
+/// A body's pose (m, rad) and linear velocity (m/s) before rapier's step.
+pub(crate) type StartState = (Isometry3<f32>, Vector3<f32>);
+
+/// Clearance (m) up to which an anchored body stands on its supports.
+const TOUCH: f32 = 1e-6;
+
+/// How a body takes part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum BodyKind {
+    Fixed,
+    Kinematic,
+    /// Dynamic, touched only by soft bodies, or *anchored* (supported and carrying an
+    /// attachment, its rigid contacts kept as constraints: `contacts::support` module docs): takes
+    /// part with its generalized inverse mass.
+    Dynamic,
+    /// Dynamic and in contact with other rigid colliders: infinitely heavy inside the soft
+    /// substeps; the soft reaction is summed as an impulse and handed to rapier.
+    Supported,
+}
+
+/// One rigid body during the soft substeps of a frame.
+#[derive(Clone, Debug)]
+pub(crate) struct BodyProxy {
+    pub handle: RigidBodyHandle,
+    pub kind: BodyKind,
+    com_local: Vector3<f32>,
+    com_start: Vector3<f32>,
+    com_end: Vector3<f32>,
+    rot_start: UnitQuaternion<f32>,
+    rot_end: UnitQuaternion<f32>,
+    v_start: Vector3<f32>,
+    w_base: Vector3<f32>,
+    v_end: Vector3<f32>,
+    w_end: Vector3<f32>,
+    dt: f32,
+    h: f32,
+    inv_mass: Vector3<f32>,
+    inv_inertia: Matrix3<f32>,
+    dx: Vector3<f32>,
+    dq: UnitQuaternion<f32>,
+    dv: Vector3<f32>,
+    dw: Vector3<f32>,
+    dx_sub: Vector3<f32>,
+    dq_sub: UnitQuaternion<f32>,
+    frac: f32,
+    /// Pose at the end of the current substep (after corrections so far).
+    pub pose: Isometry3<f32>,
+    /// Pose at the end of the previous substep.
+    pub prev: Isometry3<f32>,
+    /// Whether a soft correction moved the body this frame.
+    pub touched: bool,
+    /// How far the body moves along its path in the current substep: the shift of its
+    /// origin (m) and its turn (rad), from `prev` to `pose` before soft corrections.
+    pub substep_motion: (f32, f32),
+    sub_impulse: Vector3<f32>,
+    sub_angular: Vector3<f32>,
+    impulse: Vector3<f32>,
+    angular: Vector3<f32>,
+    /// Mean contact normal of an anchored body's rigid supports (unit, towards the body;
+    /// zero for any other body): the soft load they hold and impulses pressing the body
+    /// into them are left to them (`contacts::support` module docs).
+    support_normal: Vector3<f32>,
+    /// An anchored body's clearance above its supports (m, the smallest support constraint value,
+    /// `contacts::support` module docs) when it was last measured, and its centre of mass then.
+    clearance: (f32, Vector3<f32>),
+    /// The soft positional impulses on an anchored body (kg·m), moving it or not, summed
+    /// over the current and over the previous substep.
+    soft_load: (Vector3<f32>, Vector3<f32>),
+    /// The smallest friction coefficient of an anchored body's supports.
+    friction: f32,
+    /// Whether an anchored body is held on its supports in this substep ([`Self::hold`]).
+    held: bool,
+    /// Linear and angular velocity at the start of the current substep (before any soft
+    /// correction), and the centre of mass they refer to.
+    pre: (Vector3<f32>, Vector3<f32>, Vector3<f32>),
+}
+
+impl BodyKind {
+    /// How `body` takes part; `supported`: rapier reports it in contact with other rigid
+    /// colliders.
+    fn of(body: &RigidBody, supported: bool) -> BodyKind {
+        if body.is_dynamic() && supported {
+            BodyKind::Supported
+        } else if body.is_dynamic() {
+            BodyKind::Dynamic
+        } else if body.is_kinematic() {
+            BodyKind::Kinematic
+        } else {
+            BodyKind::Fixed
+        }
+    }
+}
+
+/// Effective inverse mass (per axis, 1/kg) and world inverse inertia (1/(kg·m²)) of a
+/// dynamic body; zero for the others.
+fn inverse_mass(body: &RigidBody) -> (Vector3<f32>, Matrix3<f32>) {
+    if body.is_dynamic() {
+        let mp = body.mass_properties();
+        (
+            to_na(mp.effective_inv_mass),
+            inertia_to_na(&mp.effective_world_inv_inertia),
+        )
+    } else {
+        (Vector3::zeros(), Matrix3::zeros())
+    }
+}
+
+impl BodyProxy {
+    /// A proxy of `body`, whose pose before rapier's step was `start` (m, rad).
+    pub fn new(
+        handle: RigidBodyHandle,
+        body: &RigidBody,
+        (start, v_start): (Isometry3<f32>, Vector3<f32>),
+        dt: f32,
+        supported: bool,
+    ) -> Self {
+        let kind = BodyKind::of(body, supported);
+        let end = crate::convert::pose_to_na(body.position());
+        let start = if kind == BodyKind::Fixed { end } else { start };
+        let com_local = to_na(body.local_center_of_mass());
+        let com_start = start * nalgebra::Point3::from(com_local);
+        let com_end = end * nalgebra::Point3::from(com_local);
+        let v_end = to_na(body.linvel());
+        let (v_start, v_end_base, w_base) = match kind {
+            BodyKind::Fixed => (Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
+            BodyKind::Kinematic => {
+                let v = (com_end.coords - com_start.coords) / dt;
+                (
+                    v,
+                    v,
+                    (end.rotation * start.rotation.inverse()).scaled_axis() / dt,
+                )
+            }
+            BodyKind::Dynamic | BodyKind::Supported => (
+                v_start,
+                v_end,
+                (end.rotation * start.rotation.inverse()).scaled_axis() / dt,
+            ),
+        };
+        let (inv_mass, inv_inertia) = inverse_mass(body);
+        BodyProxy {
+            handle,
+            kind,
+            com_local,
+            com_start: com_start.coords,
+            com_end: com_end.coords,
+            rot_start: start.rotation,
+            rot_end: end.rotation,
+            v_start,
+            w_base,
+            v_end: v_end_base,
+            dt,
+            h: dt,
+            w_end: to_na(body.angvel()),
+            inv_mass,
+            inv_inertia,
+            dx: Vector3::zeros(),
+            dq: UnitQuaternion::identity(),
+            dv: Vector3::zeros(),
+            dw: Vector3::zeros(),
+            dx_sub: Vector3::zeros(),
+            dq_sub: UnitQuaternion::identity(),
+            frac: 0.0,
+            pose: start,
+            prev: start,
+            touched: false,
+            substep_motion: (0.0, 0.0),
+            sub_impulse: Vector3::zeros(),
+            sub_angular: Vector3::zeros(),
+            impulse: Vector3::zeros(),
+            angular: Vector3::zeros(),
+            support_normal: Vector3::zeros(),
+            clearance: (0.0, Vector3::zeros()),
+            soft_load: (Vector3::zeros(), Vector3::zeros()),
+            friction: 0.0,
+            held: false,
+            pre: (Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
+        }
+    }
+
+    /// [`Self::inv_mass_at`] for a constraint that pushes the body along `push`: 0 when the
+    /// push does not move it.
+    pub fn inv_mass_pushed(&self, q: &Vector3<f32>, push: &Vector3<f32>) -> f32 {
+        if !self.moves(push) {
+            return 0.0;
+        }
+        self.inv_mass_at(q, &push.try_normalize(1e-12).unwrap_or_default())
+    }
+
+    /// `true` for a dynamic body (finite mass in rapier).
+    pub fn is_dynamic(&self) -> bool {
+        matches!(self.kind, BodyKind::Dynamic | BodyKind::Supported)
+    }
+
+    /// Moves to the end of the next substep; `frac` is its end time as a fraction of the frame.
+    pub fn begin_substep(&mut self, frac: f32, h: f32) {
+        self.h = h;
+        self.prev = self.pose;
+        self.soft_load = (Vector3::zeros(), self.soft_load.0);
+        self.held = false;
+        if self.kind == BodyKind::Dynamic {
+            self.dx_sub = self.dx;
+            self.dq_sub = self.dq;
+            self.dx += self.dv * h;
+            self.dq = UnitQuaternion::from_scaled_axis(self.dw * h) * self.dq;
+        }
+        self.set_pose(frac);
+        self.record_substep_start();
+    }
+
+    /// Records how far the body moves in the current substep and its velocity at the start.
+    fn record_substep_start(&mut self) {
+        self.substep_motion = if self.kind == BodyKind::Fixed {
+            (0.0, 0.0)
+        } else {
+            (
+                (self.pose.translation.vector - self.prev.translation.vector).norm(),
+                self.pose.rotation.angle_to(&self.prev.rotation),
+            )
+        };
+        if self.kind != BodyKind::Fixed {
+            self.pre = (
+                self.v_start.lerp(&self.v_end, self.frac) + self.dv,
+                self.w_base + self.dw,
+                self.com(),
+            );
+        }
+    }
+
+    /// Velocity of the material point at `q` at the start of the current substep, before
+    /// any soft correction of the substep, m/s.
+    pub fn velocity_at_pre(&self, q: &Vector3<f32>) -> Vector3<f32> {
+        let (v, w, com) = self.pre;
+        v + w.cross(&(q - com))
+    }
+
+    fn set_pose(&mut self, frac: f32) {
+        if self.kind == BodyKind::Fixed {
+            self.pose = Isometry3::from_parts(
+                Translation3::from(self.com_end - self.rot_end * self.com_local),
+                self.rot_end,
+            );
+            return;
+        }
+        self.frac = frac;
+        let t = frac * self.dt;
+        let com = self.com_start
+            + self.v_start * t
+            + (self.v_end - self.v_start) * (0.5 * t * (t + self.h) / self.dt)
+            + self.dx;
+        let rot = self.dq * self.rot_start.nlerp(&self.rot_end, frac);
+        self.pose = Isometry3::from_parts(Translation3::from(com - rot * self.com_local), rot);
+    }
+
+    /// Poses before and after rapier's step (no soft offsets).
+    pub fn frame_poses(&self) -> (Isometry3<f32>, Isometry3<f32>) {
+        let at = |com: Vector3<f32>, rot: UnitQuaternion<f32>| {
+            Isometry3::from_parts(Translation3::from(com - rot * self.com_local), rot)
+        };
+        (
+            at(self.com_start, self.rot_start),
+            at(self.com_end, self.rot_end),
+        )
+    }
+
+    /// Current world centre of mass, m.
+    pub fn com(&self) -> Vector3<f32> {
+        self.pose.translation.vector + self.pose.rotation * self.com_local
+    }
+
+    /// Generalized inverse mass `nᵀM⁻¹n + (r×n)ᵀ I⁻¹ (r×n)` for a unit direction `n` at the
+    /// world point `q`, 1/kg; 0 for fixed and kinematic bodies.
+    pub fn inv_mass_at(&self, q: &Vector3<f32>, n: &Vector3<f32>) -> f32 {
+        if self.kind != BodyKind::Dynamic {
+            return 0.0;
+        }
+        let rn = (q - self.com()).cross(n);
+        n.dot(&self.inv_mass.component_mul(n)) + rn.dot(&(self.inv_inertia * rn))
+    }
+
+    /// Generalized inverse mass `aᵀ I⁻¹ a` of a rotation about the unit axis `a` (world),
+    /// 1/(kg·m²); 0 for fixed and kinematic bodies.
+    pub fn inv_inertia_along(&self, a: &Vector3<f32>) -> f32 {
+        if self.kind != BodyKind::Dynamic {
+            return 0.0;
+        }
+        a.dot(&(self.inv_inertia * a))
+    }
+
+    /// Turns the body by the angular positional impulse `l` (kg·m²·rad: axis × Δλ) of a
+    /// joint (`joints` module docs); fixed and kinematic bodies do not move.
+    pub fn apply_angular_impulse(&mut self, l: &Vector3<f32>) {
+        if self.kind != BodyKind::Dynamic {
+            return;
+        }
+        let dtheta = self.inv_inertia * l;
+        let dq = Quaternion::from_parts(0.0, dtheta) * self.dq.into_inner() * 0.5;
+        self.dq = UnitQuaternion::new_normalize(self.dq.into_inner() + dq);
+        self.touched = true;
+        let frac = self.frac;
+        self.set_pose(frac);
+    }
+
+    /// Applies a soft positional impulse `p` (kg·m: direction × Δλ) at the world point `q`.
+    /// An anchored body ignores it when it does not move the body ([`Self::moves`]), and
+    /// one pressing it into its supports moves it at most down to them.
+    pub fn apply_position_impulse(&mut self, p: &Vector3<f32>, q: &Vector3<f32>) {
+        if self.is_anchored() {
+            self.soft_load.0 += p;
+            if !self.moves(p) {
+                return;
+            }
+            let sink = -self.support_normal.dot(&self.inv_mass.component_mul(p));
+            let room = self.clearance();
+            if self.presses(p) && sink > room {
+                self.apply_support_impulse(&(p * (room / sink)), q);
+                return;
+            }
+        }
+        self.apply_support_impulse(p, q);
+    }
+
+    /// Applies a positional impulse `p` (kg·m) of an anchored body's support (or a soft one
+    /// that moves the body) at the world point `q`.
+    pub fn apply_support_impulse(&mut self, p: &Vector3<f32>, q: &Vector3<f32>) {
+        if self.kind == BodyKind::Supported {
+            self.sub_impulse += p;
+            self.sub_angular += (q - self.com()).cross(p);
+            self.touched = true;
+            return;
+        }
+        if self.kind != BodyKind::Dynamic {
+            return;
+        }
+        let dtheta = self.inv_inertia * (q - self.com()).cross(p);
+        self.dx += self.inv_mass.component_mul(p);
+        let dq = Quaternion::from_parts(0.0, dtheta) * self.dq.into_inner() * 0.5;
+        self.dq = UnitQuaternion::new_normalize(self.dq.into_inner() + dq);
+        self.touched = true;
+        let frac = self.frac;
+        self.set_pose(frac);
+    }
+
+    /// Ends a substep: the offset velocities follow from the offset motion.
+    pub fn end_substep(&mut self, h: f32) {
+        if self.kind == BodyKind::Supported {
+            self.impulse += self.sub_impulse / h;
+            self.angular += self.sub_angular / h;
+            self.sub_impulse = Vector3::zeros();
+            self.sub_angular = Vector3::zeros();
+        }
+        if self.kind != BodyKind::Dynamic {
+            return;
+        }
+        self.h = h;
+        self.dv = (self.dx - self.dx_sub) / h;
+        self.dw = (self.dq * self.dq_sub.inverse()).scaled_axis() / h;
+    }
+
+    /// Velocity of the body's material point at the world point `q`, m/s.
+    pub fn velocity_at(&self, q: &Vector3<f32>) -> Vector3<f32> {
+        match self.kind {
+            BodyKind::Fixed => Vector3::zeros(),
+            _ => {
+                let w = self.w_base + self.dw;
+                let v_base = self.v_start.lerp(&self.v_end, self.frac);
+                v_base + self.dv + w.cross(&(q - self.com()))
+            }
+        }
+    }
+
+    /// Applies a velocity impulse `j` (N·s) at the world point `q` (an anchored body ignores
+    /// one that does not move it, [`Self::moves`]).
+    pub fn apply_velocity_impulse(&mut self, j: &Vector3<f32>, q: &Vector3<f32>) {
+        if !self.moves(j) {
+            return;
+        }
+        if self.kind == BodyKind::Supported {
+            self.impulse += j;
+            self.angular += (q - self.com()).cross(j);
+            self.touched = true;
+            return;
+        }
+        if self.kind != BodyKind::Dynamic {
+            return;
+        }
+        self.dv += self.inv_mass.component_mul(j);
+        self.dw += self.inv_inertia * (q - self.com()).cross(j);
+        self.touched = true;
+    }
+
+    /// Force (N) and torque about the centre of mass (N·m) that carry the summed soft
+    /// impulse on a supported body through rapier's next step (the impulse of this frame
+    /// spread over `dt`); `None` for any other body or when there is none.
+    pub fn load(&self) -> Option<(Vector3<f32>, Vector3<f32>)> {
+        (self.kind == BodyKind::Supported
+            && self.touched
+            && (self.impulse != Vector3::zeros() || self.angular != Vector3::zeros()))
+        .then(|| (self.impulse / self.dt, self.angular / self.dt))
+    }
+
+    /// Writes the result back to rapier: for a body that took part with its mass its final
+    /// pose and velocity (`v₁` plus the offset's); the [`Self::load`] of a supported body
+    /// as a force and torque added for rapier's next step (the caller takes
+    /// them off again after that step). A force, not a velocity change: rapier's solver
+    /// applies it in its substeps together with the rigid contacts, as it does gravity, where
+    /// a velocity change of the same impulse is an impact (a 100 kg soft body resting on a
+    /// 0.125 kg box hands it about 100 m/s per frame, which rapier's contacts do not cancel
+    /// cleanly). Returns `false` (and writes nothing) when the result is not finite.
+    pub fn write_back(&self, body: &mut RigidBody) -> bool {
+        if !self.touched {
+            return true;
+        }
+        let finite = |x: &Vector3<f32>| x.iter().all(|c| c.is_finite());
+        let load = self.load();
+        if load.is_some_and(|(f, t)| !(finite(&f) && finite(&t))) {
+            return false;
+        }
+        match self.kind {
+            BodyKind::Dynamic => {
+                let (v, w, p) = (self.v_end + self.dv, self.w_end + self.dw, self.pose);
+                if !(finite(&v)
+                    && finite(&w)
+                    && finite(&p.translation.vector)
+                    && p.rotation.coords.iter().all(|c| c.is_finite()))
+                {
+                    return false;
+                }
+                body.set_position(pose_to_glam(&p), true);
+                body.set_linvel(to_glam(&v), true);
+                body.set_angvel(to_glam(&w), true);
+            }
+            BodyKind::Supported => {}
+            BodyKind::Fixed | BodyKind::Kinematic => return true,
+        }
+        if let Some((force, torque)) = load {
+            body.add_force(to_glam(&force), true);
+            body.add_torque(to_glam(&torque), true);
+        }
+        true
+    }
+}

@@ -1,0 +1,92 @@
+//! Settings of the coupling between soft bodies and rapier colliders.
+
+use crate::error::CouplingError;
+use crate::soft_collider::SoftCollider;
+#[cfg(doc)]
+use crate::Coupling;
+
+/// Settings of a [`Coupling`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct CouplingSettings {
+    /// Extra distance around soft bodies and colliders when candidates are gathered once per
+    /// frame, m (0 to [`CouplingSettings::MAX_MARGIN`]). Contacts closer than the margin plus
+    /// each body's motion over the frame are evaluated in every substep.
+    pub margin: f32,
+    /// Collision properties of soft bodies without a [`SoftCollider`] component.
+    pub default_collider: SoftCollider,
+    /// Largest speed at which an overlap of a soft body with a collider is pushed out, m/s
+    /// (> 0, at most [`CouplingSettings::MAX_DEPENETRATION_SPEED`]): a contact that starts
+    /// deeper than one substep's push at that speed (a body created inside a collider, a
+    /// surface given back to a body that sank, a teleport), in any frame. Such an overlap is
+    /// resolved over several substeps and frames instead of in one substep, and the body
+    /// does not keep the speed of the push (`depenetration` module docs), so separation does
+    /// not turn into an explosion or a hop. Impacts and ongoing contacts are resolved fully.
+    /// A rigid body created inside a soft one is not covered.
+    pub max_depenetration_speed: f32,
+    /// Mass ratio from which a dynamic rigid body resting on a soft body counts as heavy
+    /// (≥ 0; `f32::INFINITY` turns the pass off). A soft body on an immovable support
+    /// (fixed or kinematic collider, supported rigid body, pinned particles) that carries a
+    /// dynamic body whose generalized mass at a contact is at least this many times the
+    /// mass of the particle (or the mean of the triangle's particles) it touches gets the
+    /// *stacking pass* after the ordinary projections of every iteration: its constraints
+    /// once more from the ground up with the supported particles held, then the heavy body's
+    /// contacts with the soft surface frozen (shock propagation, `heavy_loads` module docs).
+    /// Without it, one iteration per substep lets a 1000 kg box crush a 1 kg slab.
+    pub stacking_mass_ratio: f32,
+    /// Whether every soft body on an immovable support gets the ground-up sweep of the
+    /// stacking pass under its own weight too, not only under a heavy rigid load (default
+    /// `false`). One Gauss–Seidel iteration per substep leaves a resting body sagging by a
+    /// volume error that falls only as `h²`; the sweep carries the support's reaction to the
+    /// top within the substep and cuts that error several times, at up to about twice the
+    /// cost per frame (figures in `docs/performance.md`).
+    /// Only the sweep runs; the frozen-surface contact pass and
+    /// velocity pass stay reserved for heavy loads. The sweep is one-way (the support acts
+    /// as infinitely heavy), so leave it off for bodies that are not meant to rest.
+    pub self_weight_stacking: bool,
+}
+
+impl Default for CouplingSettings {
+    fn default() -> Self {
+        CouplingSettings {
+            margin: 0.02,
+            default_collider: SoftCollider::default(),
+            max_depenetration_speed: 2.0,
+            stacking_mass_ratio: 10.0,
+            self_weight_stacking: false,
+        }
+    }
+}
+
+impl CouplingSettings {
+    /// Largest [`CouplingSettings::margin`] accepted, m. The margin only widens the candidate
+    /// search; beyond a metre it gathers colliders no contact can reach within a frame.
+    pub const MAX_MARGIN: f32 = 1.0;
+
+    /// Largest [`CouplingSettings::max_depenetration_speed`] accepted, m/s.
+    pub const MAX_DEPENETRATION_SPEED: f32 = 100.0;
+
+    /// Checks every field.
+    pub fn validate(&self) -> Result<(), CouplingError> {
+        if !(self.margin.is_finite() && (0.0..=Self::MAX_MARGIN).contains(&self.margin)) {
+            return Err(CouplingError::BadSetting {
+                name: "margin (m, 0 to CouplingSettings::MAX_MARGIN)",
+                value: self.margin,
+            });
+        }
+        if !(self.max_depenetration_speed > 0.0
+            && self.max_depenetration_speed <= Self::MAX_DEPENETRATION_SPEED)
+        {
+            return Err(CouplingError::BadSetting {
+                name: "max depenetration speed (m/s, > 0, at most MAX_DEPENETRATION_SPEED)",
+                value: self.max_depenetration_speed,
+            });
+        }
+        if self.stacking_mass_ratio.is_nan() || self.stacking_mass_ratio < 0.0 {
+            return Err(CouplingError::BadSetting {
+                name: "stacking mass ratio",
+                value: self.stacking_mass_ratio,
+            });
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,325 @@
+//! The [`tetpbd::SubstepHook`] that runs the coupling inside the soft solver's substeps.
+
+use hecs::World;
+use rapier3d::dynamics::{ImpulseJointSet, MultibodyJointSet};
+use rapier3d::geometry::NarrowPhase;
+use rapier3d::pipeline::QueryPipeline;
+use tetpbd::{Particles, SubstepHook, Surface};
+
+use crate::attachments::{anchor_of, project_attachments, Attachments};
+use crate::contacts::corner::{project_corners, CornerPass};
+use crate::contacts::particle::{finish_substep, project_contacts, velocity_pass};
+use crate::contacts::support::{
+    end_substep_supports, hold_supported, measure_clearance, project_supports,
+};
+use crate::depenetration::{cap_depenetration, settle_substeps};
+use crate::gather::{Frame, GatherInput};
+use crate::heavy_loads::{stacked_velocity_pass, stacking_pass, Stacking};
+use crate::impact::Impact;
+use crate::joints::project_joints;
+use crate::report::{ContactReport, SoftFeature};
+use crate::response::deformation_damping::{damp, DeformationDamping};
+use crate::response::restitution::{com_velocity, end_episodes, restitution_pass};
+use crate::response::rolling::rolling_pass;
+use crate::rigid::shape_query::surface_point;
+use crate::soft_collider::SoftCollider;
+
+/// Borrows the frame state and rapier's query pipeline for one soft step.
+pub(crate) struct CouplingHook<'q, 'a> {
+    pub frame: &'q mut Frame,
+    pub qp: QueryPipeline<'a>,
+    pub narrow_phase: &'a NarrowPhase,
+    pub impulse_joints: &'a ImpulseJointSet,
+    pub multibody_joints: &'a MultibodyJointSet,
+    pub default_collider: SoftCollider,
+    pub margin: f32,
+    pub max_depenetration_speed: f32,
+    /// `CouplingSettings::stacking_mass_ratio`.
+    pub stacking_mass_ratio: f32,
+    /// `CouplingSettings::self_weight_stacking`.
+    pub self_weight_stacking: bool,
+    /// The solver's family order (the stacking pass projects in it).
+    pub order: [tetpbd::Family; 3],
+    /// The solver's projection kernel (the stacking pass's sweep runs with it).
+    pub kernel: tetpbd::systems::Kernel,
+    pub reports: &'q mut Vec<ContactReport>,
+}
+
+impl CouplingHook<'_, '_> {
+    fn frac(&self) -> f32 {
+        (self.frame.substep as f32 / self.frame.substeps.max(1) as f32).min(1.0)
+    }
+}
+
+impl SubstepHook for CouplingHook<'_, '_> {
+    fn begin_frame(&mut self, world: &mut World, _dt: f32) {
+        let input = GatherInput {
+            qp: &self.qp,
+            narrow_phase: self.narrow_phase,
+            impulse_joints: self.impulse_joints,
+            multibody_joints: self.multibody_joints,
+            default_collider: &self.default_collider,
+            margin: self.margin,
+        };
+        self.frame.gather(world, &input);
+    }
+
+    fn begin_substep(&mut self, world: &mut World, h: f32) {
+        self.frame.substep += 1;
+        for s in &mut self.frame.soft {
+            s.stacked = false;
+            if let Ok(p) = world.query_one_mut::<&Particles>(s.entity) {
+                s.v_cm_pre = com_velocity(p).0;
+            }
+        }
+        let frac = self.frac();
+        for b in &mut self.frame.bodies {
+            b.begin_substep(frac, h);
+        }
+        hold_supported(&self.frame.supports, &mut self.frame.bodies);
+        for a in &mut self.frame.attachments {
+            a.lambda = 0.0;
+        }
+    }
+
+    fn project(&mut self, world: &mut World, h: f32) {
+        let frac = self.frac();
+        let Frame {
+            soft,
+            bodies,
+            colliders,
+            contacts,
+            corners,
+            attachments,
+            supports,
+            stats,
+            layers,
+            pinned,
+            joints,
+            ..
+        } = &mut *self.frame;
+        if layers.len() < soft.len() {
+            layers.resize_with(soft.len(), Default::default);
+        }
+        measure_clearance(supports, bodies);
+        for (s, cache) in soft.iter_mut().zip(layers.iter_mut()) {
+            let Ok((p, surface)) = world.query_one_mut::<(&mut Particles, &Surface)>(s.entity)
+            else {
+                continue;
+            };
+            let mut impact = Impact::new(s.reach);
+            project_corners(
+                &mut corners[s.corners.clone()],
+                &contacts[s.contacts.clone()],
+                p,
+                surface,
+                bodies,
+                colliders,
+                self.qp.colliders,
+                CornerPass::Crossing,
+                &mut impact,
+            );
+            stats.degenerate_contacts += project_contacts(
+                &mut contacts[s.contacts.clone()],
+                p,
+                bodies,
+                colliders,
+                self.qp.colliders,
+                self.max_depenetration_speed * h,
+                &mut impact,
+            );
+            project_corners(
+                &mut corners[s.corners.clone()],
+                &contacts[s.contacts.clone()],
+                p,
+                surface,
+                bodies,
+                colliders,
+                self.qp.colliders,
+                CornerPass::Ordinary,
+                &mut impact,
+            );
+            project_attachments(&mut attachments[s.attachments.clone()], p, bodies, frac, h);
+            let mut stacking = Stacking {
+                bodies,
+                colliders,
+                set: self.qp.colliders,
+                layers: cache,
+                pinned,
+                order: self.order,
+                kernel: self.kernel,
+                ratio: self.stacking_mass_ratio,
+                self_weight: self.self_weight_stacking,
+                h,
+                max_push: self.max_depenetration_speed * h,
+            };
+            let t = std::time::Instant::now();
+            if let Some(heavy) = stacking_pass(
+                world,
+                s.entity,
+                &mut contacts[s.contacts.clone()],
+                &mut corners[s.corners.clone()],
+                &mut stacking,
+            ) {
+                stats.stacking_passes += 1;
+                s.stacked |= heavy;
+            }
+            stats.stacking_time += t.elapsed();
+        }
+        project_supports(supports, bodies);
+        project_joints(joints, bodies);
+    }
+
+    fn end_substep(&mut self, world: &mut World, h: f32) {
+        let threshold = 2.0 * self.frame.gravity * h;
+        let Frame {
+            soft,
+            bodies,
+            colliders,
+            contacts,
+            corners,
+            episodes,
+            active_colliders,
+            supports,
+            stats,
+            depenetrating,
+            ..
+        } = &mut *self.frame;
+        for b in bodies.iter_mut() {
+            b.end_substep(h);
+        }
+        end_substep_supports(supports, h);
+        for s in soft.iter() {
+            let Ok((p, surface, damping, sc)) = world.query_one_mut::<(
+                &mut Particles,
+                &Surface,
+                Option<&DeformationDamping>,
+                Option<&SoftCollider>,
+            )>(s.entity) else {
+                continue;
+            };
+            let rolling = sc.unwrap_or(&self.default_collider).rolling_resistance();
+            if let Some(d) = damping {
+                damp(p, d.rate(), h);
+            }
+            let range = s.contacts.clone();
+            if s.stacked {
+                let t = std::time::Instant::now();
+                stacked_velocity_pass(
+                    &contacts[range.clone()],
+                    &corners[s.corners.clone()],
+                    p,
+                    surface,
+                    bodies,
+                    colliders,
+                );
+                stats.stacking_time += t.elapsed();
+            }
+            velocity_pass(&mut contacts[range.clone()], p, bodies, colliders);
+            restitution_pass(
+                episodes,
+                active_colliders,
+                s.entity,
+                &mut contacts[range.clone()],
+                &mut corners[s.corners.clone()],
+                p,
+                &s.v_cm_pre,
+                bodies,
+                colliders,
+                threshold,
+            );
+            rolling_pass(
+                active_colliders,
+                &contacts[range.clone()],
+                &corners[s.corners.clone()],
+                p,
+                bodies,
+                colliders,
+                rolling,
+                h,
+            );
+            cap_depenetration(
+                depenetrating,
+                s.entity,
+                &contacts[range.clone()],
+                p,
+                &s.v_cm_pre,
+                settle_substeps(h),
+            );
+            finish_substep(&mut contacts[range], h, self.max_depenetration_speed * h);
+        }
+        end_episodes(episodes);
+        for k in corners.iter_mut() {
+            k.active = false;
+            k.impulse += k.sub_impulse / h;
+            k.sub_impulse = nalgebra::Vector3::zeros();
+            k.lambda_n = 0.0;
+            k.lambda_t = 0.0;
+        }
+    }
+
+    fn end_frame(&mut self, world: &mut World, _dt: f32) {
+        self.frame.remember_touching();
+        let frame = &mut *self.frame;
+        self.reports.clear();
+        let mut max_pen = 0.0f32;
+        let mut max_att = 0.0f32;
+        for s in &frame.soft {
+            let Ok((p, att)) =
+                world.query_one_mut::<(&Particles, Option<&mut Attachments>)>(s.entity)
+            else {
+                continue;
+            };
+            for c in &frame.contacts[s.contacts.clone()] {
+                let cp = &frame.colliders[c.collider];
+                if let Some(shape) = self.qp.colliders.get(cp.handle).map(|co| co.shape()) {
+                    let pose = cp.pose(&frame.bodies);
+                    let x = p.positions()[c.particle as usize];
+                    let fb = c.has_normal.then_some(c.normal);
+                    if let Some(sp) = surface_point(shape, cp.rule, &pose, &x, fb, fb) {
+                        if c.solve {
+                            max_pen = max_pen.max(-sp.distance);
+                        }
+                    }
+                }
+                if c.ever_active {
+                    self.reports.push(ContactReport {
+                        collider: cp.handle,
+                        entity: s.entity,
+                        feature: SoftFeature::Particle(c.particle),
+                        point: c.point,
+                        normal: c.normal,
+                        depth: c.depth,
+                        impulse: c.impulse,
+                        solved: c.solve,
+                    });
+                }
+            }
+            for k in &frame.corners[s.corners.clone()] {
+                if k.ever_active {
+                    self.reports.push(ContactReport {
+                        collider: frame.colliders[k.collider].handle,
+                        entity: s.entity,
+                        feature: SoftFeature::Triangle(k.triangle),
+                        point: k.point,
+                        normal: k.normal,
+                        depth: k.depth,
+                        impulse: k.impulse,
+                        solved: true,
+                    });
+                }
+            }
+            for a in &frame.attachments[s.attachments.clone()] {
+                let anchor = anchor_of(a, &frame.bodies, 1.0);
+                let x = p.positions()[a.particle as usize];
+                max_att = max_att.max((x - anchor).norm());
+            }
+            if let Some(att) = att {
+                att.roll_targets();
+            }
+        }
+        frame.stats.max_penetration = max_pen.max(0.0);
+        frame.stats.max_attachment_error = max_att;
+        frame.stats.contacts = self.reports.len();
+    }
+}

@@ -1,0 +1,71 @@
+//! Shared helpers of the coupling's robustness tests (bad state, trimesh windings,
+//! projectiles, loads and joints).
+#![allow(dead_code)]
+
+use hecs::Entity;
+use nalgebra::Vector3;
+use rapier3d::math::Vector;
+use rapier3d::prelude::{ColliderBuilder, ColliderHandle, RigidBodyBuilder, RigidBodyHandle};
+use tetpbd::generators::{self, CellSplit};
+use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
+use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider};
+
+/// A scene at 60 Hz with default solver and coupling settings.
+pub fn scene() -> CoupledWorld {
+    CoupledWorld::new(SolverSettings::default(), CouplingSettings::default()).expect("settings")
+}
+
+/// A scene at 60 Hz with `substeps` soft substeps, other settings default.
+pub fn scene_substeps(substeps: u32) -> CoupledWorld {
+    let solver = SolverSettings {
+        substeps,
+        ..SolverSettings::default()
+    };
+    CoupledWorld::new(solver, CouplingSettings::default()).expect("settings")
+}
+
+/// A fixed ground cuboid whose top face is at y = 0.
+pub fn ground(scene: &mut CoupledWorld) -> (RigidBodyHandle, ColliderHandle) {
+    scene.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
+        ColliderBuilder::cuboid(5.0, 0.5, 5.0),
+    )
+}
+
+/// A soft box of `size` (m) with `cells` cells per axis centred at `at`, hard edges and
+/// volume, `density` kg/m³, moving at `velocity` m/s, with the default collider.
+pub fn soft_box(
+    scene: &mut CoupledWorld,
+    size: Vector3<f32>,
+    cells: [u32; 3],
+    at: Vector3<f32>,
+    velocity: Vector3<f32>,
+    density: f32,
+) -> Entity {
+    let mesh = generators::box_grid(size, cells, CellSplit::Six).expect("mesh");
+    let e = SoftBodyBuilder::new(mesh)
+        .density(density)
+        .edges(0.0)
+        .volume(0.0)
+        .translation(at)
+        .velocity(velocity)
+        .build()
+        .expect("body")
+        .spawn(&mut scene.soft);
+    scene
+        .soft
+        .insert_one(e, SoftCollider::default())
+        .expect("entity");
+    e
+}
+
+/// Particles of a soft body (cloned).
+pub fn particles(scene: &CoupledWorld, e: Entity) -> Particles {
+    (*scene.soft.get::<&Particles>(e).expect("soft body")).clone()
+}
+
+/// Centre of mass (m) and its velocity (m/s) of a soft body.
+pub fn com(scene: &CoupledWorld, e: Entity) -> (Vector3<f32>, Vector3<f32>) {
+    let p = scene.soft.get::<&Particles>(e).expect("soft body");
+    (p.center_of_mass(), p.linear_momentum() / p.total_mass())
+}
