@@ -246,6 +246,15 @@ impl Coupling {
         &mut self.solver
     }
 
+    /// Sets (or clears) the rayon pool running the soft solver's parallel passes (feature
+    /// `parallel`; [`Solver::set_thread_pool`]): pass the `Arc` given to rapier's
+    /// `PhysicsPipeline::set_thread_pool` to run both on the same threads. Without a pool the
+    /// passes run in the caller's rayon context; [`tetpbd::ParallelSettings`] makes them serial.
+    #[cfg(feature = "parallel")]
+    pub fn set_thread_pool(&mut self, pool: Option<std::sync::Arc<tetpbd::rayon::ThreadPool>>) {
+        self.solver.set_thread_pool(pool);
+    }
+
     /// The coupling settings.
     pub fn settings(&self) -> &CouplingSettings {
         &self.settings

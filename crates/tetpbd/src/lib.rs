@@ -25,7 +25,7 @@
 //!
 //! `unsafe` is confined to `kernels/` (bounds checked once per run of a colour class, AVX2
 //! chosen at run time) and `parallel/` (disjoint writes of one region's threads, the step's
-//! helper threads, the helper's CPU mask), each use with its `SAFETY` argument.
+//! helper threads and the helper's CPU mask, both only when the integrator opts in), each use with its `SAFETY` argument.
 //!
 //! ```
 //! use nalgebra::Vector3;
@@ -63,7 +63,7 @@ pub use error::{BuildError, SettingsError, StateError, StepError};
 pub use ordering::ColourClasses;
 pub use solver::hook::{FrameContext, SubstepContext, SubstepHook};
 pub use solver::non_finite::Restored;
-pub use solver::settings::SolverSettings;
+pub use solver::settings::{ParallelSettings, SolverSettings};
 pub use solver::stats::{ErrorAccumulator, ErrorStats, FamilyStats, StepStats};
 pub use solver::step::Solver;
 pub use solver::systems;
@@ -79,3 +79,6 @@ pub use parallel::sync_stats;
 
 pub use hecs;
 pub use nalgebra;
+/// The rayon version the solver's pools are of ([`Solver::set_thread_pool`]).
+#[cfg(feature = "parallel")]
+pub use rayon;

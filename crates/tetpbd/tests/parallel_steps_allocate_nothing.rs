@@ -11,7 +11,9 @@ mod common;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use tetpbd::{Particles, Solver, SolverSettings};
+use std::sync::Arc;
+
+use tetpbd::{ParallelSettings, Particles, Solver, SolverSettings};
 
 /// Counts the allocations of all threads.
 struct Counting;
@@ -41,19 +43,17 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-#[test]
-fn parallel_steps_after_the_first_allocate_nothing() {
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
-    std::hint::black_box(vec![1u8; 16]);
-    assert!(
-        ALLOCATIONS.load(Ordering::SeqCst) > before,
-        "the counter counts"
+/// Allocations in 10 steps (after a first one) of a large hanging cube and a partitioned
+/// one, with `parallel`, on a pool of two threads: run inside it, or given to the solver
+/// and stepped from this thread (where rayon's queue that hands each pass to the pool
+/// allocates a block now and then).
+fn allocations_in_steps(parallel: ParallelSettings, given: bool) -> u64 {
+    let pool = Arc::new(
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap(),
     );
-
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
     let mut world = hecs::World::new();
     // 16³ cells: 4913 particles and 24 576 tetrahedra, above every parallel threshold; a
     // second copy cut into 4 slabs (the partitioned sweep's tasks).
@@ -62,20 +62,45 @@ fn parallel_steps_after_the_first_allocate_nothing() {
     let mut solver = Solver::new(SolverSettings {
         substeps: 4,
         max_correction_speed: Some(10.0),
+        parallel,
         ..Default::default()
     })
     .unwrap();
-    let counted = pool.install(|| {
+    if given {
+        solver.set_thread_pool(Some(pool.clone()));
+    }
+    let mut steps = || {
         solver.step(&mut world).unwrap();
         let before = ALLOCATIONS.load(Ordering::SeqCst);
         for _ in 0..10 {
             solver.step(&mut world).unwrap();
         }
         ALLOCATIONS.load(Ordering::SeqCst) - before
-    });
+    };
+    let counted = if given { steps() } else { pool.install(steps) };
     for e in [body, parted] {
         let p = world.get::<&Particles>(e).unwrap();
         assert!(p.max_speed() > 0.01, "the body moves");
     }
-    assert_eq!(counted, 0, "allocations in 10 parallel steps");
+    counted
+}
+
+/// Stepped on one of the pool's threads, with the helpers sleeping between passes (the
+/// default) or kept awake.
+#[test]
+fn parallel_steps_after_the_first_allocate_nothing() {
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    std::hint::black_box(vec![1u8; 16]);
+    assert!(
+        ALLOCATIONS.load(Ordering::SeqCst) > before,
+        "the counter counts"
+    );
+    let awake = ParallelSettings {
+        keep_helpers_awake: true,
+        ..Default::default()
+    };
+    for parallel in [ParallelSettings::default(), awake] {
+        let counted = allocations_in_steps(parallel, false);
+        assert_eq!(counted, 0, "allocations in 10 parallel steps, {parallel:?}");
+    }
 }

@@ -1,11 +1,13 @@
-//! With the `parallel` feature, results are bit-identical for any number of threads.
+//! With the `parallel` feature, results are bit-identical for any number of threads, with
+//! every [`ParallelSettings`] option, and on the caller's pool or one given to the solver.
 #![cfg(feature = "parallel")]
 
 mod common;
 
+use std::sync::Arc;
 use std::time::Duration;
 
-use tetpbd::{Particles, Solver, SolverSettings, SubstepContext, SubstepHook};
+use tetpbd::{ParallelSettings, Particles, Solver, SolverSettings, SubstepContext, SubstepHook};
 
 /// A hook slower than the time the step's helper threads wait for work (they leave, and the
 /// passes after it wake the pool through rayon instead).
@@ -42,25 +44,102 @@ fn run_parts(
     slow: bool,
 ) -> Vec<[u32; 3]> {
     on_threads(threads, || {
-        let mut world = hecs::World::new();
-        let e = common::hanging_cube_parts(&mut world, cells, parts);
-        let mut solver = Solver::new(SolverSettings {
+        hanging_cube_bits(
+            None,
+            ParallelSettings::default(),
+            cells,
+            parts,
             substeps,
-            max_correction_speed: Some(5.0),
-            ..Default::default()
-        })
-        .unwrap();
-        for _ in 0..frames {
-            if slow {
-                solver.step_with(&mut world, &mut Slow).unwrap();
-            } else {
-                solver.step(&mut world).unwrap();
+            frames,
+            slow,
+        )
+    })
+}
+
+/// Steps a hanging cube on this thread, on `pool` if given, with `parallel`; its state as
+/// bits.
+fn hanging_cube_bits(
+    pool: Option<Arc<rayon::ThreadPool>>,
+    parallel: ParallelSettings,
+    cells: u32,
+    parts: usize,
+    substeps: u32,
+    frames: usize,
+    slow: bool,
+) -> Vec<[u32; 3]> {
+    let mut world = hecs::World::new();
+    let e = common::hanging_cube_parts(&mut world, cells, parts);
+    let mut solver = Solver::new(SolverSettings {
+        substeps,
+        max_correction_speed: Some(5.0),
+        parallel,
+        ..Default::default()
+    })
+    .unwrap()
+    .with_thread_pool(pool);
+    for _ in 0..frames {
+        if slow {
+            solver.step_with(&mut world, &mut Slow).unwrap();
+        } else {
+            solver.step(&mut world).unwrap();
+        }
+    }
+    let p = world.get::<&Particles>(e).unwrap();
+    assert!(p.max_speed() > 0.01, "the body moves");
+    common::state_bits(&p)
+}
+
+/// Every combination of the parallel options.
+fn all_options() -> Vec<ParallelSettings> {
+    let mut all = Vec::new();
+    for serial in [false, true] {
+        for keep_helpers_awake in [false, true] {
+            for move_helpers_off_step_core in [false, true] {
+                all.push(ParallelSettings {
+                    serial,
+                    keep_helpers_awake,
+                    move_helpers_off_step_core,
+                });
             }
         }
-        let p = world.get::<&Particles>(e).unwrap();
-        assert!(p.max_speed() > 0.01, "the body moves");
-        common::state_bits(&p)
-    })
+    }
+    all
+}
+
+/// 16³ cells (every parallel pass, the particle passes included), with and without a hook
+/// slower than the helpers' linger: every option, on 2 and 3 threads, run inside the pool
+/// (`install`) and from a thread outside it with the pool given to the solver, agrees bit
+/// for bit with one thread.
+#[test]
+fn every_option_and_a_given_pool_agree_bit_for_bit() {
+    let (cells, substeps, frames) = (16, 2, 2);
+    for slow in [false, true] {
+        let one = run_parts(1, cells, 0, substeps, frames, slow);
+        for threads in [2, 3] {
+            let pool = Arc::new(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap(),
+            );
+            for options in all_options() {
+                let what = format!("{threads} threads, {options:?}, slow hook {slow}");
+                let inside = pool
+                    .install(|| hanging_cube_bits(None, options, cells, 0, substeps, frames, slow));
+                assert_eq!(one, inside, "installed, {what}");
+                let given = hanging_cube_bits(
+                    Some(pool.clone()),
+                    options,
+                    cells,
+                    0,
+                    substeps,
+                    frames,
+                    slow,
+                );
+                assert_eq!(one, given, "given, {what}");
+            }
+        }
+    }
 }
 
 /// 12³ cells × 6 = 10 368 tetrahedra: above the parallel threshold of every family (the

@@ -2,8 +2,15 @@
 //! 1/60 s frame), for edges + volume and for vertex–face, on 1 and 2 threads.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown --per-frame --no-energy-limit]
+//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown --per-frame --no-energy-limit --keep-helpers-awake --move-helpers-off --given-pool]
 //! ```
+//!
+//! `--keep-helpers-awake` and `--move-helpers-off` turn on
+//! [`tetpbd::ParallelSettings::keep_helpers_awake`] and
+//! [`tetpbd::ParallelSettings::move_helpers_off_step_core`] (both off by default).
+//! Each body is stepped on its pool's thread (`ThreadPool::install`); with `--given-pool`
+//! the pool is given to the solver ([`tetpbd::Solver::set_thread_pool`]) and the body is
+//! stepped from the main thread instead.
 //!
 //! With `--features parallel` the 1-thread and the 2-thread runs are *interleaved*: two
 //! copies of the body, one stepped on a pool of one thread and one on a pool of two, frame
@@ -48,6 +55,8 @@
 //! over the measured frames (the first two frames of each body are warm-up) and ns per
 //! tetrahedron per substep (1 thread).
 
+#[cfg(feature = "parallel")]
+use std::sync::Arc;
 use std::time::Instant;
 
 use nalgebra::Vector3;
@@ -106,6 +115,11 @@ fn body(
     built.spawn(&mut world);
     let solver = Solver::new(SolverSettings {
         substeps: 10,
+        parallel: tetpbd::ParallelSettings {
+            keep_helpers_awake: flag("--keep-helpers-awake"),
+            move_helpers_off_step_core: flag("--move-helpers-off"),
+            ..Default::default()
+        },
         limit_correction_energy: !flag("--no-energy-limit"),
         ..Default::default()
     })?;
@@ -210,7 +224,7 @@ fn cpu_seconds() -> (f64, f64) {
 
 /// Runs `f` on `pool` (on this thread without one).
 #[cfg(feature = "parallel")]
-fn on<T: Send>(pool: &Option<rayon::ThreadPool>, f: impl FnOnce() -> T + Send) -> T {
+fn on<T: Send>(pool: &Option<Arc<rayon::ThreadPool>>, f: impl FnOnce() -> T + Send) -> T {
     match pool {
         Some(pool) => pool.install(f),
         None => f(),
@@ -227,10 +241,22 @@ fn measure(
 ) -> Result<(), String> {
     #[cfg(feature = "parallel")]
     {
-        let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().ok();
+        let pool = |n| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .ok()
+                .map(Arc::new)
+        };
         let (p1, p2) = (pool(1), pool(2));
-        let frame = |b: &mut Body, p: &Option<rayon::ThreadPool>, warm: bool| {
-            on(p, || b.frame(warm).map_err(|e| e.to_string()))
+        let given = flag("--given-pool");
+        let frame = |b: &mut Body, p: &Option<Arc<rayon::ThreadPool>>, warm: bool| {
+            if given {
+                b.solver.set_thread_pool(p.clone());
+                b.frame(warm).map_err(|e| e.to_string())
+            } else {
+                on(p, || b.frame(warm).map_err(|e| e.to_string()))
+            }
         };
         match two {
             Some(two) if !sequential => {
@@ -280,6 +306,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "1- and 2-thread frames interleaved"
     };
     println!("hanging cube ({numbering} numbering), top face pinned, 10 substeps × 1 iteration per 1/60 s frame; median of {frames} frames after {WARM_UP} warm-up ({mode}); parts {parts} (0 = builder's choice)");
+    if parallel {
+        println!(
+            "keep helpers awake: {}, move helpers off the step's core: {}, pool {}",
+            flag("--keep-helpers-awake"),
+            flag("--move-helpers-off"),
+            if flag("--given-pool") {
+                "given to the solver, stepped from the main thread"
+            } else {
+                "installed (stepped on a pool thread)"
+            }
+        );
+    }
     println!("set           spatial order      tets  particles   1 thread ms/frame  ns/tet/substep   2 threads ms/frame  speed-up (quartiles)");
     for cells in [6u32, 12, 26, 55]
         .into_iter()

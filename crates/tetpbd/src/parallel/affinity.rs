@@ -1,4 +1,6 @@
-//! Keeping a team's helper off the core of the thread it helps (feature `parallel`, Linux).
+//! Keeping a team's helper off the core of the thread it helps (feature `parallel`, Linux),
+//! only when the integrator asks for it ([`crate::ParallelSettings::move_helpers_off_step_core`],
+//! off by default: a library does not move its host's threads unasked).
 //!
 //! Why: the helper of [`crate::parallel::team`] is a rayon thread woken by the step's thread, and the
 //! kernel often wakes it on the waker's core. Two threads spinning on one core share it, and

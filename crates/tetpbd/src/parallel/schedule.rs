@@ -7,7 +7,9 @@
 //! of work or less (a partitioned body has 3 phases per family, see [`crate::ordering::partition`]).
 //! Between two parallel iterators rayon's idle thread goes to sleep and has to be woken, which
 //! can cost tens of microseconds each time. Here every thread of the pool enters once per sweep and
-//! waits at a phase boundary by spinning on a counter.
+//! waits at a phase boundary on a counter (spinning, then yielding, then sleeping:
+//! [`crate::parallel::backoff`]); between sweeps the threads sleep as rayon's do, unless the
+//! integrator keeps them awake for the step ([`crate::parallel::team`]).
 //!
 //! **Layout.** Each phase is cut into `R` contiguous *regions*, one per thread (`R` = the
 //! pool's threads, at most [`MAX_REGIONS`]), at multiples of [`LANES`] items, and each region
@@ -165,7 +167,8 @@ fn wait_for(counter: &AtomicUsize, target: usize) {
     crate::parallel::sync_stats::phase(since);
 }
 
-/// Runs `phases` phases in order on every thread of the current rayon pool: phase `k` has
+/// Runs `phases` phases in order on every thread of the step's pool
+/// ([`crate::parallel::context`]; the step's team if it has one): phase `k` has
 /// `phase(k) = (len, split)` items, and `work(k, items)` does the `items` of phase `k`
 /// (indices within the phase): in chunks of `chunk` items (rounded up to a multiple of
 /// [`LANES`]) for [`Split::Lanes`], one item at a time for [`Split::Units`], all at once for
@@ -181,7 +184,7 @@ pub(crate) fn run_phases<C: Default + AddAssign + Send>(
     phase: impl Fn(usize) -> (usize, Split) + Sync,
     work: impl Fn(usize, Range<usize>) -> C + Sync,
 ) -> C {
-    let threads = rayon::current_num_threads();
+    let threads = crate::parallel::context::threads();
     let regions_n = threads.clamp(1, MAX_REGIONS);
     let chunk = chunk.max(1).next_multiple_of(LANES);
     let regions: [Region; MAX_REGIONS] = Default::default();
@@ -226,7 +229,8 @@ pub(crate) fn run_phases<C: Default + AddAssign + Send>(
         }
     };
     if !crate::parallel::team::post(&worker) {
-        fan_out(threads, &worker);
+        let worker = &worker;
+        crate::parallel::context::in_pool(|| fan_out(threads, worker));
     }
     total.into_inner().unwrap_or_default()
 }

@@ -9,7 +9,8 @@
 //! of particles: each particle's update is independent, so they are bit-identical too. The
 //! spin removal's copy back ([`crate::stabilisation::angular_momentum`]) sums per block of particles, one block per
 //! unit, and the blocks are folded in order on one thread: bit-identical as well.
-//! Inside [`crate::Solver::step`] every region is posted to the step's team
+//! Every region enters the step's pool ([`crate::parallel::context`]) through rayon, or, when
+//! the integrator keeps the helpers awake, is posted to the step's team
 //! ([`crate::parallel::team`]) instead of waking the pool's threads.
 
 use std::ops::Range;
@@ -38,7 +39,7 @@ const MIN_PARALLEL_PARTICLES: usize = 4096;
 /// more than one thread (on one thread the serial sweep does the same work without the
 /// region's claims and waits; the results are bit-identical either way).
 pub(crate) fn worth_it(len: usize) -> bool {
-    len >= MIN_PARALLEL && rayon::current_num_threads() > 1
+    len >= MIN_PARALLEL && crate::parallel::context::threads() > 1
 }
 
 /// Whether some body of `world` takes a parallel path (so a step is worth a team).
@@ -54,7 +55,7 @@ pub(crate) fn any_parallel(world: &mut hecs::World) -> bool {
 
 /// Whether a pass over `len` particles runs on the pool.
 pub(crate) fn particles_worth_it(len: usize) -> bool {
-    len >= MIN_PARALLEL_PARTICLES && rayon::current_num_threads() > 1
+    len >= MIN_PARALLEL_PARTICLES && crate::parallel::context::threads() > 1
 }
 
 /// [`crate::systems::predict`] of one body, in runs of particles.

@@ -1,22 +1,25 @@
-//! The pool's other threads kept awake for one solver step (feature `parallel`).
+//! The pool's other threads kept awake for one solver step (feature `parallel`), when the
+//! integrator opts in ([`crate::ParallelSettings::keep_helpers_awake`]; off by default).
 //!
 //! Why: a parallel region entered through rayon (`join`, a parallel iterator) has to wake
 //! the other threads, which go to sleep a few microseconds after they run out of work. A
 //! wake-up can cost tens of microseconds, while a substep of a 100k-tetrahedron
 //! body has six parallel passes (prediction, the copies in and out, two families, the
-//! velocity update) of 30–700 µs each.
+//! velocity update) of 30–700 µs each. The price: while a step runs, the helpers hold the
+//! pool's cores even between passes, which a host running other work on them would feel.
 //!
 //! [`with_team`] runs the step on this thread while the pool's other threads wait in a loop
 //! for work ([`post`]): each parallel pass is posted as a job that every helper runs beside
 //! this thread, then closed. A helper spins, and yields the core now and then, between jobs;
 //! after [`LINGER`] without a job (a long hook, e.g. a rigid-body step) it leaves, and the
-//! following passes enter through rayon as before. So a helper never waits on anything but a
-//! job to come or its own job's chunks, and no cycle of waits can form (two steps run on the
-//! same pool each leave the other's helper loop within [`LINGER`]).
+//! following passes enter through rayon as by default. So a helper never waits on anything
+//! but a job to come or its own job's chunks, and no cycle of waits can form (two steps run
+//! on the same pool each leave the other's helper loop within [`LINGER`]).
 //!
-//! A helper that finds itself on the core of the step's thread (the kernel often wakes it
-//! there) moves to another core for as long as it stays in the team ([`crate::parallel::affinity`]):
-//! two threads spinning on one core run no faster than one.
+//! With [`crate::ParallelSettings::move_helpers_off_step_core`] also on, a helper that
+//! finds itself on the core of the step's thread (the kernel often wakes it there) moves to
+//! another core for as long as it stays in the team ([`crate::parallel::affinity`]): two
+//! threads spinning on one core run no faster than one.
 //!
 //! Posting: the job (a closure on this thread's stack) is published with an odd epoch, and
 //! a helper registers in `active` before re-checking the epoch; closing makes the epoch even
@@ -51,6 +54,8 @@ struct Team {
     quit: AtomicBool,
     /// The core the step's thread ran on at its last post (`usize::MAX`: not known).
     step_cpu: AtomicUsize,
+    /// Whether helpers move off the step thread's core (the integrator's choice).
+    move_off: bool,
 }
 
 // SAFETY: `job` is written by the team's own thread only between jobs (epoch even, `active`
@@ -63,11 +68,12 @@ thread_local! {
     static CURRENT: Cell<*const Team> = const { Cell::new(std::ptr::null()) };
 }
 
-/// Runs `f` with the pool's other threads waiting for jobs from [`post`]. Outside a rayon
-/// pool, or on a pool of one thread, just runs `f`.
-pub(crate) fn with_team<T>(f: impl FnOnce() -> T) -> T {
-    let helpers = rayon::current_num_threads().saturating_sub(1);
-    if helpers == 0 || rayon::current_thread_index().is_none() {
+/// Runs `f` on this thread with the step pool's other threads waiting for jobs from
+/// [`post`] (moving off this thread's core if `move_off`). On a pool of one thread, or from
+/// a thread that is not one of the pool's, just runs `f`.
+pub(crate) fn with_team<T>(move_off: bool, f: impl FnOnce() -> T) -> T {
+    let helpers = crate::parallel::context::threads().saturating_sub(1);
+    if helpers == 0 || !crate::parallel::context::on_pool_thread() {
         return f();
     }
     let team = Team {
@@ -76,7 +82,12 @@ pub(crate) fn with_team<T>(f: impl FnOnce() -> T) -> T {
         active: AtomicUsize::new(0),
         helpers: AtomicUsize::new(0),
         quit: AtomicBool::new(false),
-        step_cpu: AtomicUsize::new(current_cpu().unwrap_or(usize::MAX)),
+        step_cpu: AtomicUsize::new(if move_off {
+            current_cpu().unwrap_or(usize::MAX)
+        } else {
+            usize::MAX
+        }),
+        move_off,
     };
     let mut step = OnThisThread(Some(f), None);
     let step_ref = &mut step;
@@ -91,9 +102,10 @@ pub(crate) fn with_team<T>(f: impl FnOnce() -> T) -> T {
 /// The step and its result, moved into the first closure of `rayon::join`.
 struct OnThisThread<F, T>(Option<F>, Option<T>);
 
-// SAFETY: called from a worker thread of the pool (checked in `with_team`), `rayon::join`
-// runs its first closure on the calling thread ("It will begin by executing closure A (on
-// the current thread)", rayon's docs), so neither the step nor its result changes thread.
+// SAFETY: `with_team` moves it into `rayon::join` only from a worker thread of the step's
+// pool (`on_pool_thread`), and there `rayon::join` runs its first closure on the calling
+// thread ("It will begin by executing closure A (on the current thread)", rayon's docs), so
+// neither the step nor its result changes thread.
 unsafe impl<F, T> Send for OnThisThread<F, T> {}
 
 impl<F: FnOnce() -> T, T> OnThisThread<F, T> {
@@ -148,7 +160,9 @@ fn help(team: &Team) {
     let mut idle = Instant::now();
     let mut spins = 0u32;
     let mut moved = Moved::default();
-    move_off_step(team, &mut moved);
+    if team.move_off {
+        move_off_step(team, &mut moved);
+    }
     loop {
         let e = team.epoch.load(Ordering::SeqCst);
         if e % 2 == 1 && e != seen {
@@ -165,7 +179,9 @@ fn help(team: &Team) {
             team.active.fetch_sub(1, Ordering::SeqCst);
             seen = e;
             idle = Instant::now();
-            move_off_step(team, &mut moved);
+            if team.move_off {
+                move_off_step(team, &mut moved);
+            }
             continue;
         }
         if team.quit.load(Ordering::SeqCst) {
@@ -176,7 +192,9 @@ fn help(team: &Team) {
             if idle.elapsed() > LINGER {
                 break;
             }
-            move_off_step(team, &mut moved);
+            if team.move_off {
+                move_off_step(team, &mut moved);
+            }
             std::thread::yield_now();
         } else {
             std::hint::spin_loop();
@@ -210,8 +228,10 @@ pub(crate) fn post(worker: &(dyn Fn() + Sync)) -> bool {
     if team.helpers.load(Ordering::SeqCst) == 0 {
         return false;
     }
-    if let Some(cpu) = current_cpu() {
-        team.step_cpu.store(cpu, Ordering::Relaxed);
+    if team.move_off {
+        if let Some(cpu) = current_cpu() {
+            team.step_cpu.store(cpu, Ordering::Relaxed);
+        }
     }
     // SAFETY: only the lifetime is erased; the job is closed and every helper that may use
     // it has left it (`active` drained) before this function returns or unwinds (`Close`).

@@ -71,6 +71,49 @@ pub struct SolverSettings {
     pub measure_error: bool,
     /// Also evaluate every constraint before the step ([`crate::FamilyStats::before`]).
     pub measure_before: bool,
+    /// How the parallel passes use threads (feature `parallel`; ignored without it). The
+    /// pool they run on is not a setting but a handle: [`Solver::set_thread_pool`](crate::Solver).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub parallel: ParallelSettings,
+}
+
+/// How a step uses threads (feature `parallel`; without it every step is serial and these
+/// are ignored). Results are bit-identical for every combination and any number of threads.
+///
+/// Where a step runs: on the pool given to
+/// [`Solver::set_thread_pool`](crate::Solver), or else in the caller's rayon context (the
+/// pool whose thread calls the step, or rayon's global pool from any other thread). The
+/// solver never builds, resizes or configures the global pool.
+///
+/// By default a parallel pass enters the pool through plain rayon (`join`) and the pool's
+/// threads go back to sleep between passes, as rayon's do; nothing touches a thread's CPU
+/// mask. The two `*_helpers_*` options trade that politeness for speed on machines the
+/// simulation has to itself.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+pub struct ParallelSettings {
+    /// Run every pass on the stepping thread, whatever the pool (default `false`). Turn on
+    /// when the host's threads are busy with other work of the same frame, or to rule
+    /// threads out while debugging.
+    pub serial: bool,
+    /// Keep the pool's other threads waiting for work, spinning and yielding, from one
+    /// parallel pass to the next for the whole step, instead of letting them sleep between
+    /// passes (default `false`). A helper still leaves after 0.5 ms without a pass (e.g. a
+    /// long hook), so the spinning is bounded, but while a step runs it holds every core of
+    /// the pool. Worth turning on for large bodies (≳ 50k tetrahedra) when the simulation
+    /// has the pool's cores to itself: it saves the wake-up of the sleeping threads at each
+    /// of the dozens of passes of a frame. Takes effect only when the step runs on one of
+    /// the pool's threads (called inside `pool.install(..)`); a step called from another
+    /// thread hands each pass to the pool as by default.
+    pub keep_helpers_awake: bool,
+    /// Linux only, and only with [`ParallelSettings::keep_helpers_awake`]: a helper that finds
+    /// itself on the stepping thread's core narrows its own CPU mask to the other cores it
+    /// may use, and restores its mask when it stops helping (default `false`). The kernel
+    /// often wakes a helper on its waker's core, where two spinning threads run no faster
+    /// than one. Changes the CPU mask of the pool's threads for the duration of a step:
+    /// turn on only for a pool the simulation owns, on a machine it has to itself.
+    pub move_helpers_off_step_core: bool,
 }
 
 impl Default for SolverSettings {
@@ -88,6 +131,7 @@ impl Default for SolverSettings {
             kernel: systems::Kernel::Simd,
             measure_error: false,
             measure_before: false,
+            parallel: ParallelSettings::default(),
         }
     }
 }

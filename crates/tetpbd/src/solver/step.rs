@@ -28,17 +28,31 @@ use crate::stabilisation::{correction_energy, deformation_damping};
 ///     update velocities  v ← (x − x_prev) / h, then damp deformation (DeformationDamping)
 ///     hook.end_substep
 /// ```
+///
+/// Threads (feature `parallel`): a step runs its parallel passes on the pool given to
+/// [`Solver::set_thread_pool`] (e.g. the one the integrator gives rapier's pipeline), or
+/// else in the caller's rayon context; [`SolverSettings::parallel`] makes it serial or
+/// keeps the pool's threads awake for the step. The solver never changes rayon's global
+/// pool.
 #[derive(Clone, Debug, Default)]
 pub struct Solver {
     /// The settings used by the next step.
     pub settings: SolverSettings,
+    /// Pool running the parallel passes of a step; `None` uses whichever pool the calling
+    /// thread is in.
+    #[cfg(feature = "parallel")]
+    thread_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
 }
 
 impl Solver {
     /// A solver with validated settings.
     pub fn new(settings: SolverSettings) -> Result<Solver, SettingsError> {
         settings.validate()?;
-        Ok(Solver { settings })
+        Ok(Solver {
+            settings,
+            #[cfg(feature = "parallel")]
+            thread_pool: None,
+        })
     }
 
     /// Advances every soft body in `world` by one frame.
@@ -78,14 +92,72 @@ impl Solver {
     ) -> Result<StepStats, StepError> {
         self.settings.validate_frame(dt, gravity)?;
         let frame = FrameContext::new(&self.settings, dt, gravity);
-        // With the `parallel` feature and a body large enough for a parallel pass, the pool's
-        // other threads stay awake for the step (crate::parallel::team), so the passes need not wake
-        // them.
         #[cfg(feature = "parallel")]
-        if crate::parallel::sweeps::any_parallel(world) {
-            return crate::parallel::team::with_team(|| self.run_step(world, frame, hook));
+        {
+            let p = self.settings.parallel;
+            let _context = crate::parallel::context::enter(self.thread_pool.clone(), p.serial);
+            // Asked for, and with a body large enough for a parallel pass, the pool's other
+            // threads stay awake for the step (crate::parallel::team), so the passes need not
+            // wake them.
+            if p.keep_helpers_awake && crate::parallel::sweeps::any_parallel(world) {
+                let move_off = p.move_helpers_off_step_core;
+                return crate::parallel::team::with_team(move_off, || {
+                    self.run_step(world, frame, hook)
+                });
+            }
+            self.run_step(world, frame, hook)
         }
+        #[cfg(not(feature = "parallel"))]
         self.run_step(world, frame, hook)
+    }
+
+    /// A dedicated pool of `num_threads` threads for this solver's parallel passes (0: rayon's
+    /// default, one per core).
+    #[cfg(feature = "parallel")]
+    pub fn configure_thread_pool(
+        &mut self,
+        num_threads: usize,
+    ) -> Result<(), rayon::ThreadPoolBuildError> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(num_threads)
+            .thread_name(|i| format!("tetpbd-worker-{i}"))
+            .build()?;
+        self.thread_pool = Some(std::sync::Arc::new(pool));
+        Ok(())
+    }
+
+    /// The pool running this solver's parallel passes, if it was given one.
+    #[cfg(feature = "parallel")]
+    pub fn thread_pool(&self) -> Option<std::sync::Arc<rayon::ThreadPool>> {
+        self.thread_pool.clone()
+    }
+
+    /// Sets (or clears, with `None`) the pool running this solver's parallel passes, e.g.
+    /// the one an integrator gives rapier's `PhysicsPipeline::set_thread_pool`. The step
+    /// itself stays on the calling thread; each parallel pass runs on the pool's threads.
+    #[cfg(feature = "parallel")]
+    pub fn set_thread_pool(&mut self, pool: Option<std::sync::Arc<rayon::ThreadPool>>) {
+        self.thread_pool = pool;
+    }
+
+    /// [`Solver::set_thread_pool`] as a builder.
+    #[cfg(feature = "parallel")]
+    pub fn with_thread_pool(mut self, pool: Option<std::sync::Arc<rayon::ThreadPool>>) -> Self {
+        self.thread_pool = pool;
+        self
+    }
+
+    /// Removes the dedicated pool: the parallel passes run in the calling thread's rayon
+    /// context again.
+    #[cfg(feature = "parallel")]
+    pub fn clear_thread_pool(&mut self) {
+        self.thread_pool = None;
+    }
+
+    /// The number of threads of the dedicated pool, if there is one.
+    #[cfg(feature = "parallel")]
+    pub fn num_threads(&self) -> Option<usize> {
+        self.thread_pool.as_ref().map(|p| p.current_num_threads())
     }
 
     /// One frame with validated settings: the frame starts here, each substep in
