@@ -46,6 +46,7 @@ impl Moments<f32> {
         let mv = v * m;
         self.work += mv.dot(&d);
         self.square += m * d.norm_squared();
+        self.push += d * m;
         if !SPIN {
             return;
         }
@@ -61,7 +62,6 @@ impl Moments<f32> {
         self.second[4] += mx.x * x.z;
         self.second[5] += mx.y * x.z;
         self.torque += mx.cross(&d);
-        self.push += d * m;
     }
 }
 
@@ -197,7 +197,7 @@ impl StoreRun<'_> {
     /// Copies the slots back, leaves the state before the families in them (for the second
     /// pass of [`crate::stabilisation::angular_momentum::store_measured`]) and returns the moments of the corrections (one block:
     /// f32, in particle order), `x̄` taken about `o` and `v` relative to `v0`.
-    /// Without `SPIN` only the energy sums (`work`, `square`, `inv_mass`) are taken.
+    /// Without `SPIN` only the energy sums (`work`, `square`, `push`, `inv_mass`) are taken.
     pub(crate) fn store_measuring<const SPIN: bool>(
         self,
         [o, v0]: [Vector3<f32>; 2],
