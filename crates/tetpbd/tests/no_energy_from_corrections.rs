@@ -183,13 +183,11 @@ const REFERENCE: f32 = 1000.0 * 9.81 * 1.732;
 /// nothing carries these starts through a configuration where the projections balance.
 fn known_tangled(split: CellSplit, families: Families, start: Start, substeps: u32) -> bool {
     use CellSplit::{Five, Six};
-    use Families::{EdgesVertexFace as Vfe, EdgesVolume as Ev};
+    use Families::EdgesVertexFace as Vfe;
     match (split, families, start) {
-        (Five, Vfe, Start::Collapsed) => substeps >= 5,
         (Six, Vfe, Start::Mirrored) => substeps == 1,
-        (Six, Vfe, Start::Collapsed) => substeps <= 40,
-        (Six, Vfe, Start::Scrambled) => substeps <= 10,
-        (Six, Ev, Start::Mirrored) => true,
+        (Six, Vfe, Start::Collapsed) => true,
+        (Six, Vfe, Start::Scrambled) => substeps <= 40,
         _ => false,
     }
 }
