@@ -2,13 +2,13 @@
 //! and its fine surface mesh is driven by the coarse simulation through barycentric skinning.
 //!
 //! Headless; prints one line of statistics per frame. Run with
-//! `cargo run --release --example asset_drop [-- OBJ [FRAMES [CELL_M]]]`
-//! (defaults: `examples/assets/bunny_blob.obj`, 180 frames, 0.07 m cells).
-//!
-//! Output flags (`--export DIR`, `--strip FILE`, `--animate FILE`, `--render DIR`): see the
-//! README's Gallery section.
+//! `cargo run --release --example asset_drop -- [OBJ [FRAMES [CELL_M]]] [--export DIR] …`
+//! (defaults: `examples/assets/bunny_blob.obj`, 180 frames, 0.07 m cells); `-- --help` lists
+//! every option with its unit and default (the command line is in `cli/asset_drop.rs`).
 
 use std::time::Instant;
+
+use clap::Parser;
 
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
@@ -17,21 +17,16 @@ use tetpbd::{Particles, SoftBodyBuilder, SolverSettings, Tetrahedra};
 use tetpbd_io::{Skin, SurfaceMesh, TetrahedralizeBuilder};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping, SoftColliderBuilder};
 
+#[path = "cli/asset_drop.rs"]
+mod cli;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let (mut viz, args) = tetpbd_viz::Viz::from_env()?;
-    let mut args = args.into_iter();
-    let path = args.next().unwrap_or_else(|| {
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/examples/assets/bunny_blob.obj"
-        )
-        .into()
-    });
-    let frames: usize = args.next().map_or(Ok(180), |a| a.parse())?;
-    let cell: f32 = args.next().map_or(Ok(0.07), |a| a.parse())?;
+    let cli = cli::Cli::parse();
+    let mut viz = tetpbd_viz::Viz::from_options(cli.viz)?;
+    let (path, frames, cell) = (cli.obj.display(), cli.frames, cli.cell);
 
     let t = Instant::now();
-    let render = SurfaceMesh::read_obj(&path)?;
+    let render = SurfaceMesh::read_obj(&cli.obj)?;
     let mesh = TetrahedralizeBuilder::new(cell)
         .smoothing(3)
         .build(&render)?;

@@ -2,12 +2,13 @@
 //! integrator's own rapier state (`RapierContext`) rather than the convenience world.
 //!
 //! Headless; prints one line of statistics per frame. Run with
-//! `cargo run --example kinematic_platform [-- FRAMES]`.
-//!
-//! Output flags (`--export DIR`, `--strip FILE`, `--animate FILE`, `--render DIR`): see the
-//! README's Gallery section.
+//! `cargo run --release --example kinematic_platform -- [FRAMES] [--export DIR] [--strip FILE] …`;
+//! `-- --help` lists every option with its unit and default (the command line is in
+//! `cli/kinematic_platform.rs`).
 
 use std::time::Instant;
+
+use clap::Parser;
 
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
@@ -20,9 +21,13 @@ use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{Coupling, CouplingSettings, RapierContext, SoftColliderBuilder};
 
+#[path = "cli/kinematic_platform.rs"]
+mod cli;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let (mut viz, args) = tetpbd_viz::Viz::from_env()?;
-    let frames: usize = args.first().map_or(Ok(240), |a| a.parse())?;
+    let cli = cli::Cli::parse();
+    let mut viz = tetpbd_viz::Viz::from_options(cli.viz)?;
+    let frames = cli.frames;
     // The integrator's rapier state.
     let mut pipeline = PhysicsPipeline::new();
     let params = IntegrationParameters::default();

@@ -3,61 +3,40 @@
 //!
 //! ```text
 //! cargo run --release --example recover -- [mirror|flatten|scramble|squash|nudge] [vf|ev|vfe|e]
-//!     [frames] [substeps] [cells] [--alpha A] [--max-correction-speed V]
+//!     [FRAMES] [SUBSTEPS] [CELLS] [--alpha ALPHA] [--max-correction-speed M_PER_S] [--export DIR] …
 //! ```
 //!
 //! `vf` = vertex–face constraints alone, `ev` = edges + volume, `vfe` = vertex–face + edges,
 //! `e` = edges alone (which cannot un-invert a mirrored body). `--alpha` sets the compliance of
 //! every family (m/N; volume m⁵/N), default 0; `--max-correction-speed` turns on the solver's
-//! safety net (m/s). Defaults: mirror, vfe, 120 frames, 10 substeps, 4³ cells.
-//!
-//! Output flags (`--export DIR`, `--strip FILE`, `--animate FILE`, `--render DIR`): see the
-//! README's Gallery section.
+//! safety net (m/s). Defaults: mirror, vfe, 120 frames, 10 substeps, 4³ cells. `-- --help`
+//! lists every option with its unit and default (the command line is in `cli/recover.rs`).
 
+use clap::{Parser, ValueEnum};
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, Tetrahedra};
 
+#[path = "cli/recover.rs"]
+mod cli;
+
+use cli::{Families, Mode};
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let (mut viz, all) = tetpbd_viz::Viz::from_env()?;
-    let flag = |name: &str| -> Result<Option<f32>, Box<dyn std::error::Error>> {
-        match all.iter().position(|a| a == name) {
-            Some(i) => Ok(Some(
-                all.get(i + 1)
-                    .ok_or(format!("{name} needs a value"))?
-                    .parse()?,
-            )),
-            None => Ok(None),
-        }
-    };
-    let alpha = flag("--alpha")?.unwrap_or(0.0);
-    let max_correction_speed = flag("--max-correction-speed")?;
-    let mut args = Vec::new();
-    let mut skip = false;
-    for a in &all {
-        if skip {
-            skip = false;
-        } else if a.starts_with("--") {
-            skip = true;
-        } else {
-            args.push(a.clone());
-        }
-    }
-    let mode = args.first().map_or("mirror", String::as_str);
-    let families = args.get(1).map_or("vfe", String::as_str);
-    let frames: usize = args.get(2).map_or(Ok(120), |s| s.parse())?;
-    let substeps: u32 = args.get(3).map_or(Ok(10), |s| s.parse())?;
-    let cells: u32 = args.get(4).map_or(Ok(4), |s| s.parse())?;
+    let cli = cli::Cli::parse();
+    let mut viz = tetpbd_viz::Viz::from_options(cli.viz)?;
+    let (mode, families, frames, substeps, cells) =
+        (cli.mode, cli.families, cli.frames, cli.substeps, cli.cells);
+    let (alpha, max_correction_speed) = (cli.alpha, cli.max_correction_speed);
 
     let mut world = hecs::World::new();
     let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Five)?;
     let b = SoftBodyBuilder::new(mesh).density(1000.0);
     let b = match families {
-        "vf" => b.vertex_face(alpha),
-        "ev" => b.edges(alpha).volume(alpha),
-        "vfe" => b.vertex_face(alpha).edges(alpha),
-        "e" => b.edges(alpha),
-        other => return Err(format!("unknown constraint set `{other}` (vf, ev, vfe, e)").into()),
+        Families::VertexFace => b.vertex_face(alpha),
+        Families::EdgesVolume => b.edges(alpha).volume(alpha),
+        Families::VertexFaceEdges => b.vertex_face(alpha).edges(alpha),
+        Families::Edges => b.edges(alpha),
     };
     let body = b.build()?.spawn(&mut world);
     {
@@ -72,12 +51,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for i in 0..p.len() {
             let x = p.positions()[i];
             let y = match mode {
-                "mirror" => Vector3::new(-x.x, x.y, x.z),
-                "flatten" => Vector3::new(x.x, 0.0, x.z),
-                "squash" => Vector3::new(x.x, 0.5 * x.y, x.z),
-                "nudge" => Vector3::new(x.x, 0.95 * x.y, x.z),
-                "scramble" => Vector3::new(rand(), rand(), rand()),
-                other => return Err(format!("unknown mode `{other}`").into()),
+                Mode::Mirror => Vector3::new(-x.x, x.y, x.z),
+                Mode::Flatten => Vector3::new(x.x, 0.0, x.z),
+                Mode::Squash => Vector3::new(x.x, 0.5 * x.y, x.z),
+                Mode::Nudge => Vector3::new(x.x, 0.95 * x.y, x.z),
+                Mode::Scramble => Vector3::new(rand(), rand(), rand()),
             };
             p.set_position(i, y)?;
         }
@@ -91,7 +69,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Default::default()
     })?;
     println!(
-        "mode {mode}, constraints {families} (α = {alpha}), {cells}³ cells, {substeps} substeps × 1 iteration, dt 1/60 s, safety net {max_correction_speed:?}"
+        "mode {}, constraints {} (α = {alpha}), {cells}³ cells, {substeps} substeps × 1 iteration, dt 1/60 s, safety net {max_correction_speed:?}",
+        name(mode),
+        name(families)
     );
     println!(
         "frame  inverted  volume%   max|C|edge  max|C|vf   max|C|vol   degenerate  max|v|     ms"
@@ -125,4 +105,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     viz.finish()?;
     Ok(())
+}
+
+/// The name a value has on the command line.
+fn name(value: impl ValueEnum) -> String {
+    value
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_owned())
 }

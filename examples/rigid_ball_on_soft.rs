@@ -1,12 +1,13 @@
 //! A rigid ball dropped onto a row of soft cubes lying on fixed ground.
 //!
 //! Headless; prints one line of statistics per frame. Run with
-//! `cargo run --example rigid_ball_on_soft [-- FRAMES]`.
-//!
-//! Output flags (`--export DIR`, `--strip FILE`, `--animate FILE`, `--render DIR`): see the
-//! README's Gallery section.
+//! `cargo run --release --example rigid_ball_on_soft -- [FRAMES] [--export DIR] [--strip FILE] …`;
+//! `-- --help` lists every option with its unit and default (the command line is in
+//! `cli/rigid_ball_on_soft.rs`).
 
 use std::time::Instant;
+
+use clap::Parser;
 
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
@@ -15,9 +16,13 @@ use tetpbd::generators::{self, CellSplit};
 use tetpbd::{SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping};
 
+#[path = "cli/rigid_ball_on_soft.rs"]
+mod cli;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let (mut viz, args) = tetpbd_viz::Viz::from_env()?;
-    let frames: usize = args.first().map_or(Ok(180), |a| a.parse())?;
+    let cli = cli::Cli::parse();
+    let mut viz = tetpbd_viz::Viz::from_options(cli.viz)?;
+    let frames = cli.frames;
     let solver = SolverSettings {
         substeps: 10,
         measure_error: true,

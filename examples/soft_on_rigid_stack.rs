@@ -1,12 +1,13 @@
 //! A soft cube lands on a stack of three dynamic rigid boxes standing on fixed ground.
 //!
 //! Headless; prints one line of statistics per frame. Run with
-//! `cargo run --example soft_on_rigid_stack [-- FRAMES]`.
-//!
-//! Output flags (`--export DIR`, `--strip FILE`, `--animate FILE`, `--render DIR`): see the
-//! README's Gallery section.
+//! `cargo run --release --example soft_on_rigid_stack -- [FRAMES] [--export DIR] [--strip FILE] …`;
+//! `-- --help` lists every option with its unit and default (the command line is in
+//! `cli/soft_on_rigid_stack.rs`).
 
 use std::time::Instant;
+
+use clap::Parser;
 
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
@@ -15,9 +16,13 @@ use tetpbd::generators::{self, CellSplit};
 use tetpbd::{SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftColliderBuilder};
 
+#[path = "cli/soft_on_rigid_stack.rs"]
+mod cli;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let (mut viz, args) = tetpbd_viz::Viz::from_env()?;
-    let frames: usize = args.first().map_or(Ok(180), |a| a.parse())?;
+    let cli = cli::Cli::parse();
+    let mut viz = tetpbd_viz::Viz::from_options(cli.viz)?;
+    let frames = cli.frames;
     let solver = SolverSettings {
         substeps: 10,
         measure_error: true,

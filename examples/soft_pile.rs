@@ -5,13 +5,14 @@
 //! simulated time, the largest particle speed and the largest penetrations of that second.
 //!
 //! ```text
-//! cargo run --release --example soft_pile -- [rigid|soft] [seconds]
+//! cargo run --release --example soft_pile -- [rigid|soft] [SECONDS] [--export DIR] …
 //! ```
 //!
-//! Progress goes to standard error (a bar on a terminal, a line per 10 % otherwise).
-//! Output flags (`--export DIR`, `--strip FILE`, `--animate FILE`, `--render DIR`): see the
-//! README's Gallery section.
+//! `-- --help` lists every option with its unit and default (the command line is in
+//! `cli/soft_pile.rs`). Progress goes to standard error (a bar on a terminal, a line per 10 %
+//! otherwise).
 
+use clap::Parser;
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
@@ -21,10 +22,14 @@ use tetpbd_rapier::{
     CoupledWorld, CouplingSettings, DeformationDamping, SoftContactSettings, SoftContacts,
 };
 
+#[path = "cli/soft_pile.rs"]
+mod cli;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let (mut viz, args) = tetpbd_viz::Viz::from_env()?;
-    let soft_ground = args.iter().any(|a| a == "soft");
-    let seconds: u32 = args.iter().find_map(|a| a.parse().ok()).unwrap_or(5);
+    let cli = cli::Cli::parse();
+    let mut viz = tetpbd_viz::Viz::from_options(cli.viz)?;
+    let soft_ground = cli.ground == cli::Ground::Soft;
+    let seconds = cli.seconds;
     let solver = SolverSettings {
         substeps: 20,
         // The soft slab needs some drag; on rigid ground the coupling's deformation damping

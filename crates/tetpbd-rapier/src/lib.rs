@@ -21,9 +21,6 @@
 //! * Per-body collision properties (friction, restitution, rolling resistance, thickness)
 //!   and groups: the [`SoftCollider`] component; deformation damping: the
 //!   [`DeformationDamping`] component.
-//! * Triangle meshes without pseudo-normals are one-sided: their inside is behind each
-//!   face's counter-clockwise winding normal; heightfields are solid below their surface
-//!   (see [`SoftCollider`]).
 //! * Attachments: the [`Attachments`] component.
 //! * Contact reports: [`Coupling::contacts`]; statistics: [`CouplingStats`].
 //! * Other hooks (e.g. soft–soft contacts) run in the same substeps through
@@ -80,6 +77,8 @@ mod heavy_loads;
 mod impact;
 mod joints;
 mod mesh_side;
+mod placement;
+pub mod prelude;
 mod report;
 mod response;
 mod rigid;
@@ -93,6 +92,7 @@ mod validate;
 pub use attachments::{AttachTarget, Attachment, Attachments};
 pub use coupling::{Coupling, RapierContext};
 pub use error::CouplingError;
+pub use placement::RapierPlacement;
 pub use report::{ContactReport, CouplingStats, SoftFeature};
 pub use response::deformation_damping::DeformationDamping;
 pub use scene::CoupledWorld;

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-/// An error of the frame exporter, the renderer or the option parser.
+/// An error of the frame exporter or the renderer.
 #[derive(Debug)]
 pub enum VizError {
     /// A file or folder could not be written.
@@ -26,13 +26,6 @@ pub enum VizError {
         /// The cause.
         source: png::EncodingError,
     },
-    /// A command-line option is missing its value or has a bad one.
-    Option {
-        /// The option, e.g. `--export`.
-        name: String,
-        /// What is wrong.
-        problem: String,
-    },
     /// An image size of zero or larger than 16384 pixels on a side.
     ImageSize {
         /// Width asked for, pixels.
@@ -48,7 +41,6 @@ impl std::fmt::Display for VizError {
             VizError::Io { path, source } => write!(f, "{}: {source}", path.display()),
             VizError::Write { path, source } => write!(f, "{}: {source}", path.display()),
             VizError::Png { path, source } => write!(f, "{}: PNG: {source}", path.display()),
-            VizError::Option { name, problem } => write!(f, "option {name}: {problem}"),
             VizError::ImageSize { width, height } => write!(
                 f,
                 "image size {width}×{height}: each side must be 1 to 16384 pixels"

@@ -9,8 +9,9 @@
 //!   a run, flat Lambert shading), written as PNG, frame strips or animated PNG ([`write_png`],
 //!   [`strip`]).
 //! * [`Viz`]: the outputs an example's `--export DIR`, `--render DIR`, `--strip FILE`,
-//!   `--animate FILE` flags (or `TETPBD_EXPORT`, … variables, see [`VizOptions`]) ask for,
-//!   fed one frame at a time.
+//!   `--animate FILE` options (or `TETPBD_EXPORT`, … variables) ask for, fed one frame at a
+//!   time; [`VizOptions`] is those options as a [`clap::Args`] group that each example
+//!   flattens into its own command line.
 //! * [`Progress`]: a progress bar on a terminal, plain periodic lines otherwise (CI).
 //!
 //! ```

@@ -15,12 +15,22 @@ const FRAME_TIME: f32 = 1.0 / 60.0;
 /// The outputs [`VizOptions`] asked for, written as frames arrive ([`Viz::frame`]) and at the
 /// end ([`Viz::finish`]). With no output asked for, both do nothing.
 ///
-/// In an example:
+/// In an example, with the options flattened into its command line (see [`VizOptions`]):
 ///
 /// ```no_run
+/// use clap::Parser;
+///
+/// /// Steps a scene.
+/// #[derive(Parser)]
+/// struct Cli {
+///     #[command(flatten)]
+///     viz: tetpbd_viz::VizOptions,
+/// }
+///
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// # let mut world = tetpbd::hecs::World::new();
-/// let (mut viz, args) = tetpbd_viz::Viz::from_env()?; // args: the example's own arguments
+/// let cli = Cli::parse(); // `--help`, or a bad option, prints and exits
+/// let mut viz = tetpbd_viz::Viz::from_options(cli.viz)?;
 /// for _ in 0..120 {
 ///     // … step the scene …
 ///     viz.frame(&world)?;
@@ -37,12 +47,10 @@ pub struct Viz {
 }
 
 impl Viz {
-    /// The outputs selected by the process's arguments and environment, and the arguments
-    /// left for the caller (without the program name).
-    pub fn from_env() -> Result<(Viz, Vec<String>), VizError> {
-        let (options, rest) =
-            VizOptions::parse(std::env::args().skip(1), |k| std::env::var(k).ok())?;
-        Ok((Viz::new(options, RenderSettings::default())?, rest))
+    /// The outputs of `options`, pictures drawn with the default [`RenderSettings`]; creates
+    /// the export folder.
+    pub fn from_options(options: VizOptions) -> Result<Viz, VizError> {
+        Viz::new(options, RenderSettings::default())
     }
 
     /// The outputs of `options`, pictures drawn with `settings`; creates the export folder.

@@ -1,4 +1,4 @@
-//! Frame export files, collider tessellation and option parsing.
+//! Frame export files, collider tessellation, progress and the frame-output session.
 
 use nalgebra::Vector3;
 use rapier3d::math::{Pose, Vector};
@@ -133,43 +133,6 @@ fn collider_shapes_become_triangle_meshes_of_their_size() {
     assert!(plane.positions.iter().all(|p| p.y == 0.0));
 
     assert!(shape_mesh(&Segment::new(Vector::ZERO, Vector::X)).is_none());
-}
-
-#[test]
-fn options_come_out_of_the_arguments_and_fall_back_on_the_environment() {
-    let args = [
-        "mirror",
-        "--export",
-        "out/frames",
-        "vf",
-        "--strip-frames",
-        "3",
-        "60",
-    ]
-    .map(String::from);
-    let env = |k: &str| (k == "TETPBD_STRIP" || k == "TETPBD_EXPORT").then(|| format!("{k}.png"));
-    let (o, rest) = VizOptions::parse(args, env).unwrap();
-    assert_eq!(rest, ["mirror", "vf", "60"]);
-    assert_eq!(
-        o.export.unwrap().to_str(),
-        Some("out/frames"),
-        "the flag wins"
-    );
-    assert_eq!(o.strip.unwrap().to_str(), Some("TETPBD_STRIP.png"));
-    assert_eq!(o.strip_frames, 3);
-    assert_eq!(o.render, None);
-
-    for bad in [
-        &["--export"][..],
-        &["--strip", "--render", "x"],
-        &["--strip-frames", "0"],
-    ] {
-        let err = VizOptions::parse(bad.iter().map(|s| s.to_string()), |_| None).unwrap_err();
-        assert!(
-            matches!(&err, VizError::Option { name, .. } if name == bad[0]),
-            "{bad:?}: {err}"
-        );
-    }
 }
 
 #[test]

@@ -68,6 +68,13 @@ pub enum BuildError {
     },
     /// The initial velocity is NaN or infinite.
     NonFiniteVelocity,
+    /// The placement's rotation or translation has a non-finite component.
+    NonFinitePose,
+    /// The placement's scale is not finite and positive.
+    BadScale {
+        /// The value given.
+        value: f32,
+    },
     /// A generator parameter is out of range.
     BadGeneratorParameter {
         /// Parameter name.
@@ -123,7 +130,13 @@ impl fmt::Display for BuildError {
             BuildError::BadEpsilon { value } => {
                 write!(f, "volume epsilon must be finite and >= 0, got {value}")
             }
-            BuildError::NonFiniteVelocity => write!(f, "initial velocity is not finite"),
+            BuildError::NonFiniteVelocity => {
+                write!(f, "initial linear or angular velocity is not finite")
+            }
+            BuildError::NonFinitePose => write!(f, "placement rotation or translation is not finite"),
+            BuildError::BadScale { value } => {
+                write!(f, "scale must be finite and positive, got {value}")
+            }
             BuildError::BadGeneratorParameter { name, value } => {
                 write!(f, "generator parameter `{name}` is out of range: {value}")
             }
@@ -206,6 +219,17 @@ pub enum StateError {
         /// The value given.
         value: f32,
     },
+    /// Every particle that would take an impulse is pinned.
+    AllPinned,
+    /// The body has no tetrahedron to take an impulse at a point.
+    NoTetrahedra,
+    /// A parameter is out of range (a radius ≤ 0, a non-finite speed).
+    BadParameter {
+        /// Which parameter.
+        what: &'static str,
+        /// The value given.
+        value: f32,
+    },
 }
 
 impl fmt::Display for StateError {
@@ -219,6 +243,11 @@ impl fmt::Display for StateError {
             }
             StateError::BadCompliance { value } => {
                 write!(f, "compliance must be finite and >= 0, got {value}")
+            }
+            StateError::AllPinned => write!(f, "every particle that would take it is pinned"),
+            StateError::NoTetrahedra => write!(f, "the body has no tetrahedron"),
+            StateError::BadParameter { what, value } => {
+                write!(f, "{what} is out of range: {value}")
             }
         }
     }

@@ -48,14 +48,17 @@ mod kernels;
 mod ordering;
 #[cfg(feature = "parallel")]
 mod parallel;
+pub mod prelude;
 mod solver;
 mod stabilisation;
 
 pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
 pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};
 pub use body::generators;
+pub use body::impulses::PointImpulse;
 pub use body::mesh::{Surface, Tetrahedra};
 pub use body::particles::{ExternalAcceleration, Particles};
+pub use body::placement::Placement;
 pub use error::{BuildError, SettingsError, StateError, StepError};
 pub use ordering::ColourClasses;
 pub use solver::hook::SubstepHook;

@@ -60,10 +60,17 @@ fn builder_rejects_bad_meshes() {
         err(SoftBodyBuilder::new(m)),
         BuildError::UnreferencedVertex { vertex: 4 }
     );
-    // A non-finite translation is caught on the translated vertices.
+    // A non-finite translation is a bad pose; one that overflows the coordinates names the
+    // vertex.
     assert_eq!(
         err(SoftBodyBuilder::new(unit_tet()).translation(Vector3::new(0.0, f32::NAN, 0.0))),
-        BuildError::NonFiniteVertex { vertex: 0 }
+        BuildError::NonFinitePose
+    );
+    let mut m = unit_tet();
+    m.vertices[1].x = f32::MAX;
+    assert_eq!(
+        err(SoftBodyBuilder::new(m).scale(2.0)),
+        BuildError::NonFiniteVertex { vertex: 1 }
     );
 }
 

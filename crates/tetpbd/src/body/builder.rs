@@ -1,11 +1,12 @@
 //! Building soft bodies from vertices and tetrahedra.
 
 use hecs::{Entity, World};
-use nalgebra::Vector3;
+use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::body::mesh::{Surface, Tetrahedra};
 use crate::body::particles::Particles;
+use crate::body::placement::Placement;
 use crate::constraints::{bounded_height, signed_volume, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
 use crate::error::BuildError;
 use crate::kernels::slots::{Slot, WorkCopy};
@@ -75,8 +76,7 @@ pub struct SoftBodyBuilder {
     vertex_face: Option<f32>,
     volume: Option<f32>,
     pinned: Vec<u32>,
-    velocity: Vector3<f32>,
-    translation: Vector3<f32>,
+    placement: Placement,
     epsilon: f32,
     spatial_order: bool,
     parts: usize,
@@ -100,8 +100,7 @@ impl SoftBodyBuilder {
             vertex_face: None,
             volume: None,
             pinned: Vec::new(),
-            velocity: Vector3::zeros(),
-            translation: Vector3::zeros(),
+            placement: Placement::default(),
             epsilon: Self::DEFAULT_EPSILON,
             spatial_order: Self::DEFAULT_SPATIAL_ORDER,
             parts: 0,
@@ -146,13 +145,46 @@ impl SoftBodyBuilder {
 
     /// Initial velocity of every free particle, m/s.
     pub fn velocity(mut self, v: Vector3<f32>) -> Self {
-        self.velocity = v;
+        self.placement.linear_velocity = v;
         self
     }
 
-    /// Moves the mesh by `t` (m) before building; rest data is translation-free.
+    /// Initial angular velocity about the placed body's centre of mass, rad/s (added to
+    /// [`Self::velocity`] on free particles).
+    pub fn angular_velocity(mut self, w: Vector3<f32>) -> Self {
+        self.placement.angular_velocity = w;
+        self
+    }
+
+    /// Moves the mesh by `t` (m) after rotating it; rest data is translation-free.
     pub fn translation(mut self, t: Vector3<f32>) -> Self {
-        self.translation = t;
+        self.placement.translation = t;
+        self
+    }
+
+    /// Rotates the mesh about its origin before translating it; rest data is rotation-free.
+    pub fn rotation(mut self, r: UnitQuaternion<f32>) -> Self {
+        self.placement.rotation = r;
+        self
+    }
+
+    /// Rotation and translation at once (rotation about the mesh's origin first).
+    pub fn pose(mut self, pose: Isometry3<f32>) -> Self {
+        self.placement.rotation = pose.rotation;
+        self.placement.translation = pose.translation.vector;
+        self
+    }
+
+    /// Scales the mesh uniformly by `s` (> 0) about its origin: the rest shape, and with it
+    /// masses and rest lengths, is the scaled mesh.
+    pub fn scale(mut self, s: f32) -> Self {
+        self.placement.scale = s;
+        self
+    }
+
+    /// Pose, scale and initial motion at once (see [`Placement`]).
+    pub fn placement(mut self, placement: Placement) -> Self {
+        self.placement = placement;
         self
     }
 
@@ -192,25 +224,25 @@ impl SoftBodyBuilder {
             vertex_face,
             volume,
             pinned,
-            velocity,
-            translation,
+            placement,
             epsilon,
             spatial_order,
             parts,
         } = self;
+        let mut mesh = mesh;
         let n = mesh.vertices.len();
-        let positions: Vec<Vector3<f32>> = mesh.vertices.iter().map(|v| v + translation).collect();
-        for (i, (v, p)) in mesh.vertices.iter().zip(&positions).enumerate() {
-            if !v.iter().chain(p.iter()).all(|c| c.is_finite()) {
+        for (i, v) in mesh.vertices.iter_mut().enumerate() {
+            let input_finite = v.iter().all(|c| c.is_finite());
+            *v *= placement.scale;
+            if !(input_finite && placement.place(v).iter().all(|c| c.is_finite())) {
                 return Err(BuildError::NonFiniteVertex { vertex: i });
             }
         }
+        let positions: Vec<Vector3<f32>> =
+            mesh.vertices.iter().map(|v| placement.place(v)).collect();
         let (rest_volumes, masses) = rest_volumes_and_masses(&mesh, density, epsilon)?;
         let inv_masses = pinned_inverse_masses(&masses, &pinned)?;
-        let velocities: Vec<Vector3<f32>> = inv_masses
-            .iter()
-            .map(|w| if *w > 0.0 { velocity } else { Vector3::zeros() })
-            .collect();
+        let velocities = placement.velocities(&positions, &masses, &inv_masses);
         // Particle order (see `ordering::spatial`): particle `k` is input vertex
         // `particle_source[k]`.
         let (particle_source, local_tets, local_source) =
@@ -291,10 +323,7 @@ impl SoftBodyBuilder {
                 }
             }
         }
-        if !self.velocity.iter().all(|c| c.is_finite()) {
-            return Err(BuildError::NonFiniteVelocity);
-        }
-        Ok(())
+        self.placement.check()
     }
 }
 

@@ -83,7 +83,10 @@ impl Tetrahedra {
     pub fn count_inverted(&self, positions: &[Vector3<f32>]) -> usize {
         (0..self.len())
             // A non-finite volume counts as inverted (NaN compares false).
-            .filter(|&t| !(self.volume_at(t, positions) * self.rest_volumes[t] > 0.0))
+            .filter(|&t| {
+                let product = self.volume_at(t, positions) * self.rest_volumes[t];
+                product.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+            })
             .count()
     }
 }

@@ -9,5 +9,7 @@
 pub(crate) mod builder;
 pub(crate) mod families;
 pub mod generators;
+pub(crate) mod impulses;
 pub(crate) mod mesh;
 pub(crate) mod particles;
+pub(crate) mod placement;

@@ -85,7 +85,8 @@ pub(crate) fn velocity_scale(
     let square = (sums.square - theta.dot(&r_cross_d)).max(0.0);
     let (a, q) = (work / h, square / (2.0 * h * h));
     let gain = a + q;
-    if !(gain > 0.0) {
+    // No gain, or a NaN one: nothing to limit.
+    if gain.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return 1.0;
     }
     let e = budget(sums.inv_mass as f32, a, gain).max(0.0);
