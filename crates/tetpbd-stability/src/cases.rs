@@ -21,18 +21,64 @@ pub struct Case {
     /// Group ("stiff", "large steps", …).
     pub group: &'static str,
     /// Row label.
-    pub name: &'static str,
+    pub name: String,
     /// What it does.
     pub description: &'static str,
     /// Fast or long.
     pub kind: CaseKind,
+    /// Part of the sweep over grid splits and substep counts: the report runs it without the
+    /// safety net only (the defaults are what the sweep measures).
+    pub sweep: bool,
     /// The scene.
     pub scene: Scene,
 }
 
+/// The substep counts the recovery and impact sweeps run at.
+pub const SWEEP_SUBSTEPS: [u32; 6] = [1, 5, 10, 20, 40, 80];
+
+/// The released starts of the recovery sweep, with their row labels.
+fn released_starts() -> [(Start, &'static str); 5] {
+    [
+        (Start::Mirrored, "mirrored"),
+        (Start::Flattened, "flattened"),
+        (Start::Collapsed, "collapsed to a point"),
+        (Start::Scrambled(0.5), "scrambled"),
+        (
+            Start::Dragged(0, Vector3::new(100.0 / 3.0, 0.0, 0.0)),
+            "one vertex dragged 100 cells",
+        ),
+    ]
+}
+
+fn split_label(split: CellSplit) -> &'static str {
+    match split {
+        CellSplit::Five => "5 tets/cell",
+        CellSplit::Six => "6 tets/cell",
+    }
+}
+
+/// A 0.5 m cube of 4³ cells, its bottom 5 cm above the ground, thrown down at `speed`
+/// (m/s), gravity on, 2 s.
+fn impact(split: CellSplit, speed: f32, substeps: u32) -> Scene {
+    let mut mesh = box_grid(Vector3::repeat(0.5), [4; 3], split).unwrap_or_default();
+    for v in &mut mesh.vertices {
+        v.y += 0.3;
+    }
+    let mut s = Scene::new(mesh);
+    s.velocity = Vector3::new(0.0, -speed, 0.0);
+    s.ground = true;
+    s.settings.substeps = substeps;
+    s.frames = 120;
+    s
+}
+
 fn cube(size: f32, cells: u32) -> TetMesh {
+    cube_split(size, cells, CellSplit::Six)
+}
+
+fn cube_split(size: f32, cells: u32, split: CellSplit) -> TetMesh {
     // Cannot fail for positive finite sizes and 1..=1024 cells.
-    box_grid(Vector3::repeat(size), [cells; 3], CellSplit::Six).unwrap_or_default()
+    box_grid(Vector3::repeat(size), [cells; 3], split).unwrap_or_default()
 }
 
 fn top(mesh: &TetMesh) -> Vec<u32> {
@@ -55,8 +101,9 @@ fn hanging(size: f32, substeps: u32, frames: usize) -> Scene {
     s
 }
 
-fn released(start: Start) -> Scene {
-    let mut s = Scene::new(cube(1.0, 3));
+fn released(start: Start, split: CellSplit, substeps: u32) -> Scene {
+    let mut s = Scene::new(cube_split(1.0, 3, split));
+    s.settings.substeps = substeps;
     s.start = start;
     s.settings.gravity = Vector3::zeros();
     s.settings.damping = 1.0;
@@ -81,15 +128,19 @@ fn single_tet(apex_height: f32) -> TetMesh {
 /// [`tetpbd::SolverSettings::max_correction_speed`] on every scene.
 pub fn all_cases(safety_net: Option<f32>) -> Vec<Case> {
     let mut cases = Vec::new();
-    let mut add = |group, name, description, kind, mut scene: Scene| {
+    let mut add_case = |group, name: String, description, kind, sweep, mut scene: Scene| {
         scene.settings.max_correction_speed = safety_net;
         cases.push(Case {
             group,
             name,
             description,
             kind,
+            sweep,
             scene,
         });
+    };
+    let mut add = |group, name: &str, description, kind, scene| {
+        add_case(group, name.to_string(), description, kind, false, scene)
     };
     use CaseKind::{Fast, Long};
 
@@ -157,42 +208,15 @@ pub fn all_cases(safety_net: Option<f32>) -> Vec<Case> {
         s,
     );
 
-    add(
-        "initial state",
-        "mirrored",
-        "every tetrahedron inverted, zero gravity, 5 s",
-        Fast,
-        released(Start::Mirrored),
-    );
-    add(
-        "initial state",
-        "flattened",
-        "onto the plane y = 0",
-        Fast,
-        released(Start::Flattened),
-    );
-    add(
-        "initial state",
-        "collapsed to a point",
-        "every vertex at the centre",
-        Fast,
-        released(Start::Collapsed),
-    );
-    add(
-        "initial state",
-        "scrambled",
-        "vertices random in the cube",
-        Fast,
-        released(Start::Scrambled(0.5)),
-    );
-    add(
-        "initial state",
-        "one vertex dragged 100 cells",
-        "vertex 0 moved 33 m (100 cell sizes) and released",
-        Fast,
-        released(Start::Dragged(0, Vector3::new(100.0 / 3.0, 0.0, 0.0))),
-    );
-
+    for (start, label) in released_starts() {
+        add(
+            "initial state",
+            label,
+            "1 m cube of 3³ cells, 6 tetrahedra per cell, released at rest, zero gravity, 5 s",
+            Fast,
+            released(start, CellSplit::Six, 10),
+        );
+    }
     let mut s = Scene::new(
         box_grid(Vector3::new(1.0, 1e-3, 1.0), [3, 1, 3], CellSplit::Six).unwrap_or_default(),
     );
@@ -247,6 +271,20 @@ pub fn all_cases(safety_net: Option<f32>) -> Vec<Case> {
         hanging(100.0, 10, 120),
     );
 
+    let slab = box_grid(Vector3::new(10.0, 0.01, 1.0), [10, 1, 1], CellSplit::Six);
+    let mut s = Scene::new(slab.unwrap_or_default());
+    s.pinned = (0..s.mesh.vertices.len() as u32)
+        .filter(|&i| s.mesh.vertices[i as usize].x < -4.99)
+        .collect();
+    s.frames = 180;
+    add(
+        "mesh",
+        "cantilever slab, aspect 100",
+        "10 m × 1 cm × 1 m slab of 10 × 1 × 1 cells, one end pinned, bending under gravity, 3 s",
+        Fast,
+        s,
+    );
+
     let mut s = Scene::new(cube(1.0, 3));
     s.start = Start::Mirrored;
     s.settings.gravity = Vector3::zeros();
@@ -262,5 +300,36 @@ pub fn all_cases(safety_net: Option<f32>) -> Vec<Case> {
         s,
     );
 
+    for split in [CellSplit::Six, CellSplit::Five] {
+        for (start, label) in released_starts() {
+            for substeps in SWEEP_SUBSTEPS {
+                if split == CellSplit::Six && substeps == 10 {
+                    continue; // the "initial state" rows
+                }
+                add_case(
+                    "recovery",
+                    format!("{label}, {}, {substeps} substeps", split_label(split)),
+                    "as the initial state rows, on this grid split and substep count",
+                    if substeps == 10 { Fast } else { Long },
+                    true,
+                    released(start.clone(), split, substeps),
+                );
+            }
+        }
+    }
+    for split in [CellSplit::Six, CellSplit::Five] {
+        for speed in [100.0, 300.0] {
+            for substeps in SWEEP_SUBSTEPS {
+                add_case(
+                    "impact",
+                    format!("{speed} m/s, {}, {substeps} substeps", split_label(split)),
+                    "0.5 m cube of 4³ cells thrown at immovable ground (restitution 0), gravity on, 2 s: ends intact, never rises faster than it came",
+                    if substeps == 10 && speed == 300.0 { Fast } else { Long },
+                    true,
+                    impact(split, speed, substeps),
+                );
+            }
+        }
+    }
     cases
 }

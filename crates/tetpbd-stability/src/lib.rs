@@ -13,12 +13,15 @@ mod config;
 mod coupled;
 mod coupled_rapier;
 mod coupled_robust;
+pub mod energy;
+mod ground;
 mod report;
 mod run;
 
-pub use cases::{all_cases, Case, CaseKind};
+pub use cases::{all_cases, Case, CaseKind, SWEEP_SUBSTEPS};
 pub use config::{Config, ConstraintSet};
 pub use coupled::{coupled_cases, CoupledCase, CoupledOutcome};
 pub use coupled_rapier::rapier_comparison;
-pub use report::markdown;
+pub use ground::Ground;
+pub use report::{markdown, verdict, Verdict};
 pub use run::{run_scene, run_scene_observed, FrameView, Outcome, Scene, Start};

@@ -1,8 +1,10 @@
-//! The stability suite's bounds, asserted. `docs/stability.md` shows the whole matrix,
-//! including the cells that still fail (slivers; the vertex–face family alone from released
-//! deformations).
+//! The stability suite's bounds, asserted at default settings. `docs/stability.md` shows the
+//! whole matrix, including the cells that still fail (slivers) and the vertex–face-alone
+//! shape cells.
 
-use tetpbd_stability::{all_cases, run_scene, CaseKind, Config, ConstraintSet, Outcome};
+use tetpbd_stability::{
+    all_cases, run_scene, verdict, CaseKind, Config, ConstraintSet, Outcome, Verdict,
+};
 
 fn fast_cases(net: Option<f32>) -> Vec<tetpbd_stability::Case> {
     all_cases(net)
@@ -44,40 +46,78 @@ fn every_fast_case_stays_finite_with_safety_net() {
     assert_finite(Some(10.0));
 }
 
-/// The configurations that pass every fast case but the sliver plate.
-#[test]
-fn hard_edges_volume_and_vertex_face_edges_pass_every_fast_case_but_slivers() {
-    let configs = [
-        Config {
-            set: ConstraintSet::EdgesVolume,
-            soft: false,
-        },
-        Config {
-            set: ConstraintSet::VertexFaceEdges,
-            soft: false,
-        },
-    ];
-    for case in fast_cases(None) {
-        if case.name.starts_with("slivers") {
-            continue;
-        }
-        for config in &configs {
-            let o = run_scene(&case.scene, config);
-            assert!(o.pass(), "{}", describe(&case, config, &o));
+/// Cells that fail at default settings, each listed in the report (`docs/stability.md`) and
+/// its findings: (case name, configuration label). Slivers next to pins invert; released
+/// soft vertex–face + edges can settle tangled; an impact at 300 m/s crushes the vertex–face
+/// configurations and soft bodies on the five-tetrahedra grid; a body collapsed to a point on
+/// the five-tetrahedra 3³ grid stays collapsed under edges + volume; a hard vertex–face cube
+/// hanging at 20 substeps gains 1e-3 of `M g L`.
+const KNOWN_LIMITS: &[(&str, &str)] = &[
+    ("hanging cube, 20 substeps", "vertex-face, α=0"),
+    ("stiffest finite α, 20 substeps", "vertex-face, α=0"),
+    ("flattened", "vertex-face, soft"),
+    ("collapsed to a point", "vertex-face+edges, soft"),
+    ("scrambled", "vertex-face+edges, soft"),
+    ("slivers, aspect 1000", "*"),
+    ("cantilever slab, aspect 100", "*"),
+    (
+        "collapsed to a point, 5 tets/cell, 10 substeps",
+        "edges+volume, α=0",
+    ),
+    (
+        "collapsed to a point, 5 tets/cell, 10 substeps",
+        "edges+volume, soft",
+    ),
+    (
+        "collapsed to a point, 5 tets/cell, 10 substeps",
+        "vertex-face+edges, soft",
+    ),
+    ("300 m/s, 6 tets/cell, 10 substeps", "vertex-face, α=0"),
+    ("300 m/s, 6 tets/cell, 10 substeps", "vertex-face, soft"),
+    (
+        "300 m/s, 6 tets/cell, 10 substeps",
+        "vertex-face+edges, α=0",
+    ),
+    (
+        "300 m/s, 6 tets/cell, 10 substeps",
+        "vertex-face+edges, soft",
+    ),
+    ("300 m/s, 5 tets/cell, 10 substeps", "edges+volume, soft"),
+    ("300 m/s, 5 tets/cell, 10 substeps", "vertex-face, soft"),
+];
+
+fn known_limit(case: &tetpbd_stability::Case, config: &Config) -> bool {
+    let label = config.label();
+    KNOWN_LIMITS
+        .iter()
+        .any(|&(name, c)| case.name == name && (c == "*" || c == label))
+}
+
+/// Every cell of `cases` at default settings passes, but the vertex–face-alone shape cells
+/// (expected: four heights fix four of six shape degrees of freedom) and the known limits.
+fn assert_pass_at_defaults(cases: Vec<tetpbd_stability::Case>) {
+    let mut failed = Vec::new();
+    for case in cases {
+        for config in Config::all() {
+            let o = run_scene(&case.scene, &config);
+            if verdict(&config, &o) == Verdict::Fail && !known_limit(&case, &config) {
+                failed.push(describe(&case, &config, &o));
+            }
         }
     }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
 
 #[test]
-fn soft_edges_volume_passes_every_fast_case() {
-    let config = Config {
-        set: ConstraintSet::EdgesVolume,
-        soft: true,
-    };
-    for case in fast_cases(None) {
-        let o = run_scene(&case.scene, &config);
-        assert!(o.pass(), "{}", describe(&case, &config, &o));
-    }
+fn every_fast_cell_passes_at_defaults_but_known_limits() {
+    assert_pass_at_defaults(fast_cases(None));
+}
+
+/// The recovery and impact sweeps: both grid splits, 1–80 substeps.
+#[test]
+#[ignore = "long: run in release by .ci/run"]
+fn every_sweep_cell_passes_at_defaults() {
+    assert_pass_at_defaults(all_cases(None).into_iter().filter(|c| c.sweep).collect());
 }
 
 #[test]
@@ -103,7 +143,7 @@ fn long_cases_pass_with_hard_edges_and_volume() {
     };
     for case in all_cases(None)
         .into_iter()
-        .filter(|c| c.kind == CaseKind::Long)
+        .filter(|c| c.kind == CaseKind::Long && !c.sweep)
     {
         let o = run_scene(&case.scene, &config);
         assert!(o.pass(), "{}", describe(&case, &config, &o));

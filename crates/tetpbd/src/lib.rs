@@ -67,8 +67,8 @@ pub use solver::settings::{ParallelSettings, SolverSettings};
 pub use solver::stats::{ErrorAccumulator, ErrorStats, FamilyStats, StepStats};
 pub use solver::step::Solver;
 pub use solver::systems;
-pub use stabilisation::ground_up_sweep::GroundUpSweep;
 pub use stabilisation::deformation_damping::DeformationDamping;
+pub use stabilisation::ground_up_sweep::GroundUpSweep;
 pub use stabilisation::rigid_fit::RigidFit;
 
 /// The constraint math under its former name; the same module as [`constraints`].

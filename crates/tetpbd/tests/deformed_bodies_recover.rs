@@ -116,19 +116,11 @@ fn vertex_face_and_edges_recover_mirrored_and_flattened_starts() {
     }
 }
 
-/// Finding: hard vertex–face + edges from the scrambled start settle, calm, in a tangled
-/// state (10 of 135 tetrahedra inverted on this grid, 1 on the six-tetrahedra one) once
-/// the corrections no longer become velocity (`limit_correction_energy`, the default);
-/// before, the snap-back's kinetic energy shook them out of it (and, on larger grids, kept
-/// tangled bodies at 10⁷ J). Guarded so that a fix shows up here.
+/// Hard vertex–face + edges from the scrambled start recover at default settings, calm.
 #[test]
-fn vertex_face_and_edges_from_a_scrambled_start_settle_calm_but_may_stay_tangled() {
+fn vertex_face_and_edges_recover_from_a_scrambled_start() {
     let r = run(Families::VertexFaceEdges, Start::Scrambled, 300);
-    assert!(
-        r.recovered.is_none(),
-        "recovers now: update the finding ({r:?})"
-    );
-    assert!(r.final_inverted <= 10, "{r:?}");
+    assert!(r.recovered.is_some() && r.final_inverted == 0, "{r:?}");
 }
 
 #[test]

@@ -185,14 +185,12 @@ const REFERENCE: f32 = 1000.0 * 9.81 * 1.732;
 /// docs/decisions/correction-energy.md): once the corrections no longer become velocity,
 /// nothing carries these starts through a configuration where the projections balance.
 fn known_tangled(split: CellSplit, families: Families, start: Start, substeps: u32) -> bool {
-    use CellSplit::{Five, Six};
-    use Families::{EdgesVertexFace as Vfe, EdgesVolume as Ev};
+    use CellSplit::Six;
+    use Families::EdgesVertexFace as Vfe;
     match (split, families, start) {
-        (Five, Vfe, Start::Collapsed) => substeps >= 5,
         (Six, Vfe, Start::Mirrored) => substeps == 1,
-        (Six, Vfe, Start::Collapsed) => substeps <= 40,
-        (Six, Vfe, Start::Scrambled) => substeps <= 10,
-        (Six, Ev, Start::Mirrored) => true,
+        (Six, Vfe, Start::Collapsed) => true,
+        (Six, Vfe, Start::Scrambled) => substeps <= 40,
         _ => false,
     }
 }
@@ -220,16 +218,18 @@ fn check_tangled(split: CellSplit, families: Families, start: Start, substeps: u
     }
 }
 
-/// A mirrored six-tetrahedra cube of hard edges + vertex–face used to keep ~10⁷ J and
-/// half its tetrahedra inverted; it now recovers its shape without moving.
+/// A mirrored six-tetrahedra cube of hard edges + vertex–face recovers its shape without
+/// moving at 5, 10, 20 and 40 substeps (more substeps must not make it worse).
 #[test]
-fn mirrored_hard_cube_recovers_without_gaining_energy() {
-    check_tangled(
-        CellSplit::Six,
-        Families::EdgesVertexFace,
-        Start::Mirrored,
-        10,
-    );
+fn mirrored_six_tetrahedra_cube_recovers_without_gaining_energy_at_any_substep_count() {
+    for substeps in [5, 10, 20, 40] {
+        check_tangled(
+            CellSplit::Six,
+            Families::EdgesVertexFace,
+            Start::Mirrored,
+            substeps,
+        );
+    }
 }
 
 #[test]
@@ -288,11 +288,13 @@ fn check_impact(split: CellSplit, speed: f32, substeps: u32) {
     }
 }
 
-/// A 0.5 m cube hitting immovable ground at 300 m/s used to keep 9–18 % of its volume and
-/// ~200 m/s particles; it now ends intact and never leaves faster than it came.
+/// A 0.5 m cube hitting immovable ground at 100 or 300 m/s ends intact and never leaves
+/// faster than it came.
 #[test]
-fn cube_hitting_the_ground_at_300_m_s_ends_intact() {
-    check_impact(CellSplit::Six, 300.0, 10);
+fn fast_cube_hitting_immovable_ground_ends_intact() {
+    for speed in [100.0, 300.0] {
+        check_impact(CellSplit::Six, speed, 10);
+    }
 }
 
 /// 100 and 300 m/s on both splits at 1–80 substeps (release build: `.ci/run`).
@@ -305,6 +307,68 @@ fn impacts_end_intact_at_any_substep_count() {
                 check_impact(split, speed, substeps);
             }
         }
+    }
+}
+
+/// A mirrored cube thrown spinning (2 m/s, 3 rad/s) keeps its linear and angular momentum
+/// while the limit holds back its snap-back: one scale per body keeps the linear momentum,
+/// and the rigid part of what it holds back, fitted about the positions the substep ends
+/// at, is given back. Typical over these 30 frames of untangling: linear 1–2e-5, angular
+/// 4e-6 relative (8 % of the angular momentum lost without the give-back).
+#[test]
+fn limited_tangled_body_keeps_its_momentum() {
+    for split in SPLITS {
+        let mut world = hecs::World::new();
+        let body = build(1.0, 4, split, Families::EdgesVertexFace).spawn(&mut world);
+        let (p0, l0, scale) = {
+            let mut p = world.get::<&mut Particles>(body).unwrap();
+            let c = p.center_of_mass();
+            let omega = Vector3::new(0.0, 3.0, 1.0);
+            for i in 0..p.len() {
+                let x = p.positions()[i];
+                p.set_position(i, Vector3::new(2.0 * c.x - x.x, x.y, x.z))
+                    .unwrap();
+                let v = Vector3::new(2.0, 0.0, 0.0) + omega.cross(&(x - c));
+                p.set_velocity(i, v).unwrap();
+            }
+            let scale: f32 = p
+                .velocities()
+                .iter()
+                .zip(p.masses())
+                .map(|(v, m)| m * v.norm())
+                .sum();
+            (p.linear_momentum(), p.angular_momentum(), scale)
+        };
+        let ke0 = world.get::<&Particles>(body).unwrap().kinetic_energy();
+        let mut solver = Solver::new(SolverSettings {
+            gravity: Vector3::zeros(),
+            ..Default::default()
+        })
+        .unwrap();
+        let (mut limited, mut peak) = (0, 0.0f32);
+        for _ in 0..30 {
+            limited += solver.step(&mut world).unwrap().energy_limited;
+            peak = peak.max(world.get::<&Particles>(body).unwrap().kinetic_energy());
+        }
+        assert!(limited > 0, "{split:?}: the limit acts");
+        // Hard constraints store no energy: what is given back never adds any.
+        assert!(
+            peak <= ke0 * (1.0 + 1e-4),
+            "{split:?}: kinetic energy {peak} J from {ke0} J"
+        );
+        let p = world.get::<&Particles>(body).unwrap();
+        let dp = (p.linear_momentum() - p0).norm() / scale;
+        // About the origin: the centre moves, Σ m x × v includes that.
+        let dl = (p.angular_momentum() - l0).norm() / (scale * 2.0);
+        eprintln!("{split:?}: linear {dp:e} angular {dl:e} limited {limited}");
+        assert!(
+            dp < 1e-4,
+            "{split:?}: linear momentum drift {dp:e} (relative)"
+        );
+        assert!(
+            dl < 1e-4,
+            "{split:?}: angular momentum drift {dl:e} (relative)"
+        );
     }
 }
 
@@ -389,6 +453,45 @@ fn print_outcomes() {
                     o.peak_ke, o.final_ke, o.inverted, o.volume_ratio, o.max_speed
                 );
             }
+        }
+    }
+}
+
+/// A hard cube hanging from its top face is held by its pins at one substep and at ten:
+/// the limit measures the work of the corrections with absolute velocities, so a body whose
+/// corrections carry momentum (from its pins) is not mistaken for one gaining energy.
+#[test]
+fn hanging_hard_cube_is_held_by_its_pins() {
+    for families in [Families::EdgesVolume, Families::EdgesVertexFace] {
+        for substeps in [1, 10] {
+            let mesh = box_grid(Vector3::repeat(1.0), [3; 3], CellSplit::Six).unwrap();
+            let top: Vec<u32> = (0..mesh.vertices.len() as u32)
+                .filter(|&i| mesh.vertices[i as usize].y > 0.49)
+                .collect();
+            let b = SoftBodyBuilder::new(mesh).density(1000.0).pinned(top);
+            let b = match families {
+                Families::EdgesVolume => b.edges(0.0).volume(0.0),
+                _ => b.edges(0.0).vertex_face(0.0),
+            };
+            let mut world = hecs::World::new();
+            let body = b.build().unwrap().spawn(&mut world);
+            let mut solver = Solver::new(SolverSettings {
+                substeps,
+                ..Default::default()
+            })
+            .unwrap();
+            let mut peak = 0.0f32;
+            for _ in 0..120 {
+                solver.step(&mut world).unwrap();
+                peak = peak.max(world.get::<&Particles>(body).unwrap().kinetic_energy());
+            }
+            let o = outcome(&mut world, body, peak);
+            assert!(
+                o.peak_ke < 1e-3 * REFERENCE && o.inverted == 0,
+                "{families:?}, {substeps} substeps: peak {} J, {} inverted",
+                o.peak_ke,
+                o.inverted
+            );
         }
     }
 }

@@ -306,14 +306,17 @@ pub(crate) fn fix_up(
     scale: f32,
 ) {
     let n = fix.positions.len();
-    let (xp, before) = (fix.prev_positions, fix.before);
-    let shared = (Shared::new(fix.positions), Shared::new(fix.residuals));
-    for_runs(n, PARTICLE_CHUNK, &shared, |i, (x, r)| {
+    let xp = fix.prev_positions;
+    let shared = (
+        (Shared::new(fix.positions), Shared::new(fix.residuals)),
+        Shared::new(fix.before),
+    );
+    for_runs(n, PARTICLE_CHUNK, &shared, |i, ((x, r), before)| {
         rigid_fit::FixUp {
             positions: x,
             residuals: r,
-            prev_positions: &xp[i.clone()],
-            before: &before[i],
+            prev_positions: &xp[i],
+            before,
         }
         .apply(origin_centre, theta, scale);
         Nothing

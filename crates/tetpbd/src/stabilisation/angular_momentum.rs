@@ -53,7 +53,7 @@
 use nalgebra::Vector3;
 
 use crate::body::particles::Particles;
-use crate::stabilisation::rigid_fit::{FixUp, Moments, StoreRun, BLOCK};
+use crate::stabilisation::rigid_fit::{give_back_rigid, FixUp, Moments, StoreRun, BLOCK};
 
 /// Copies a body's working copy back ([`crate::kernels::working_copy::store`]), removes the rigid-rotation
 /// part of the corrections the families made on it since it was loaded (the copy in the
@@ -143,6 +143,9 @@ pub(crate) fn store_measured(
     } else {
         (Vector3::zeros(), Vector3::zeros())
     };
+    // The work was summed with velocities relative to `v0`: Σ m v·Δ = Σ m (v − v0)·Δ + v0·Σ m Δ
+    // (the last term vanishes on a free body, not on a pinned one).
+    sums.work += v0.cast::<f64>().dot(&sums.push);
     let scale = crate::stabilisation::correction_energy::velocity_scale(&sums, c, theta, h, budget);
     if theta == Vector3::zeros() && scale == 1.0 {
         return false;
@@ -153,6 +156,7 @@ pub(crate) fn store_measured(
         positions,
         prev_positions,
         residuals,
+        masses,
         work,
         ..
     } = p;
@@ -160,14 +164,21 @@ pub(crate) fn store_measured(
         positions,
         residuals,
         prev_positions,
-        before: &work.0,
+        before: &mut work.0,
     };
     #[cfg(feature = "parallel")]
     if parallel {
         crate::parallel::sweeps::fix_up(fix, [o, c], theta, scale);
-        return scale < 1.0;
+    } else {
+        fix.apply([o, c], theta, scale);
     }
+    #[cfg(not(feature = "parallel"))]
     fix.apply([o, c], theta, scale);
+    // The scale keeps the momentum of the corrections about the substep start, not about
+    // where the velocity update ends: give that back on a free body.
+    if scale < 1.0 && spin {
+        give_back_rigid(positions, residuals, &work.0, masses);
+    }
     scale < 1.0
 }
 

@@ -32,8 +32,12 @@
 //! `E`, the largest `s ∈ [0, 1]` with `ΔK(s) = E` is kept: the positions keep all of `Δ`,
 //! the velocity update sees `sΔ/h` (the rest is taken out of the rounding residual the
 //! update adds back, [`crate::systems::add_compensated`]). One scale for the whole field keeps its
-//! zero linear and angular momentum, so the limit never pushes or turns a body; a body with
-//! pinned particles (no spin removal) exchanges momentum with its pins anyway. The sums are
+//! zero linear momentum, and its zero angular momentum about the substep starts; about the
+//! positions the velocity update ends at, the part held back `(1 − s)Δ` carries a little
+//! angular momentum, whose rigid fit is given back to a free body
+//! ([`crate::stabilisation::rigid_fit::give_back_rigid`], one more pass in iterations where the
+//! limit acts), so the limit never pushes or turns a free body. A body with pinned particles
+//! (no spin removal) exchanges momentum with its pins anyway. The sums are
 //! the spin removal's ([`crate::stabilisation::angular_momentum`]), taken in the same pass; the limit costs a few
 //! multiply–adds per particle there and one more pass only in iterations where it acts.
 //!

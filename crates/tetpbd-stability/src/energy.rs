@@ -1,0 +1,89 @@
+//! A body's mechanical energy, for the matrix's energy column: kinetic + elastic (what its
+//! compliant constraints store) + gravitational potential.
+//!
+//! The elastic energy of a family with compliance `α > 0` is `Σ C²/(2α)` (J; `C` in m for
+//! the edges and vertex–faces, α in m/N; `C` in m³ for the volumes, α in m⁵/N). Hard
+//! families (`α = 0`) hold no defined energy and count as 0: a hard body's energy is its
+//! kinetic and potential energy. The potential is `−Σ mᵢ g·xᵢ` (J). Without external work
+//! (pins do none: they do not move; a ground contact with restitution 0 only removes
+//! energy) this sum may only fall. The matrix compares kinetic + gravitational energy
+//! ([`motion`]) at every frame with the whole sum at the start: a rise above it is energy
+//! gained. (Not the whole sum at every frame: with one iteration of few substeps XPBD does
+//! not converge, the body is softer than its compliance, and `C²/2α` of its sag is not
+//! energy it holds.)
+
+use hecs::{Entity, World};
+use nalgebra::Vector3;
+use tetpbd::constraint::{bounded_height, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
+use tetpbd::{EdgeConstraints, Particles, Tetrahedra, VertexFaceConstraints, VolumeConstraints};
+
+/// Elastic energy of the compliant families of body `e`, J.
+pub fn elastic(world: &World, e: Entity) -> f64 {
+    let Ok(p) = world.get::<&Particles>(e) else {
+        return 0.0;
+    };
+    let x = p.positions();
+    let mut u = 0.0f64;
+    let term = |c: f32, alpha: f32| f64::from(c) * f64::from(c) / (2.0 * f64::from(alpha));
+    if let Ok(f) = world.get::<&EdgeConstraints>(e) {
+        let alpha = f.compliance();
+        if alpha > 0.0 {
+            for (&[a, b], &l) in f.edges().iter().zip(f.rest_lengths()) {
+                u += term((x[a as usize] - x[b as usize]).norm() - l, alpha);
+            }
+        }
+    }
+    let Ok(t) = world.get::<&Tetrahedra>(e) else {
+        return u;
+    };
+    if let Ok(f) = world.get::<&VolumeConstraints>(e) {
+        let alpha = f.compliance();
+        if alpha > 0.0 {
+            for (k, &v0) in t.rest_volumes().iter().enumerate() {
+                u += term(t.volume_at(k, x) - v0, alpha);
+            }
+        }
+    }
+    if let Ok(f) = world.get::<&VertexFaceConstraints>(e) {
+        let alpha = f.compliance();
+        if alpha > 0.0 {
+            for (tet, rest) in t.indices().iter().zip(f.rest_heights()) {
+                for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
+                    let [a, b, c, d] = order.map(|o| x[tet[o] as usize]);
+                    // A face collapsed to a point has no height: its violation is the rest value.
+                    let h =
+                        bounded_height(&a, &b, &c, &d, VERTEX_FACE_KAPPA, rest[k]).unwrap_or(0.0);
+                    u += term(h - rest[k], alpha);
+                }
+            }
+        }
+    }
+    u
+}
+
+/// Kinetic + elastic + gravitational energy of body `e` under gravity `g` (m/s²), J.
+pub fn mechanical(world: &World, e: Entity, g: Vector3<f32>) -> f64 {
+    motion(world, e, g) + elastic(world, e)
+}
+
+/// Kinetic + gravitational energy of body `e` under gravity `g` (m/s²), J: a lower bound of
+/// [`mechanical`] (the elastic energy is never negative).
+pub fn motion(world: &World, e: Entity, g: Vector3<f32>) -> f64 {
+    let Ok(p) = world.get::<&Particles>(e) else {
+        return 0.0;
+    };
+    let g = g.cast::<f64>();
+    let potential: f64 = p
+        .positions()
+        .iter()
+        .zip(p.masses())
+        .map(|(x, &m)| -f64::from(m) * g.dot(&x.cast::<f64>()))
+        .sum();
+    let kinetic: f64 = p
+        .velocities()
+        .iter()
+        .zip(p.masses())
+        .map(|(v, &m)| 0.5 * f64::from(m) * v.cast::<f64>().norm_squared())
+        .sum();
+    kinetic + potential
+}

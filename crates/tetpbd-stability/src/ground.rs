@@ -1,0 +1,33 @@
+//! The immovable ground of the impact cases: the plane y = 0, restitution 0.
+//!
+//! A [`SubstepHook`] that runs after the families every substep: a particle below the plane
+//! is put back on it (a position constraint, as a coupling's contacts are), and a particle
+//! on it leaves the substep with no normal velocity (the velocity pass of an XPBD contact,
+//! Müller et al. 2020, with restitution 0). It only ever removes energy. The coupled table
+//! runs rapier colliders through `tetpbd-rapier`; this plane keeps the impact rows
+//! independent of the coupling so every constraint configuration is measured the same way.
+
+use tetpbd::{hecs, Particles, SubstepHook};
+
+/// The plane y = 0 (see the module docs).
+pub struct Ground;
+
+impl SubstepHook for Ground {
+    fn project(&mut self, world: &mut hecs::World, _substep: tetpbd::SubstepContext) {
+        for p in world.query_mut::<&mut Particles>() {
+            for x in p.positions_mut() {
+                x.y = x.y.max(0.0);
+            }
+        }
+    }
+
+    fn end_substep(&mut self, world: &mut hecs::World, _substep: tetpbd::SubstepContext) {
+        for p in world.query_mut::<&mut Particles>() {
+            for i in 0..p.len() {
+                if p.positions()[i].y <= 0.0 && p.velocities()[i].y < 0.0 {
+                    p.velocities_mut()[i].y = 0.0;
+                }
+            }
+        }
+    }
+}
