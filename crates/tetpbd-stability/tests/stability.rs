@@ -113,13 +113,6 @@ fn every_fast_cell_passes_at_defaults_but_known_limits() {
     assert_pass_at_defaults(fast_cases(None));
 }
 
-/// The recovery and impact sweeps: both grid splits, 1–80 substeps.
-#[test]
-#[ignore = "long: run in release by .ci/run"]
-fn every_sweep_cell_passes_at_defaults() {
-    assert_pass_at_defaults(all_cases(None).into_iter().filter(|c| c.sweep).collect());
-}
-
 #[test]
 fn collapsed_vertex_face_body_recovers_with_the_degenerate_fallback() {
     let config = Config {

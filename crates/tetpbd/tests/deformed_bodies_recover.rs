@@ -55,6 +55,7 @@ fn run_on(families: Families, start: Start, max_frames: usize, split: CellSplit)
         substeps: 10,
         damping: 1.0,
         max_correction_speed: Some(10.0),
+        limit_correction_energy: true,
         ..Default::default()
     })
     .unwrap();

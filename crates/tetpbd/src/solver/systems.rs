@@ -31,7 +31,7 @@ pub use crate::stabilisation::deformation_damping::damp_deformation;
 /// kinematically.
 ///
 /// A particle whose position or velocity is not finite when prediction reads it is restored
-/// first (see [`crate::solver::non_finite`]) and reported in the result.
+/// first (see [`crate::Restored`]) and reported in the result.
 pub fn predict(
     world: &mut World,
     h: f32,
