@@ -81,6 +81,7 @@ mod joints;
 mod mesh_side;
 mod placement;
 pub mod prelude;
+mod queries;
 mod report;
 mod response;
 mod rigid;
@@ -95,6 +96,10 @@ pub use attachments::{AttachTarget, Attachment, Attachments};
 pub use coupling::{Coupling, RapierContext};
 pub use error::CouplingError;
 pub use placement::RapierPlacement;
+pub use queries::{
+    QueryError, ScenePointProjection, SceneRayHit, SoftLocation, SoftPointProjection, SoftQueries,
+    SoftQueryFilter, SoftRayHit, SoftVolumePoint,
+};
 pub use report::{ContactReport, CouplingStats, SoftFeature};
 pub use scene::CoupledWorld;
 pub use settings::CouplingSettings;

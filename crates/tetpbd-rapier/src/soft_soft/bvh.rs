@@ -214,6 +214,18 @@ fn ray_triangle(
     b: &Vector3<f32>,
     c: &Vector3<f32>,
 ) -> Option<f32> {
+    ray_triangle_barycentric(o, dir, [a, b, c]).map(|(t, _)| t)
+}
+
+/// Möller–Trumbore: the ray parameter `t ≥ 0` (in units of `|dir|`) at which the ray
+/// `o + t dir` meets triangle `(a, b, c)`, and the barycentric coordinates of the hit point
+/// (weights of `a`, `b`, `c`; in `[0, 1]`, summing to 1); `None` when it misses, runs
+/// parallel to the triangle's plane or the triangle is degenerate.
+pub(crate) fn ray_triangle_barycentric(
+    o: &Vector3<f32>,
+    dir: &Vector3<f32>,
+    [a, b, c]: [&Vector3<f32>; 3],
+) -> Option<(f32, [f32; 3])> {
     let e1 = b - a;
     let e2 = c - a;
     let pv = dir.cross(&e2);
@@ -233,7 +245,7 @@ fn ray_triangle(
         return None;
     }
     let t = e2.dot(&qv) * inv;
-    (t >= 0.0 && t.is_finite()).then_some(t)
+    (t >= 0.0 && t.is_finite()).then_some((t, [1.0 - u - v, u, v]))
 }
 
 /// `true` when `x` lies strictly inside the tetrahedron `t` (either orientation).
@@ -250,6 +262,26 @@ pub(crate) fn in_tet(x: &Vector3<f32>, t: &[Vector3<f32>; 4]) -> bool {
         && vol(&t[0], x, &t[2], &t[3]) * s > 0.0
         && vol(&t[0], &t[1], x, &t[3]) * s > 0.0
         && vol(&t[0], &t[1], &t[2], x) * s > 0.0
+}
+
+/// Barycentric coordinates of `x` in tetrahedron `t` (weights of its four corners, summing
+/// to 1), when `x` lies inside it or on its boundary (all weights ≥ 0, either orientation);
+/// `None` outside or for a flat tetrahedron.
+pub(crate) fn tet_barycentric(x: &Vector3<f32>, t: &[Vector3<f32>; 4]) -> Option<[f32; 4]> {
+    let vol = |a: &Vector3<f32>, b: &Vector3<f32>, c: &Vector3<f32>, d: &Vector3<f32>| {
+        (b - a).dot(&(c - a).cross(&(d - a)))
+    };
+    let total = vol(&t[0], &t[1], &t[2], &t[3]);
+    if total == 0.0 || !total.is_finite() {
+        return None;
+    }
+    let w = [
+        vol(x, &t[1], &t[2], &t[3]) / total,
+        vol(&t[0], x, &t[2], &t[3]) / total,
+        vol(&t[0], &t[1], x, &t[3]) / total,
+        vol(&t[0], &t[1], &t[2], x) / total,
+    ];
+    w.iter().all(|w| *w >= 0.0 && w.is_finite()).then_some(w)
 }
 
 /// Unit normal `(b − a) × (c − a) / |…|` of a triangle, or `None` when it is degenerate.
