@@ -99,8 +99,10 @@ impl QueryBody {
         } else {
             Aabb::new(to_glam(&lo), to_glam(&hi))
         };
-        let none = vec![0.0; self.xs.len()];
-        self.cache.refit_triangles(&self.xs, &none);
+        // Triangle boxes grown by a hair of the body's size, so that a ray grazing a box
+        // face (a face of an axis-aligned body) is not lost to the box test's rounding.
+        let pad = vec![1e-5 * (hi - lo).norm(); self.xs.len()];
+        self.cache.refit_triangles(&self.xs, &pad);
         self.cache.refit_tets(&self.positions);
         Ok(())
     }

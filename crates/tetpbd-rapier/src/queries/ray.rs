@@ -14,6 +14,12 @@ use super::SoftQueries;
 use crate::convert::{to_glam, to_na};
 use crate::soft_soft::bvh::{ray_triangle_barycentric, triangle_normal};
 
+/// How far outside a triangle (in barycentric units) a ray still hits it, so that a ray
+/// through a vertex or edge shared by several triangles cannot slip between them by
+/// rounding. The hit point is then clamped onto the triangle: it is off by at most this
+/// fraction of the triangle's size.
+const SLACK: f32 = 1e-5;
+
 /// Where a ray met a soft body.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SoftRayHit {
@@ -128,7 +134,7 @@ fn triangle_hit(
     d: &Vector3<f32>,
 ) -> Option<SoftRayHit> {
     let [a, b, c] = body.triangle(t);
-    let (toi, barycentric) = ray_triangle_barycentric(o, d, [&a, &b, &c])?;
+    let (toi, barycentric) = ray_triangle_barycentric(o, d, [&a, &b, &c], SLACK)?;
     let normal = triangle_normal(&a, &b, &c).map_or(Vector::ZERO, |n| to_glam(&n));
     Some(SoftRayHit {
         entity: body.entity,
@@ -153,7 +159,7 @@ fn first_hit(body: &QueryBody, ray: &Ray, max_toi: f32, solid: bool) -> Option<S
     let (o, d) = (to_na(ray.origin), to_na(ray.dir));
     let (t, _) = body.cache.tri_bvh.cast_ray(ray, max_toi, |t, _| {
         let [a, b, c] = body.triangle(t as usize);
-        ray_triangle_barycentric(&o, &d, [&a, &b, &c]).map(|(toi, _)| toi)
+        ray_triangle_barycentric(&o, &d, [&a, &b, &c], SLACK).map(|(toi, _)| toi)
     })?;
     triangle_hit(body, t as usize, &o, &d)
 }

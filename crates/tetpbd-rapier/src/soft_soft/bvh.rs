@@ -214,17 +214,21 @@ fn ray_triangle(
     b: &Vector3<f32>,
     c: &Vector3<f32>,
 ) -> Option<f32> {
-    ray_triangle_barycentric(o, dir, [a, b, c]).map(|(t, _)| t)
+    ray_triangle_barycentric(o, dir, [a, b, c], 0.0).map(|(t, _)| t)
 }
 
 /// Möller–Trumbore: the ray parameter `t ≥ 0` (in units of `|dir|`) at which the ray
 /// `o + t dir` meets triangle `(a, b, c)`, and the barycentric coordinates of the hit point
 /// (weights of `a`, `b`, `c`; in `[0, 1]`, summing to 1); `None` when it misses, runs
-/// parallel to the triangle's plane or the triangle is degenerate.
+/// parallel to the triangle's plane or the triangle is degenerate. A hit up to `slack`
+/// (dimensionless, in barycentric units) outside the triangle counts, its weights clamped
+/// back onto the triangle: with a slack of a few ulps a ray through a vertex or edge shared
+/// by several triangles meets at least one of them despite rounding.
 pub(crate) fn ray_triangle_barycentric(
     o: &Vector3<f32>,
     dir: &Vector3<f32>,
     [a, b, c]: [&Vector3<f32>; 3],
+    slack: f32,
 ) -> Option<(f32, [f32; 3])> {
     let e1 = b - a;
     let e2 = c - a;
@@ -236,16 +240,24 @@ pub(crate) fn ray_triangle_barycentric(
     let inv = 1.0 / det;
     let tv = o - a;
     let u = tv.dot(&pv) * inv;
-    if !(0.0..=1.0).contains(&u) {
+    if !(-slack..=1.0 + slack).contains(&u) {
         return None;
     }
     let qv = tv.cross(&e1);
     let v = dir.dot(&qv) * inv;
-    if v < 0.0 || u + v > 1.0 {
+    if v < -slack || u + v > 1.0 + slack {
         return None;
     }
     let t = e2.dot(&qv) * inv;
-    (t >= 0.0 && t.is_finite()).then_some((t, [1.0 - u - v, u, v]))
+    if !(t >= 0.0 && t.is_finite()) {
+        return None;
+    }
+    if slack == 0.0 {
+        return Some((t, [1.0 - u - v, u, v]));
+    }
+    let w = [1.0 - u - v, u, v].map(|w| w.max(0.0));
+    let sum = w[0] + w[1] + w[2];
+    Some((t, w.map(|w| w / sum)))
 }
 
 /// `true` when `x` lies strictly inside the tetrahedron `t` (either orientation).
