@@ -1,31 +1,7 @@
 //! Scene queries against soft bodies: ray casts, point projection and containment, AABB and
 //! shape overlap, and the same ray cast and projection over rapier's colliders and the soft
-//! bodies in one call.
-//!
-//! # The snapshot and when to refresh it
-//!
-//! [`SoftQueries`] answers against a *snapshot* of the soft bodies: their particle positions,
-//! collision groups and bounds as they were at the last [`SoftQueries::update`]. Each body
-//! keeps a BVH over its surface triangles and one over its tetrahedra (the soft–soft
-//! contacts' per-body structure, built once per mesh on its shape at the first update and
-//! refitted — boxes only, O(particles + tetrahedra) — at every later update), and a BVH over
-//! the bodies' bounds is rebuilt at every update (O(bodies · log bodies)).
-//!
-//! **Rule:** call [`SoftQueries::update`] after every step and after writing particle
-//! positions, adding or removing bodies or changing a body's `SoftCollider`; every query
-//! answers for the world as it was at that call, whatever happened since. Nothing is read
-//! from the world during a query, so the answers of one frame are consistent with each other.
-//!
-//! # Conventions
-//!
-//! Inputs and outputs are rapier's types ([`Ray`](rapier3d::geometry::Ray), glam
-//! [`Vector`](rapier3d::math::Vector), [`Pose`](rapier3d::math::Pose),
-//! [`Aabb`](rapier3d::geometry::Aabb)); lengths are in metres, a time of impact in units of
-//! the ray direction's length (m when it is a unit vector), as in rapier. Normals are the
-//! outward unit normals of the surface triangles (triangles are wound outwards,
-//! `tetpbd::Surface`). Non-finite inputs are rejected with a [`QueryError`] naming the
-//! value; bodies whose positions are not finite are left out of the snapshot and listed
-//! by [`SoftQueries::skipped`].
+//! bodies in one call. [`SoftQueries`] holds the snapshot the queries answer against (its
+//! docs give the refresh rule and the conventions); one file per kind of query.
 
 mod body;
 mod error;
@@ -50,9 +26,41 @@ pub use point::{SoftPointProjection, SoftVolumePoint};
 pub use ray::SoftRayHit;
 pub use scene::{ScenePointProjection, SceneRayHit};
 
-/// Scene queries against the soft bodies of a hecs world (see the `queries` module docs
-/// above for the snapshot rule: call [`SoftQueries::update`] after every step and after
-/// writing positions).
+/// Scene queries against the soft bodies of a hecs world: ray casts
+/// ([`cast_ray`](Self::cast_ray), [`intersect_ray`](Self::intersect_ray)), point projection
+/// and containment ([`project_point`](Self::project_point),
+/// [`contains_point`](Self::contains_point), [`intersect_point`](Self::intersect_point)),
+/// overlaps ([`intersect_aabb`](Self::intersect_aabb),
+/// [`intersect_shape`](Self::intersect_shape)), and the nearest ray hit or surface point over
+/// rapier's colliders and the soft bodies at once ([`cast_ray_scene`](Self::cast_ray_scene),
+/// [`project_point_scene`](Self::project_point_scene)). Every query takes a
+/// [`SoftQueryFilter`] (groups, an excluded entity, a predicate), like rapier's
+/// `QueryFilter`.
+///
+/// # The snapshot, and when to refresh it
+///
+/// The queries answer against a *snapshot*: every soft body's particle positions, collision
+/// groups and bounds as they were at the last [`SoftQueries::update`]. **Call `update` after
+/// every step, and after writing particle positions, adding or removing bodies or changing a
+/// body's [`SoftCollider`]**; until then the queries answer for the world as it was (nothing
+/// is read from the world during a query, so the answers of one frame agree with each other).
+///
+/// Each body keeps a BVH over its surface triangles and one over its tetrahedra (the
+/// soft–soft contacts' per-body structure), built on the body's shape the first time it is
+/// seen or when its mesh changes, and refitted (boxes only) at every later `update`: cost
+/// O(particles + tetrahedra) per body. A BVH over the bodies' bounds is rebuilt at every
+/// `update`. Figures: `docs/performance.md`, "Scene queries".
+///
+/// # Conventions
+///
+/// Inputs and outputs are rapier's types ([`Ray`](rapier3d::geometry::Ray), glam
+/// [`Vector`](rapier3d::math::Vector), [`Pose`](rapier3d::math::Pose),
+/// [`Aabb`](rapier3d::geometry::Aabb)); lengths in m; a time of impact in units of the ray
+/// direction's length (m for a unit direction), as in rapier. Normals are the outward unit
+/// normals of the surface triangles. A NaN or infinite input is rejected with a
+/// [`QueryError`] naming the value; a body whose positions are not finite is left out of the
+/// snapshot and listed by [`SoftQueries::skipped`]. Bodies whose `SoftCollider` is disabled
+/// are not in the snapshot.
 ///
 /// ```
 /// use nalgebra::Vector3;

@@ -5,6 +5,7 @@ use hecs::Entity;
 use nalgebra::Vector3;
 use rapier3d::geometry::Ray;
 use rapier3d::math::Vector;
+use rapier3d::parry::partitioning::BvhNode;
 
 use super::body::QueryBody;
 use super::error::{check_limit, check_vector, QueryError};
@@ -89,7 +90,7 @@ impl SoftQueries {
         check_ray(ray, max_toi)?;
         let mut bodies: Vec<u32> = self
             .top
-            .leaves(|node| node.cast_ray(ray, max_toi) <= max_toi)
+            .leaves(|node| ray_meets(node, ray, max_toi))
             .collect();
         bodies.sort_unstable();
         let mut hits = Vec::new();
@@ -102,6 +103,13 @@ impl SoftQueries {
         hits.sort_by(|a, b| a.time_of_impact.total_cmp(&b.time_of_impact));
         Ok(hits)
     }
+}
+
+/// `true` when the ray meets the node's box within `max_toi` (`BvhNode::cast_ray` answers
+/// `f32::MAX` for a miss).
+fn ray_meets(node: &BvhNode, ray: &Ray, max_toi: f32) -> bool {
+    let toi = node.cast_ray(ray, max_toi);
+    toi < f32::MAX && toi <= max_toi
 }
 
 /// Rejects a non-finite ray or a bad `max_toi`.
@@ -176,7 +184,7 @@ fn all_hits(body: &QueryBody, ray: &Ray, max_toi: f32, solid: bool, out: &mut Ve
     let tris = body
         .cache
         .tri_bvh
-        .leaves(|node| node.cast_ray(ray, max_toi) <= max_toi);
+        .leaves(|node| ray_meets(node, ray, max_toi));
     for t in tris {
         if let Some(hit) = triangle_hit(body, t as usize, &o, &d) {
             if hit.time_of_impact <= max_toi {
