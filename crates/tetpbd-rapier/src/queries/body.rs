@@ -79,8 +79,12 @@ impl QueryBody {
         self.cache.matches(surface, tets, positions.len())
     }
 
-    /// Copies the positions and refits both BVHs and the body's bounds to them.
+    /// Copies the positions and refits both BVHs and the body's bounds to them (nothing to do
+    /// for a body that has not moved since the last snapshot).
     pub fn refit(&mut self, positions: &[Vector3<f32>]) -> Result<(), Skip> {
+        if self.positions == positions {
+            return Ok(());
+        }
         if !positions.iter().all(finite3) {
             return Err(Skip::NonFinite);
         }

@@ -97,7 +97,7 @@ impl BodyCache {
             let aabb = Aabb::new(to_glam(&lo), to_glam(&hi));
             self.tri_bvh.insert_or_update_partially(aabb, t as u32, 0.0);
         }
-        self.tri_bvh.refit(&mut self.workspace);
+        self.tri_bvh.refit_without_opt();
     }
 
     /// Refits the tetrahedron BVH to the particle positions `p` (all particles).
@@ -111,7 +111,7 @@ impl BodyCache {
             let aabb = Aabb::new(to_glam(&lo), to_glam(&hi));
             self.tet_bvh.insert_or_update_partially(aabb, t as u32, 0.0);
         }
-        self.tet_bvh.refit(&mut self.workspace);
+        self.tet_bvh.refit_without_opt();
     }
 
     /// Builds the one-ring exclusion lists (once) for self collision.
