@@ -122,3 +122,57 @@ fn the_nearer_of_a_rigid_cuboid_and_a_soft_cube_is_hit_first() {
         "{rigid_wins} rigid, {soft_wins} soft"
     );
 }
+
+#[test]
+fn a_coupled_world_answers_for_its_current_state_after_steps_and_writes() {
+    use tetpbd_rapier::CoupledWorld;
+    let mut scene = CoupledWorld::new(Default::default(), Default::default()).unwrap();
+    scene.physics.insert(
+        RigidBodyBuilder::fixed().translation(rapier3d::math::Vector::new(0.0, -0.5, 0.0)),
+        ColliderBuilder::cuboid(3.0, 0.5, 3.0),
+    );
+    let cube = spawn_cube(
+        &mut scene.soft,
+        0.2,
+        2,
+        Isometry3::translation(0.0, 0.25, 0.0),
+    );
+    let ray = Ray::new(
+        rapier3d::math::Vector::new(0.0, 3.0, 0.0),
+        -rapier3d::math::Vector::Y,
+    );
+    let all = SoftQueryFilter::new();
+    for frame in 0..30 {
+        scene.step().unwrap();
+        let top = {
+            let p = scene.soft.get::<&tetpbd::Particles>(cube).unwrap();
+            p.positions().iter().map(|x| x.y).fold(f32::MIN, f32::max)
+        };
+        let (soft, rigid) = scene.queries();
+        let hit = soft
+            .cast_ray_scene(&rigid, &ray, f32::MAX, true, all)
+            .unwrap();
+        let Some(SceneRayHit::Soft(h)) = hit else {
+            panic!("frame {frame}: {hit:?}");
+        };
+        assert_eq!(h.entity, cube);
+        // The top face is where the particles are now (it sags a little under gravity).
+        assert!(
+            (h.time_of_impact - (3.0 - top)).abs() < 0.02,
+            "frame {frame}: {} vs top {top}",
+            h.time_of_impact
+        );
+    }
+    // The user lifts the cube by 1 m: the next call sees it.
+    for x in scene
+        .soft
+        .get::<&mut tetpbd::Particles>(cube)
+        .unwrap()
+        .positions_mut()
+    {
+        x.y += 1.0;
+    }
+    let (soft, _) = scene.queries();
+    let h = soft.cast_ray(&ray, f32::MAX, true, all).unwrap().unwrap();
+    assert!(h.time_of_impact < 3.0 - 1.0, "{}", h.time_of_impact);
+}
