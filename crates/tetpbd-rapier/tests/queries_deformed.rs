@@ -13,7 +13,6 @@ use tetpbd_rapier::{SoftQueries, SoftQueryFilter};
 #[test]
 fn stretched_and_moved_cubes_are_hit_where_their_new_faces_are() {
     let mut rng = Rng::new(51);
-    let f = SoftQueryFilter::new();
     for case in 0..20 {
         let h = rng.range(0.1, 1.0);
         let mut world = World::new();
@@ -49,48 +48,76 @@ fn stretched_and_moved_cubes_are_hit_where_their_new_faces_are() {
             let half = (hi - lo).component_mul(&stretch) / 2.0;
             for axis in 0..3 {
                 for sign in [-1.0f32, 1.0] {
-                    let mut n = Vector3::zeros();
-                    n[axis] = sign;
-                    let mut target = new_centre + n.component_mul(&half);
-                    for k in (0..3).filter(|&k| k != axis) {
-                        target[k] += rng.range(-0.9, 0.9) * half[k];
-                    }
-                    let gap = rng.range(0.1, 2.0);
-                    let ray = Ray::new(glam(&(target + n * gap)), glam(&-n));
-                    let what = format!("case {case}, round {round}, face {n:?}");
-                    let hit = queries
-                        .cast_ray(&ray, f32::MAX, true, f)
-                        .unwrap()
-                        .expect(&what);
-                    let tol = 2e-4 * (1.0 + half.norm() + new_centre.norm() + gap);
-                    assert!(
-                        (hit.time_of_impact - gap).abs() < tol,
-                        "{what}: {} vs {gap}",
-                        hit.time_of_impact
-                    );
-                    assert!((na(hit.normal) - n).norm() < 1e-4, "{what}");
-                    assert!(
-                        (location_point(&world, cube, &hit.location) - target).norm() < tol,
-                        "{what}"
-                    );
-                    // Just inside and just outside the new face.
-                    let inside = target - n * (0.01 * half[axis]);
-                    let outside = target + n * (0.01 * half[axis]);
-                    assert!(
-                        queries.contains_point(glam(&inside), f).unwrap().is_some(),
-                        "{what}: inside"
-                    );
-                    assert!(
-                        queries.contains_point(glam(&outside), f).unwrap().is_none(),
-                        "{what}: outside"
-                    );
-                    let p = queries
-                        .project_point(glam(&outside), f32::MAX, f)
-                        .unwrap()
-                        .expect(&what);
-                    assert!((na(p.point) - target).norm() < tol, "{what}: projection");
+                    let what = format!("case {case}, round {round}, axis {axis}, side {sign}");
+                    let face = Face {
+                        axis,
+                        sign,
+                        centre: new_centre,
+                        half,
+                    };
+                    check_face(&queries, &world, cube, &face, &mut rng, &what);
                 }
             }
         }
     }
+}
+
+/// A face of an axis-aligned box: its axis, side (±1), the box's centre and half extents, m.
+struct Face {
+    axis: usize,
+    sign: f32,
+    centre: Vector3<f32>,
+    half: Vector3<f32>,
+}
+
+/// A ray at a random point of the face hits it at the analytic distance, and points just
+/// inside and outside the face are told apart and projected onto it.
+fn check_face(
+    queries: &SoftQueries,
+    world: &World,
+    cube: hecs::Entity,
+    face: &Face,
+    rng: &mut Rng,
+    what: &str,
+) {
+    let f = SoftQueryFilter::new();
+    let (axis, half) = (face.axis, face.half);
+    let mut n = Vector3::zeros();
+    n[axis] = face.sign;
+    let mut target = face.centre + n.component_mul(&half);
+    for k in (0..3).filter(|&k| k != axis) {
+        target[k] += rng.range(-0.9, 0.9) * half[k];
+    }
+    let gap = rng.range(0.1, 2.0);
+    let ray = Ray::new(glam(&(target + n * gap)), glam(&-n));
+    let hit = queries
+        .cast_ray(&ray, f32::MAX, true, f)
+        .unwrap()
+        .expect(what);
+    let tol = 2e-4 * (1.0 + half.norm() + face.centre.norm() + gap);
+    assert!(
+        (hit.time_of_impact - gap).abs() < tol,
+        "{what}: {} vs {gap}",
+        hit.time_of_impact
+    );
+    assert!((na(hit.normal) - n).norm() < 1e-4, "{what}");
+    assert!(
+        (location_point(world, cube, &hit.location) - target).norm() < tol,
+        "{what}"
+    );
+    let inside = target - n * (0.01 * half[axis]);
+    let outside = target + n * (0.01 * half[axis]);
+    assert!(
+        queries.contains_point(glam(&inside), f).unwrap().is_some(),
+        "{what}: inside"
+    );
+    assert!(
+        queries.contains_point(glam(&outside), f).unwrap().is_none(),
+        "{what}: outside"
+    );
+    let p = queries
+        .project_point(glam(&outside), f32::MAX, f)
+        .unwrap()
+        .expect(what);
+    assert!((na(p.point) - target).norm() < tol, "{what}: projection");
 }

@@ -109,21 +109,33 @@ fn aabbs_find_the_bodies_whose_bounds_they_meet() {
     assert!(queries.intersect_aabb(&above, f).unwrap().is_empty());
 }
 
-#[test]
-fn groups_predicates_excluded_and_disabled_bodies_are_not_seen_by_any_query() {
-    let mut rng = Rng::new(32);
-    let g1 = InteractionGroups::new(Group::GROUP_1, Group::ALL, InteractionTestMode::And);
-    let g2 = InteractionGroups::new(Group::GROUP_2, Group::ALL, InteractionTestMode::And);
-    let only = |g: Group| InteractionGroups::new(Group::ALL, g, InteractionTestMode::And);
-    for case in 0..10 {
-        // Three cubes in a row along a random direction: near (group 1), middle (group 2),
-        // far (disabled); all along the same ray.
+/// Three cubes in a row along a ray: near (group 1), middle (group 2), far (disabled).
+struct Row {
+    queries: SoftQueries,
+    ray: Ray,
+    near: hecs::Entity,
+    middle: hecs::Entity,
+    /// Centre of cube `k` (1 near, 2 middle, 3 far), m.
+    centres: [Vector; 4],
+    h: f32,
+}
+
+/// Groups that accept only the members of `g`.
+fn only(g: Group) -> InteractionGroups {
+    InteractionGroups::new(Group::ALL, g, InteractionTestMode::And)
+}
+
+impl Row {
+    fn new(rng: &mut Rng) -> Row {
+        let g1 = InteractionGroups::new(Group::GROUP_1, Group::ALL, InteractionTestMode::And);
+        let g2 = InteractionGroups::new(Group::GROUP_2, Group::ALL, InteractionTestMode::And);
         let rot = rng.rotation();
         let x = rot * Vector3::x();
         let start = rng.cube() * 3.0;
         let mut world = World::new();
         let h = rng.range(0.2, 0.6);
-        let place = |k: f32| Isometry3::from_parts((start + x * (3.0 * k)).into(), rot);
+        let centre = |k: f32| start + x * (3.0 * k);
+        let place = |k: f32| Isometry3::from_parts(centre(k).into(), rot);
         let near = spawn_cube(&mut world, h, 2, place(1.0));
         let middle = spawn_cube(&mut world, h, 2, place(2.0));
         let far = spawn_cube(&mut world, h, 2, place(3.0));
@@ -140,81 +152,127 @@ fn groups_predicates_excluded_and_disabled_bodies_are_not_seen_by_any_query() {
         world.insert_one(far, off).unwrap();
         let mut queries = SoftQueries::new();
         queries.update(&world);
+        let centres = [0.0, 1.0, 2.0, 3.0].map(|k| glam(&centre(k)));
         let ray = Ray::new(glam(&start), glam(&x));
-        let first = |f: SoftQueryFilter| {
-            queries
-                .cast_ray(&ray, f32::MAX, false, f)
-                .unwrap()
-                .map(|h| h.entity)
-        };
-        let crossed = |f: SoftQueryFilter| {
-            let mut e: Vec<_> = queries
-                .intersect_ray(&ray, f32::MAX, false, f)
-                .unwrap()
-                .iter()
-                .map(|h| h.entity)
-                .collect();
-            e.dedup();
-            e
-        };
+        Row {
+            queries,
+            ray,
+            near,
+            middle,
+            centres,
+            h,
+        }
+    }
+
+    fn first(&self, f: SoftQueryFilter) -> Option<hecs::Entity> {
+        let hit = self
+            .queries
+            .cast_ray(&self.ray, f32::MAX, false, f)
+            .unwrap();
+        hit.map(|h| h.entity)
+    }
+
+    fn crossed(&self, f: SoftQueryFilter) -> Vec<hecs::Entity> {
+        let hits = self
+            .queries
+            .intersect_ray(&self.ray, f32::MAX, false, f)
+            .unwrap();
+        let mut e: Vec<_> = hits.iter().map(|h| h.entity).collect();
+        e.dedup();
+        e
+    }
+}
+
+#[test]
+fn groups_predicates_excluded_and_disabled_bodies_are_not_seen_by_rays() {
+    let mut rng = Rng::new(32);
+    for case in 0..10 {
+        let r = Row::new(&mut rng);
+        let (near, middle) = (r.near, r.middle);
         let all = SoftQueryFilter::new();
-        assert_eq!(first(all), Some(near), "case {case}");
+        assert_eq!(r.first(all), Some(near), "case {case}");
         assert_eq!(
-            crossed(all),
+            r.crossed(all),
             vec![near, middle],
             "case {case}: the disabled body is never seen"
         );
         assert_eq!(
-            first(all.groups(only(Group::GROUP_2))),
+            r.first(all.groups(only(Group::GROUP_2))),
             Some(middle),
             "case {case}"
         );
-        assert_eq!(first(all.exclude_entity(near)), Some(middle), "case {case}");
+        assert_eq!(
+            r.first(all.exclude_entity(near)),
+            Some(middle),
+            "case {case}"
+        );
         let not_middle = |e: hecs::Entity| e != middle;
         assert_eq!(
-            crossed(all.predicate(&not_middle)),
+            r.crossed(all.predicate(&not_middle)),
             vec![near],
             "case {case}"
         );
-        assert_eq!(first(all.groups(only(Group::GROUP_3))), None, "case {case}");
-        // The same filters on point, AABB and shape queries.
-        let centre = |k: f32| glam(&(start + x * (3.0 * k)));
-        let p = centre(1.0);
         assert_eq!(
-            queries.contains_point(p, all).unwrap().map(|v| v.entity),
-            Some(near)
+            r.first(all.groups(only(Group::GROUP_3))),
+            None,
+            "case {case}"
         );
-        assert!(queries
-            .contains_point(p, all.exclude_entity(near))
-            .unwrap()
-            .is_none());
+    }
+}
+
+#[test]
+fn groups_predicates_excluded_and_disabled_bodies_are_not_seen_by_point_and_overlap_queries() {
+    let mut rng = Rng::new(33);
+    for case in 0..10 {
+        let r = Row::new(&mut rng);
+        let (q, near, middle) = (&r.queries, r.near, r.middle);
+        let all = SoftQueryFilter::new();
+        let p = r.centres[1];
+        assert_eq!(
+            q.contains_point(p, all).unwrap().map(|v| v.entity),
+            Some(near),
+            "case {case}"
+        );
         assert!(
-            queries.contains_point(centre(3.0), all).unwrap().is_none(),
-            "disabled"
+            q.contains_point(p, all.exclude_entity(near))
+                .unwrap()
+                .is_none(),
+            "case {case}"
         );
-        let proj = queries
+        assert!(
+            q.contains_point(r.centres[3], all).unwrap().is_none(),
+            "case {case}: disabled"
+        );
+        let proj = q
             .project_point(p, f32::MAX, all.groups(only(Group::GROUP_2)))
             .unwrap();
-        assert_eq!(proj.map(|p| p.entity), Some(middle));
+        assert_eq!(proj.map(|p| p.entity), Some(middle), "case {case}");
         let everything = Aabb::new(Vector::splat(-100.0), Vector::splat(100.0));
         let mut two = vec![near, middle];
         two.sort_by_key(|e| e.to_bits());
-        assert_eq!(queries.intersect_aabb(&everything, all).unwrap(), two);
         assert_eq!(
-            queries
-                .intersect_aabb(&everything, all.predicate(&not_middle))
-                .unwrap(),
-            vec![near]
+            q.intersect_aabb(&everything, all).unwrap(),
+            two,
+            "case {case}"
         );
-        let ball = Ball::new(0.5 * h);
-        let at_middle = Pose::from_translation(centre(2.0));
+        let not_middle = |e: hecs::Entity| e != middle;
+        let seen = q
+            .intersect_aabb(&everything, all.predicate(&not_middle))
+            .unwrap();
+        assert_eq!(seen, vec![near], "case {case}");
+        let ball = Ball::new(0.5 * r.h);
+        let at_middle = Pose::from_translation(r.centres[2]);
         assert_eq!(
-            queries.intersect_shape(&at_middle, &ball, all).unwrap(),
-            vec![middle]
+            q.intersect_shape(&at_middle, &ball, all).unwrap(),
+            vec![middle],
+            "case {case}"
         );
-        assert!(queries
-            .intersect_shape(&at_middle, &ball, all.groups(only(Group::GROUP_1)))
-            .unwrap()
-            .is_empty());
+        let g1_only = all.groups(only(Group::GROUP_1));
+        assert!(
+            q.intersect_shape(&at_middle, &ball, g1_only)
+                .unwrap()
+                .is_empty(),
+            "case {case}"
+        );
     }
 }

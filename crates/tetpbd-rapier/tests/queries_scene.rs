@@ -6,17 +6,25 @@ mod queries_common;
 use hecs::World;
 use nalgebra::{Isometry3, Vector3};
 use queries_common::{glam, spawn_cube, Rng};
-use rapier3d::geometry::Ray;
+use rapier3d::geometry::{ColliderHandle, Ray};
 use rapier3d::prelude::{ColliderBuilder, PhysicsWorld, QueryFilter, RigidBodyBuilder};
 use tetpbd_rapier::{ScenePointProjection, SceneRayHit, SoftQueries, SoftQueryFilter};
 
-#[test]
-fn the_nearer_of_a_rigid_cuboid_and_a_soft_cube_is_hit_first() {
-    let mut rng = Rng::new(41);
-    let (mut rigid_wins, mut soft_wins) = (0, 0);
-    for case in 0..40 {
-        // Along a random direction from a random origin: a soft cube and a rigid cuboid at
-        // random distances, one behind the other, both facing the ray.
+/// A soft cube and a rigid cuboid one behind the other along a ray, both facing it.
+struct Case {
+    queries: SoftQueries,
+    physics: PhysicsWorld,
+    soft: hecs::Entity,
+    collider: ColliderHandle,
+    ray: Ray,
+    /// Distances along the ray to the two bodies' facing faces, m.
+    soft_at: f32,
+    rigid_at: f32,
+}
+
+impl Case {
+    /// Along a random direction from a random origin, at random sizes and distances.
+    fn new(rng: &mut Rng) -> Case {
         let rot = rng.rotation();
         let x = rot * Vector3::x();
         let origin = rng.cube() * 3.0;
@@ -30,12 +38,8 @@ fn the_nearer_of_a_rigid_cuboid_and_a_soft_cube_is_hit_first() {
         let soft_centre = origin + x * (soft_at + hs);
         let rigid_centre = origin + x * (rigid_at + hr);
         let mut world = World::new();
-        let soft = spawn_cube(
-            &mut world,
-            hs,
-            2,
-            Isometry3::from_parts(soft_centre.into(), rot),
-        );
+        let soft_pose = Isometry3::from_parts(soft_centre.into(), rot);
+        let soft = spawn_cube(&mut world, hs, 2, soft_pose);
         let mut queries = SoftQueries::new();
         queries.update(&world);
         let mut physics = PhysicsWorld::new();
@@ -50,72 +54,117 @@ fn the_nearer_of_a_rigid_cuboid_and_a_soft_cube_is_hit_first() {
         );
         physics.step();
         let ray = Ray::new(glam(&origin), glam(&x));
-        let rigid = physics.query_pipeline();
-        let all = SoftQueryFilter::new();
-        let hit = queries
-            .cast_ray_scene(&rigid, &ray, f32::MAX, true, all)
-            .unwrap()
-            .expect("a hit");
-        let tol = 2e-4 * (1.0 + soft_at + rigid_at);
-        match hit {
-            SceneRayHit::Soft(h) => {
-                soft_wins += 1;
-                assert!(soft_at < rigid_at, "case {case}");
-                assert_eq!(h.entity, soft);
-                assert!((h.time_of_impact - soft_at).abs() < tol, "case {case}");
-            }
-            SceneRayHit::Rigid {
-                collider: c,
-                intersection,
-            } => {
-                rigid_wins += 1;
-                assert!(rigid_at < soft_at, "case {case}");
-                assert_eq!(c, collider);
-                assert!(
-                    (intersection.time_of_impact - rigid_at).abs() < tol,
-                    "case {case}"
-                );
-            }
+        Case {
+            queries,
+            physics,
+            soft,
+            collider,
+            ray,
+            soft_at,
+            rigid_at,
         }
-        assert!((hit.time_of_impact() - soft_at.min(rigid_at)).abs() < tol);
+    }
+
+    fn tol(&self) -> f32 {
+        2e-4 * (1.0 + self.soft_at + self.rigid_at)
+    }
+
+    /// Checks that the nearer body is hit first, and returns whether it was the soft one.
+    fn check_first_hit(&self, case: usize) -> bool {
+        let rigid = self.physics.query_pipeline();
+        let all = SoftQueryFilter::new();
+        let hit = self
+            .queries
+            .cast_ray_scene(&rigid, &self.ray, f32::MAX, true, all);
+        let hit = hit.unwrap().expect("a hit");
+        let near = self.soft_at.min(self.rigid_at);
         assert!(
-            (hit.normal() + glam(&x)).length() < 1e-3,
+            (hit.time_of_impact() - near).abs() < self.tol(),
+            "case {case}"
+        );
+        assert!(
+            (hit.normal() + self.ray.dir).length() < 1e-3,
             "case {case}: facing the ray"
         );
-        // Excluding the nearer one on its side shows the other.
-        let far = soft_at.max(rigid_at);
-        let next = match hit {
-            SceneRayHit::Soft(_) => {
-                queries.cast_ray_scene(&rigid, &ray, f32::MAX, true, all.exclude_entity(soft))
+        match hit {
+            SceneRayHit::Soft(h) => {
+                assert!(self.soft_at < self.rigid_at, "case {case}");
+                assert_eq!(h.entity, self.soft);
+                true
             }
-            SceneRayHit::Rigid { .. } => {
-                let rigid = physics
-                    .query_pipeline_with_filter(QueryFilter::new().exclude_collider(collider));
-                queries.cast_ray_scene(&rigid, &ray, f32::MAX, true, all)
+            SceneRayHit::Rigid { collider, .. } => {
+                assert!(self.rigid_at < self.soft_at, "case {case}");
+                assert_eq!(collider, self.collider);
+                false
             }
+        }
+    }
+
+    /// Excluding the nearer body on its side, the farther one is hit; a max time of impact
+    /// short of both hits nothing.
+    fn check_farther_and_short(&self, case: usize, soft_nearer: bool) {
+        let all = SoftQueryFilter::new();
+        let next = if soft_nearer {
+            let rigid = self.physics.query_pipeline();
+            let no_soft = all.exclude_entity(self.soft);
+            self.queries
+                .cast_ray_scene(&rigid, &self.ray, f32::MAX, true, no_soft)
+        } else {
+            let filter = QueryFilter::new().exclude_collider(self.collider);
+            let rigid = self.physics.query_pipeline_with_filter(filter);
+            self.queries
+                .cast_ray_scene(&rigid, &self.ray, f32::MAX, true, all)
         };
         let next = next.unwrap().expect("the farther one");
+        let far = self.soft_at.max(self.rigid_at);
         assert!(
-            (next.time_of_impact() - far).abs() < tol,
-            "case {case}: {next:?}, far {far}, soft {soft_at}, rigid {rigid_at}"
+            (next.time_of_impact() - far).abs() < self.tol(),
+            "case {case}: {next:?}"
         );
-        // A max time of impact short of both: nothing.
-        let none = queries
-            .cast_ray_scene(&rigid, &ray, 0.9 * soft_at.min(rigid_at), true, all)
-            .unwrap();
-        assert!(none.is_none(), "case {case}");
-        // The nearest surface point from the ray origin: the nearer body's facing face.
-        let p = queries
-            .project_point_scene(&rigid, glam(&origin), f32::MAX, all)
-            .unwrap()
-            .expect("a point");
-        let d = (p.point() - glam(&origin)).length();
-        assert!(d <= soft_at.min(rigid_at) + tol, "case {case}");
+        let short = 0.9 * self.soft_at.min(self.rigid_at);
+        let rigid = self.physics.query_pipeline();
+        let none = self
+            .queries
+            .cast_ray_scene(&rigid, &self.ray, short, true, all);
+        assert!(none.unwrap().is_none(), "case {case}");
+    }
+
+    /// The nearest surface point from the ray's origin is the centre of the nearer body's
+    /// facing face (the farther body lies wholly beyond its own facing plane).
+    fn check_projection(&self, case: usize, soft_nearer: bool) {
+        let rigid = self.physics.query_pipeline();
+        let origin = self.ray.origin;
+        let p = self
+            .queries
+            .project_point_scene(&rigid, origin, f32::MAX, SoftQueryFilter::new());
+        let p = p.unwrap().expect("a point");
+        let near = self.soft_at.min(self.rigid_at);
+        let expected = origin + self.ray.dir * near;
+        assert!((p.point() - expected).length() < self.tol(), "case {case}");
         assert!(!p.is_inside());
         match p {
-            ScenePointProjection::Soft(s) => assert_eq!(s.entity, soft),
-            ScenePointProjection::Rigid { collider: c, .. } => assert_eq!(c, collider),
+            ScenePointProjection::Soft(s) => assert!(soft_nearer && s.entity == self.soft),
+            ScenePointProjection::Rigid { collider, .. } => {
+                assert!(!soft_nearer && collider == self.collider)
+            }
         }
+    }
+}
+
+#[test]
+fn the_nearer_of_a_rigid_cuboid_and_a_soft_cube_is_hit_first() {
+    let mut rng = Rng::new(41);
+    let (mut rigid_wins, mut soft_wins) = (0, 0);
+    for case in 0..40 {
+        let c = Case::new(&mut rng);
+        let soft_nearer = c.check_first_hit(case);
+        if soft_nearer {
+            soft_wins += 1;
+        } else {
+            rigid_wins += 1;
+        }
+        c.check_farther_and_short(case, soft_nearer);
+        c.check_projection(case, soft_nearer);
     }
     assert!(
         rigid_wins > 5 && soft_wins > 5,
