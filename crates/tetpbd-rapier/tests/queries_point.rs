@@ -229,3 +229,75 @@ fn non_finite_points_and_bad_distances_are_rejected_by_name() {
         "{err}"
     );
 }
+
+#[test]
+fn a_body_with_non_finite_positions_is_left_out_and_listed() {
+    let mut world = World::new();
+    let good = spawn_cube(&mut world, 0.5, 2, Isometry3::identity());
+    let bad = spawn_cube(&mut world, 0.5, 2, Isometry3::translation(0.0, 2.0, 0.0));
+    let mut queries = SoftQueries::new();
+    queries.update(&world);
+    assert_eq!(queries.len(), 2);
+    assert!(queries.skipped().is_empty());
+    world.get::<&mut Particles>(bad).unwrap().positions_mut()[3].y = f32::NAN;
+    queries.update(&world);
+    assert_eq!(queries.skipped(), &[bad]);
+    assert_eq!(queries.len(), 1);
+    let f = SoftQueryFilter::new();
+    // A ray down through both: only the good body answers, nothing panics.
+    let ray = rapier3d::geometry::Ray::new(Vector::new(0.0, 5.0, 0.0), -Vector::Y);
+    let hits = queries.intersect_ray(&ray, f32::MAX, true, f).unwrap();
+    assert!(!hits.is_empty() && hits.iter().all(|h| h.entity == good));
+    assert!(queries
+        .contains_point(Vector::new(0.0, 2.0, 0.0), f)
+        .unwrap()
+        .is_none());
+    // Repaired, it is back.
+    world.get::<&mut Particles>(bad).unwrap().positions_mut()[3].y = 2.0 - 0.5;
+    queries.update(&world);
+    assert!(queries.skipped().is_empty());
+    let v = queries
+        .contains_point(Vector::new(0.1, 2.1, 0.1), f)
+        .unwrap();
+    assert_eq!(v.map(|v| v.entity), Some(bad));
+}
+
+#[test]
+fn degenerate_rays_and_empty_snapshots_answer_nothing_without_panicking() {
+    let mut world = World::new();
+    let cube = spawn_cube(&mut world, 0.5, 2, Isometry3::identity());
+    let mut queries = SoftQueries::new();
+    let f = SoftQueryFilter::new();
+    let ray = |o: Vector, d: Vector| rapier3d::geometry::Ray::new(o, d);
+    // Before any update: nothing to see.
+    assert!(queries
+        .cast_ray(&ray(Vector::ZERO, Vector::X), f32::MAX, true, f)
+        .unwrap()
+        .is_none());
+    assert!(queries
+        .project_point(Vector::ZERO, f32::MAX, f)
+        .unwrap()
+        .is_none());
+    queries.update(&world);
+    // A zero direction: a solid ray from inside still hits at 0, from outside nothing.
+    let inside = queries
+        .cast_ray(&ray(Vector::splat(0.1), Vector::ZERO), f32::MAX, true, f)
+        .unwrap();
+    assert_eq!(
+        inside.map(|h| (h.entity, h.time_of_impact)),
+        Some((cube, 0.0))
+    );
+    let outside = queries
+        .intersect_ray(&ray(Vector::splat(3.0), Vector::ZERO), f32::MAX, false, f)
+        .unwrap();
+    assert!(outside.is_empty());
+    // A zero max time of impact from outside: nothing; max_toi = 0 from inside with solid: the body.
+    assert!(queries
+        .cast_ray(&ray(Vector::new(0.0, 3.0, 0.0), -Vector::Y), 0.0, true, f)
+        .unwrap()
+        .is_none());
+    assert!(queries
+        .cast_ray(&ray(Vector::ZERO, Vector::Y), 0.0, true, f)
+        .unwrap()
+        .is_some());
+}

@@ -56,8 +56,9 @@ impl SoftQueries {
         check_vector("point", point)?;
         check_limit("max_dist", max_dist)?;
         let x = to_na(point);
+        // The search keeps costs strictly below its limit; a point at exactly `max_dist` counts.
         let best = self.top.find_best(
-            max_dist,
+            max_dist.next_up(),
             |node, _| node.aabb().distance_to_local_point(point, true),
             |leaf, best| {
                 let body = self.bodies.get(leaf as usize)?;

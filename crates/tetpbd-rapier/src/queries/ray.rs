@@ -58,8 +58,9 @@ impl SoftQueries {
         filter: SoftQueryFilter,
     ) -> Result<Option<SoftRayHit>, QueryError> {
         check_ray(ray, max_toi)?;
+        // The search keeps costs strictly below its limit; a hit at exactly `max_toi` counts.
         let best = self.top.find_best(
-            max_toi,
+            max_toi.next_up(),
             |node, best| node.cast_ray(ray, best),
             |leaf, best| {
                 let body = self.bodies.get(leaf as usize)?;
