@@ -304,5 +304,38 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .collect();
     let mut many = Scene::new("100 bodies of 4³ cells".to_string(), &grid)?;
     measure(&mut many, n, repeats)?;
+    deformed(cells, n, repeats)
+}
+
+/// Rays on the single body after a strong deformation (stretched 2× along x, sheared by
+/// 0.5 y along x): its trees refitted since they were built on the undeformed shape, against
+/// trees built on the deformed shape (what the refit costs in tree quality).
+fn deformed(cells: u32, n: usize, repeats: usize) -> Result<(), Box<dyn std::error::Error>> {
+    let mut scene = Scene::new(String::new(), &[(1.0, cells, Vector3::zeros())])?;
+    for p in scene.world.query_mut::<&mut Particles>() {
+        for x in p.positions_mut() {
+            *x = Vector3::new(2.0 * x.x + 0.5 * x.y, x.y, x.z);
+        }
+    }
+    scene.queries.update(&scene.world);
+    let mut fresh = SoftQueries::new();
+    fresh.update(&scene.world);
+    // The deformed box, for aiming the rays.
+    scene.boxes = vec![(
+        Vector3::new(-1.25, -0.5, -0.5),
+        Vector3::new(1.25, 0.5, 0.5),
+    )];
+    let rays = scene.rays(&mut Rng(0x2545_f491_4f6c_dd1d), n);
+    let f = SoftQueryFilter::new();
+    println!("one body, {cells}³ cells, stretched 2× and sheared 0.5 after its trees were built");
+    let refitted = time(&rays, repeats, |r| {
+        black_box(scene.queries.cast_ray(r, f32::MAX, true, f).ok());
+    });
+    row("cast_ray, refitted trees", refitted, "");
+    let rebuilt = time(&rays, repeats, |r| {
+        black_box(fresh.cast_ray(r, f32::MAX, true, f).ok());
+    });
+    let ratio = format!("refitted / built: {:.2}", refitted[0] / rebuilt[0]);
+    row("cast_ray, trees built on this shape", rebuilt, &ratio);
     Ok(())
 }
