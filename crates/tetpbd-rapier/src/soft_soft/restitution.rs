@@ -41,8 +41,11 @@ use crate::soft_soft::gather::{ContactFrame, Gather};
 /// State of the body-level restitution kept across substeps and frames.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct BodyRestitution {
-    /// Per pair of the frame: sum of the contact normals of the substep.
+    /// Per pair of the frame: the contact impulses of the substep, `Σ λ n` (kg·m).
     sums: Vec<Vector3<f32>>,
+    /// Per pair of the frame: sum of the contact normals of the substep (the direction when
+    /// the impulses cancel).
+    counts: Vec<Vector3<f32>>,
     /// Per frame body: centre-of-mass velocity at the substep start (only when some pair
     /// has a restitution above 0).
     v_pre: Vec<Vector3<f32>>,
@@ -73,6 +76,8 @@ impl BodyRestitution {
     ) {
         self.sums.clear();
         self.sums.resize(g.pairs.len(), Vector3::zeros());
+        self.counts.clear();
+        self.counts.resize(g.pairs.len(), Vector3::zeros());
         let mut any = false;
         for c in frame.candidates.iter().filter(|c| c.active) {
             let bp = g.body_of_slot(c.p as usize);
@@ -84,9 +89,11 @@ impl BodyRestitution {
             let Ok(k) = g.pairs.binary_search(&key) else {
                 continue;
             };
-            // The triangle's normal points from its body to the particle's.
+            // The triangle's normal points from its body to the particle's; the particle's
+            // body received the impulse `λ n / h` through it.
             let n = if bp == key.0 { c.n } else { -c.n };
-            self.sums[k] += n;
+            self.sums[k] += n * c.lambda_n;
+            self.counts[k] += n;
             any = true;
         }
         if any {
@@ -101,11 +108,12 @@ impl BodyRestitution {
     /// The restitution of pair `k` of the frame.
     fn pair(&mut self, world: &mut World, g: &Gather, k: usize, threshold: f32) {
         let (a, b) = g.pairs[k];
-        let len = self.sums[k].norm();
-        if len.is_nan() || len <= 1e-9 {
+        let Some(n) = [self.sums[k], self.counts[k]].into_iter().find_map(|s| {
+            let len = s.norm();
+            (len.is_finite() && len > 1e-9).then(|| s / len)
+        }) else {
             return;
-        }
-        let n = self.sums[k] / len;
+        };
         let (ba, bb) = (&g.bodies[a], &g.bodies[b]);
         if ba.inv_mass + bb.inv_mass <= 0.0 {
             return;
