@@ -50,6 +50,10 @@ pub(crate) struct BodyRestitution {
     /// has a restitution above 0).
     v_pre: Vec<Vector3<f32>>,
     episodes: Episodes,
+    /// Contact axis of each pair in contact (by entity bits, sorted): the direction of its
+    /// contact impulse in the first substep of the contact, kept while the contact lasts;
+    /// `true` when seen in the current substep.
+    axes: Vec<((u64, u64), Vector3<f32>, bool)>,
 }
 
 impl BodyRestitution {
@@ -103,6 +107,24 @@ impl BodyRestitution {
             }
         }
         self.episodes.end_substep();
+        self.axes.retain(|a| a.2);
+        for a in &mut self.axes {
+            a.2 = false;
+        }
+    }
+
+    /// The contact axis of pair `key`, begun as `n` if the pair was not in contact in the
+    /// previous substep.
+    fn axis(&mut self, key: (u64, u64), n: Vector3<f32>) -> Vector3<f32> {
+        let k = match self.axes.binary_search_by(|a| a.0.cmp(&key)) {
+            Ok(k) => k,
+            Err(k) => {
+                self.axes.insert(k, (key, n, false));
+                k
+            }
+        };
+        self.axes[k].2 = true;
+        self.axes[k].1
     }
 
     /// The restitution of pair `k` of the frame.
@@ -118,10 +140,12 @@ impl BodyRestitution {
         if ba.inv_mass + bb.inv_mass <= 0.0 {
             return;
         }
+        let key = (ba.entity.to_bits().get(), bb.entity.to_bits().get());
+        let current = n;
+        let n = self.axis(key, n);
         let v_n = relative_normal_velocity(world, ba, bb, &n);
         let e = g.pair_props[k].restitution;
         let impact = if e > 0.0 {
-            let key = (ba.entity.to_bits().get(), bb.entity.to_bits().get());
             let v_pre = (self.v_pre.get(a), self.v_pre.get(b));
             let approach = || match v_pre {
                 (Some(va), Some(vb)) => (va - vb).dot(&n),
@@ -137,6 +161,13 @@ impl BodyRestitution {
         };
         if let Some(dv) = dv.filter(|dv| !dv.is_nan()) {
             exchange(world, (ba, bb), &n, dv);
+        }
+        if e <= 0.0 {
+            // No separation along this substep's impulse either.
+            let v_c = relative_normal_velocity(world, ba, bb, &current);
+            if v_c > 0.0 {
+                exchange(world, (ba, bb), &current, -v_c);
+            }
         }
     }
 }
