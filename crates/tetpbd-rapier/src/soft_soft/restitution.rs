@@ -107,6 +107,20 @@ impl BodyRestitution {
             }
         }
         self.episodes.end_substep();
+        // A pair keeps its axis while its bodies are within contact range (some candidate
+        // between them in the frame), even in substeps without an active contact.
+        for c in &frame.candidates {
+            let bp = g.body_of_slot(c.p as usize);
+            let bt = g.body_of_slot(c.tri[0] as usize);
+            if bp == bt {
+                continue;
+            }
+            let (ea, eb) = (&g.bodies[bp.min(bt)], &g.bodies[bp.max(bt)]);
+            let key = (ea.entity.to_bits().get(), eb.entity.to_bits().get());
+            if let Ok(k) = self.axes.binary_search_by(|a| a.0.cmp(&key)) {
+                self.axes[k].2 = true;
+            }
+        }
         self.axes.retain(|a| a.2);
         for a in &mut self.axes {
             a.2 = false;
@@ -141,7 +155,6 @@ impl BodyRestitution {
             return;
         }
         let key = (ba.entity.to_bits().get(), bb.entity.to_bits().get());
-        let current = n;
         let n = self.axis(key, n);
         let v_n = relative_normal_velocity(world, ba, bb, &n);
         let e = g.pair_props[k].restitution;
@@ -161,13 +174,6 @@ impl BodyRestitution {
         };
         if let Some(dv) = dv.filter(|dv| !dv.is_nan()) {
             exchange(world, (ba, bb), &n, dv);
-        }
-        if e <= 0.0 {
-            // No separation along this substep's impulse either.
-            let v_c = relative_normal_velocity(world, ba, bb, &current);
-            if v_c > 0.0 {
-                exchange(world, (ba, bb), &current, -v_c);
-            }
         }
     }
 }
