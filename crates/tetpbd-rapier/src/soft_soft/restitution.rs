@@ -41,19 +41,12 @@ use crate::soft_soft::gather::{ContactFrame, Gather};
 /// State of the body-level restitution kept across substeps and frames.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct BodyRestitution {
-    /// Per pair of the frame: the contact impulses of the substep, `Σ λ n` (kg·m).
+    /// Per pair of the frame: sum of the contact normals of the substep.
     sums: Vec<Vector3<f32>>,
-    /// Per pair of the frame: sum of the contact normals of the substep (the direction when
-    /// the impulses cancel).
-    counts: Vec<Vector3<f32>>,
     /// Per frame body: centre-of-mass velocity at the substep start (only when some pair
     /// has a restitution above 0).
     v_pre: Vec<Vector3<f32>>,
     episodes: Episodes,
-    /// Contact axis of each pair in contact (by entity bits, sorted): the direction of its
-    /// contact impulse in the first substep of the contact, kept while the contact lasts;
-    /// `true` when seen in the current substep.
-    axes: Vec<((u64, u64), Vector3<f32>, bool)>,
 }
 
 impl BodyRestitution {
@@ -80,8 +73,6 @@ impl BodyRestitution {
     ) {
         self.sums.clear();
         self.sums.resize(g.pairs.len(), Vector3::zeros());
-        self.counts.clear();
-        self.counts.resize(g.pairs.len(), Vector3::zeros());
         let mut any = false;
         for c in frame.candidates.iter().filter(|c| c.active) {
             let bp = g.body_of_slot(c.p as usize);
@@ -93,11 +84,9 @@ impl BodyRestitution {
             let Ok(k) = g.pairs.binary_search(&key) else {
                 continue;
             };
-            // The triangle's normal points from its body to the particle's; the particle's
-            // body received the impulse `λ n / h` through it.
+            // The triangle's normal points from its body to the particle's.
             let n = if bp == key.0 { c.n } else { -c.n };
-            self.sums[k] += n * c.lambda_n;
-            self.counts[k] += n;
+            self.sums[k] += n;
             any = true;
         }
         if any {
@@ -107,58 +96,24 @@ impl BodyRestitution {
             }
         }
         self.episodes.end_substep();
-        // A pair keeps its axis while its bodies are within contact range (some candidate
-        // between them in the frame), even in substeps without an active contact.
-        for c in &frame.candidates {
-            let bp = g.body_of_slot(c.p as usize);
-            let bt = g.body_of_slot(c.tri[0] as usize);
-            if bp == bt {
-                continue;
-            }
-            let (ea, eb) = (&g.bodies[bp.min(bt)], &g.bodies[bp.max(bt)]);
-            let key = (ea.entity.to_bits().get(), eb.entity.to_bits().get());
-            if let Ok(k) = self.axes.binary_search_by(|a| a.0.cmp(&key)) {
-                self.axes[k].2 = true;
-            }
-        }
-        self.axes.retain(|a| a.2);
-        for a in &mut self.axes {
-            a.2 = false;
-        }
-    }
-
-    /// The contact axis of pair `key`, begun as `n` if the pair was not in contact in the
-    /// previous substep.
-    fn axis(&mut self, key: (u64, u64), n: Vector3<f32>) -> Vector3<f32> {
-        let k = match self.axes.binary_search_by(|a| a.0.cmp(&key)) {
-            Ok(k) => k,
-            Err(k) => {
-                self.axes.insert(k, (key, n, false));
-                k
-            }
-        };
-        self.axes[k].2 = true;
-        self.axes[k].1
     }
 
     /// The restitution of pair `k` of the frame.
     fn pair(&mut self, world: &mut World, g: &Gather, k: usize, threshold: f32) {
         let (a, b) = g.pairs[k];
-        let Some(n) = [self.sums[k], self.counts[k]].into_iter().find_map(|s| {
-            let len = s.norm();
-            (len.is_finite() && len > 1e-9).then(|| s / len)
-        }) else {
+        let len = self.sums[k].norm();
+        if len.is_nan() || len <= 1e-9 {
             return;
-        };
+        }
+        let n = self.sums[k] / len;
         let (ba, bb) = (&g.bodies[a], &g.bodies[b]);
         if ba.inv_mass + bb.inv_mass <= 0.0 {
             return;
         }
-        let key = (ba.entity.to_bits().get(), bb.entity.to_bits().get());
-        let n = self.axis(key, n);
         let v_n = relative_normal_velocity(world, ba, bb, &n);
         let e = g.pair_props[k].restitution;
         let impact = if e > 0.0 {
+            let key = (ba.entity.to_bits().get(), bb.entity.to_bits().get());
             let v_pre = (self.v_pre.get(a), self.v_pre.get(b));
             let approach = || match v_pre {
                 (Some(va), Some(vb)) => (va - vb).dot(&n),
