@@ -54,8 +54,11 @@ mod stabilisation;
 
 pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
 pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};
+pub use body::forces::UserForces;
 pub use body::generators;
+pub use body::grab::Grab;
 pub use body::impulses::PointImpulse;
+pub use body::material_point::MaterialPoint;
 pub use body::mesh::{Surface, Tetrahedra};
 pub use body::particles::{ExternalAcceleration, Particles};
 pub use body::placement::Placement;
