@@ -70,6 +70,7 @@
 mod attachments;
 mod ccd;
 mod contacts;
+mod context;
 mod convert;
 mod coupling;
 mod depenetration;
@@ -92,7 +93,8 @@ mod substep;
 mod validate;
 
 pub use attachments::{AttachTarget, Attachment, Attachments};
-pub use coupling::{Coupling, RapierContext};
+pub use context::RapierContext;
+pub use coupling::Coupling;
 pub use error::CouplingError;
 pub use placement::RapierPlacement;
 pub use report::{ContactReport, CouplingStats, SoftFeature};
