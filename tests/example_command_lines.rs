@@ -12,6 +12,8 @@ use clap::{CommandFactory, Parser};
 
 #[path = "../examples/cli/asset_drop.rs"]
 mod asset_drop;
+#[path = "../examples/cli/integrating.rs"]
+mod integrating;
 #[path = "../examples/cli/kinematic_platform.rs"]
 mod kinematic_platform;
 #[path = "../examples/cli/recover.rs"]
@@ -27,6 +29,7 @@ mod soft_pile;
 fn commands() -> Vec<clap::Command> {
     vec![
         asset_drop::Cli::command(),
+        integrating::Cli::command(),
         kinematic_platform::Cli::command(),
         recover::Cli::command(),
         rigid_ball_on_soft::Cli::command(),
@@ -116,6 +119,20 @@ fn the_documented_invocations_parse() {
         "defaults"
     );
     assert!(!cli.viz.renders());
+
+    // .ci/run and docs/guide/integrating.md.
+    let cli = integrating::Cli::try_parse_from(["integrating", "--frames", "60"]).unwrap();
+    assert_eq!(cli.frames, 60);
+    assert_eq!(
+        (cli.render_hz, cli.physics_hz, cli.substeps),
+        (144.0, 60.0, 10)
+    );
+    let e = error(
+        integrating::Cli::command(),
+        &["integrating", "--render-hz", "fast"],
+    );
+    assert_eq!(e.kind(), ErrorKind::ValueValidation);
+    assert!(e.to_string().contains("--render-hz"), "{e}");
 
     // .ci/run and the README's gallery section.
     let cli = rigid_ball_on_soft::Cli::try_parse_from([
@@ -207,6 +224,7 @@ fn a_bad_argument_is_rejected_with_a_message_naming_it() {
         (soft_pile::Cli::command(), &["x", "soft", "-1"], "SECONDS"),
         (
             asset_drop::Cli::command(),
+            integrating::Cli::command(),
             &["x", "a.obj", "60", "-0.1"],
             "CELL_M",
         ),
