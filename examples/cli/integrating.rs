@@ -14,7 +14,7 @@ use tetpbd_viz::VizOptions;
 #[command(name = "integrating")]
 pub struct Cli {
     /// Rendered frames to run.
-    #[arg(long, default_value_t = 240)]
+    #[arg(long, default_value_t = 240, allow_negative_numbers = true)]
     pub frames: usize,
     /// Display rate, Hz: the accumulator gains 1/render-hz s per rendered frame.
     #[arg(long, default_value_t = 144.0)]
