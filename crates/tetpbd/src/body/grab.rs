@@ -149,10 +149,11 @@ fn check_target(target: &Vector3<f32>) -> Result<(), StateError> {
     }
 }
 
-/// Zeroes every grab's multiplier (start of a substep).
+/// Zeroes every grab's multiplier and force (start of a substep).
 pub fn reset_grabs(world: &mut hecs::World) {
     for g in world.query_mut::<&mut Grab>() {
         g.lambda = 0.0;
+        g.force = Vector3::zeros();
     }
 }
 
