@@ -1,10 +1,13 @@
 //! Picking by ray cast and dragging with a grab, with a scripted mouse.
 //!
-//! `pick` is the one place that asks the scene which soft body a ray hits; everything else
-//! works from its answer (entity and point).
+//! `pick` is the one place that asks the scene which soft body a ray hits (a ray cast
+//! against the soft bodies' surfaces); everything else works from its answer (entity and
+//! point).
 
 use nalgebra::Vector3;
-use tetpbd_rapier::prelude::{Grab, Particles, Surface, Tetrahedra};
+use tetpbd_rapier::prelude::{Grab, Particles, SoftQueries, SoftQueryFilter, Tetrahedra};
+use tetpbd_rapier::rapier3d::geometry::Ray;
+use tetpbd_rapier::rapier3d::math::Vector;
 
 /// Grab stretch under the body's own weight, m: the compliance is this over `M g`.
 const STRETCH_UNDER_WEIGHT: f32 = 0.01;
@@ -12,45 +15,28 @@ const STRETCH_UNDER_WEIGHT: f32 = 0.01;
 const MAX_FORCE_IN_WEIGHTS: f32 = 3.0;
 
 /// The first soft surface a ray from `origin` along `dir` hits: the entity and the point.
+///
+/// A scene query ([`SoftQueries`]) against the soft bodies as they are now: the snapshot is
+/// taken here, at the press. A game that queries every frame keeps one `SoftQueries` and
+/// updates it after each physics step.
 fn pick(
     soft: &hecs::World,
     origin: Vector3<f32>,
     dir: Vector3<f32>,
 ) -> Option<(hecs::Entity, Vector3<f32>)> {
-    let mut best: Option<(f32, hecs::Entity)> = None;
-    for (e, p, s) in soft.query::<(hecs::Entity, &Particles, &Surface)>().iter() {
-        for tri in s.triangles() {
-            let [a, b, c] = tri.map(|i| p.positions()[i as usize]);
-            if let Some(t) = ray_triangle(origin, dir, a, b, c) {
-                if best.is_none_or(|(bt, _)| t < bt) {
-                    best = Some((t, e));
-                }
-            }
-        }
-    }
-    best.map(|(t, e)| (e, origin + dir * t))
-}
-
-/// Möller–Trumbore: the ray parameter where it crosses triangle `abc`, if it does.
-fn ray_triangle(
-    o: Vector3<f32>,
-    d: Vector3<f32>,
-    a: Vector3<f32>,
-    b: Vector3<f32>,
-    c: Vector3<f32>,
-) -> Option<f32> {
-    let (e1, e2) = (b - a, c - a);
-    let p = d.cross(&e2);
-    let det = e1.dot(&p);
-    if det.abs() < 1e-12 {
-        return None;
-    }
-    let s = o - a;
-    let u = s.dot(&p) / det;
-    let q = s.cross(&e1);
-    let v = d.dot(&q) / det;
-    let t = e2.dot(&q) / det;
-    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0).then_some(t)
+    let mut queries = SoftQueries::new();
+    queries.update(soft);
+    let ray = Ray::new(
+        Vector::new(origin.x, origin.y, origin.z),
+        Vector::new(dir.x, dir.y, dir.z),
+    );
+    let hit = queries
+        .cast_ray(&ray, f32::MAX, true, SoftQueryFilter::new())
+        .ok()??;
+    Some((
+        hit.entity,
+        Vector3::new(hit.point.x, hit.point.y, hit.point.z),
+    ))
 }
 
 /// A mouse that presses on the scene at a third of the run, drags 0.4 m up and 0.5 m to the
