@@ -18,15 +18,17 @@ use crate::stabilisation::{correction_energy, deformation_damping};
 ///
 /// ```text
 /// for each of `substeps` substeps (h = dt / substeps):
-///     predict            x_prev ← x; v ← (v + h(g + a))·damping; x ← x + h v
+///     predict            x_prev ← x; v ← (v + h(g + a + F/m))·damping; x ← x + h v
 ///     reset λ
 ///     repeat `iterations` times:
 ///         copy the particles into the projections' working copy (crate::kernels::working_copy)
 ///         project families in `order` on it, remove the rigid rotation of their
 ///         corrections (conserve_angular_momentum), limit the kinetic energy they add
-///         (limit_correction_energy), copy back, then hook.project
+///         (limit_correction_energy), copy back, project the grabs (Grab), then
+///         hook.project
 ///     update velocities  v ← (x − x_prev) / h, then damp deformation (DeformationDamping)
 ///     hook.end_substep
+/// after the last substep: the grabs' targets roll on (systems::roll_grab_targets)
 /// ```
 ///
 /// Threads (feature `parallel`): a step runs its parallel passes on the pool given to
@@ -191,6 +193,7 @@ impl Solver {
             restored.count += r.count;
             restored.first = restored.first.or(r.first);
         }
+        systems::roll_grab_targets(world);
         let t = Instant::now();
         hook.end_frame(world, frame);
         hook_time += t.elapsed();
@@ -239,8 +242,10 @@ impl Solver {
         let t = Instant::now();
         hook.begin_substep(world, frame.substep(index, 0));
         *hook_time += t.elapsed();
+        let frac = (index + 1) as f32 / s.substeps as f32;
         for k in 0..s.iterations {
             self.iteration(world, h, stats);
+            systems::project_grabs(world, h, frac);
             let t = Instant::now();
             hook.project(world, frame.substep(index, k));
             *hook_time += t.elapsed();
