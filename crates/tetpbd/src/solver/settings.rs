@@ -62,10 +62,13 @@ pub struct SolverSettings {
     /// add energy. One scale per body and iteration keeps linear and angular momentum. Cost:
     /// a few multiply–adds per particle in the copy back from the working copy, plus a pass
     /// in iterations where it acts (counted in [`crate::StepStats::energy_limited`]). Theory
-    /// in `stabilisation::correction_energy`. Off by default because it cannot yet tell a
-    /// hook's contact work from a violation already there: with it on, bodies resting or
-    /// sliding on contacts keep jittering or drag (see `docs/decisions/correction-energy.md`).
-    /// Turn it on for free bodies that may start tangled or collapsed.
+    /// in `stabilisation::correction_energy`. A hook's position corrections (contacts,
+    /// attachments) count as external work in its budget, so bodies resting and sliding on
+    /// contacts behave as without it. Off by default because soft–soft impacts still come
+    /// out wrong with it on (two hard cubes meeting at 4 m/s with restitution 0 part at
+    /// 0.46 m/s; a pile of nine cubes on a pinned slab does not settle; see
+    /// `docs/decisions/correction-energy.md`). Turn it on for bodies that may start
+    /// tangled, collapsed or crushed.
     pub limit_correction_energy: bool,
     /// Scalar or SIMD projection kernels (default SIMD; they agree to rounding).
     pub kernel: systems::Kernel,

@@ -12,7 +12,7 @@ use crate::solver::hook::{FrameContext, SubstepHook};
 use crate::solver::settings::SolverSettings;
 use crate::solver::stats::StepStats;
 use crate::solver::systems;
-use crate::stabilisation::{correction_energy, deformation_damping};
+use crate::stabilisation::{correction_energy, deformation_damping, hook_work};
 
 /// Runs frames of the soft-body systems on a [`hecs::World`].
 ///
@@ -236,13 +236,17 @@ impl Solver {
         let restored = systems::predict(world, h, frame.gravity(), s.damping);
         systems::reset_lambdas(world);
         stats.predict_time += t.elapsed();
+        // The hook's corrections are external work in the correction-energy budget.
+        let measure = s.limit_correction_energy && hook.moves_particles();
         let t = Instant::now();
-        hook.begin_substep(world, frame.substep(index, 0));
+        measured(world, h, measure, |w| {
+            hook.begin_substep(w, frame.substep(index, 0))
+        });
         *hook_time += t.elapsed();
         for k in 0..s.iterations {
             self.iteration(world, h, stats);
             let t = Instant::now();
-            hook.project(world, frame.substep(index, k));
+            measured(world, h, measure, |w| hook.project(w, frame.substep(index, k)));
             *hook_time += t.elapsed();
         }
         let t = Instant::now();
@@ -282,6 +286,18 @@ impl Solver {
             working_copy::store_bodies(world);
             stats.copy_time += t.elapsed();
         }
+    }
+}
+
+/// Runs a hook call, measuring the kinetic energy its corrections hand the families
+/// ([`crate::stabilisation::hook_work`]) when `measure` is set.
+fn measured(world: &mut World, h: f32, measure: bool, call: impl FnOnce(&mut World)) {
+    if measure {
+        hook_work::before_hook(world);
+    }
+    call(world);
+    if measure {
+        hook_work::after_hook(world, h);
     }
 }
 

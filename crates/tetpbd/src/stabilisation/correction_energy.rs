@@ -198,11 +198,15 @@ pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: b
             crate::kernels::working_copy::store(p);
             continue;
         }
+        // What a hook's corrections handed this pass is external work, spent here.
+        let hook = std::mem::take(&mut p.hook.energy);
         let budget = |w_max: f32, work: f64, gain: f64| {
-            if limit {
-                elastic_release([h, w_max], [work, gain], e, t, vf, vol)
-            } else {
+            if !limit {
                 f64::INFINITY
+            } else if hook >= gain {
+                hook
+            } else {
+                hook + elastic_release([h, w_max], [work, gain - hook], e, t, vf, vol)
             }
         };
         if crate::stabilisation::angular_momentum::store_measured(p, h, spin, budget) {
