@@ -67,7 +67,10 @@ fn incline_acceleration(mu: f32, substeps: u32) -> f32 {
     for v in &mut mesh.vertices {
         *v = rot * *v + start;
     }
-    let body = SoftBodyBuilder::new(mesh).density(1000.0).edges(0.0).volume(0.0);
+    let body = SoftBodyBuilder::new(mesh)
+        .density(1000.0)
+        .edges(0.0)
+        .volume(0.0);
     let e = spawn_with(&mut s, body, SoftColliderBuilder::new().friction(mu));
     let velocity = |s: &CoupledWorld| {
         let p = particles(s, e);

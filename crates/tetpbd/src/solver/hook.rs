@@ -164,11 +164,12 @@ pub trait SubstepHook {
     fn end_substep(&mut self, _world: &mut World, _substep: SubstepContext) {}
     /// Once per frame, after the last substep.
     fn end_frame(&mut self, _world: &mut World, _frame: FrameContext) {}
-    /// Whether [`SubstepHook::begin_substep`] or [`SubstepHook::project`] may move particles
-    /// (default `true`). For a hook that does, the solver measures the kinetic energy its
-    /// corrections hand the constraint families (external work in the budget of
-    /// [`crate::SolverSettings::limit_correction_energy`]): one copy of the positions and
-    /// one pass over them per call. A hook that never moves a particle may return `false`
+    /// Whether [`SubstepHook::begin_substep`] or [`SubstepHook::project`] may move particles,
+    /// or [`SubstepHook::end_substep`] change their velocities (default `true`). For a hook
+    /// that does, the solver measures the kinetic energy its impulses hand the constraint
+    /// families (external work in the budget of
+    /// [`crate::SolverSettings::limit_correction_energy`]): one copy of the positions or
+    /// velocities and one pass over them per call. A hook that never moves a particle may return `false`
     /// to skip that.
     fn moves_particles(&self) -> bool {
         true

@@ -12,7 +12,8 @@ use crate::solver::hook::{FrameContext, SubstepHook};
 use crate::solver::settings::SolverSettings;
 use crate::solver::stats::StepStats;
 use crate::solver::systems;
-use crate::stabilisation::{correction_energy, deformation_damping, hook_work};
+use crate::stabilisation::hook_work::{self, Changed};
+use crate::stabilisation::{correction_energy, deformation_damping};
 
 /// Runs frames of the soft-body systems on a [`hecs::World`].
 ///
@@ -237,16 +238,18 @@ impl Solver {
         systems::reset_lambdas(world);
         stats.predict_time += t.elapsed();
         // The hook's corrections are external work in the correction-energy budget.
-        let measure = s.limit_correction_energy && hook.moves_particles();
+        let measure = (s.limit_correction_energy && hook.moves_particles()).then_some(h);
         let t = Instant::now();
-        measured(world, h, measure, |w| {
+        measured(world, measure, Changed::Positions, |w| {
             hook.begin_substep(w, frame.substep(index, 0))
         });
         *hook_time += t.elapsed();
         for k in 0..s.iterations {
             self.iteration(world, h, stats);
             let t = Instant::now();
-            measured(world, h, measure, |w| hook.project(w, frame.substep(index, k)));
+            measured(world, measure, Changed::Positions, |w| {
+                hook.project(w, frame.substep(index, k))
+            });
             *hook_time += t.elapsed();
         }
         let t = Instant::now();
@@ -256,7 +259,9 @@ impl Solver {
         deformation_damping::damp_deformation(world, h);
         stats.velocity_time += t.elapsed();
         let t = Instant::now();
-        hook.end_substep(world, frame.substep(index, 0));
+        measured(world, measure, Changed::Velocities, |w| {
+            hook.end_substep(w, frame.substep(index, 0))
+        });
         *hook_time += t.elapsed();
         restored
     }
@@ -290,14 +295,19 @@ impl Solver {
 }
 
 /// Runs a hook call, measuring the kinetic energy its corrections hand the families
-/// ([`crate::stabilisation::hook_work`]) when `measure` is set.
-fn measured(world: &mut World, h: f32, measure: bool, call: impl FnOnce(&mut World)) {
-    if measure {
-        hook_work::before_hook(world);
+/// ([`crate::stabilisation::hook_work`]) in a substep of length `measure` (s), if given.
+fn measured(
+    world: &mut World,
+    measure: Option<f32>,
+    changed: Changed,
+    call: impl FnOnce(&mut World),
+) {
+    if measure.is_some() {
+        hook_work::before_hook(world, changed);
     }
     call(world);
-    if measure {
-        hook_work::after_hook(world, h);
+    if let Some(h) = measure {
+        hook_work::after_hook(world, h, changed);
     }
 }
 

@@ -20,6 +20,9 @@
 //! summed over the hook's calls between two passes of the families (its `project` after an
 //! iteration, its `begin_substep` before the next one) is added to the limit's budget of the
 //! next pass and spent there: a hook that stops pushing gives nothing to the passes after.
+//! A hook that changes velocities instead (`end_substep`: velocity-level friction and
+//! restitution on the particles a contact touches) hands the next prediction the same kind
+//! of relative motion; its impulses `mᵢΔvᵢ` count `Σ mᵢ|Δvᵢ|²/2` the same way.
 //! On a body alone (the empty hook, [`crate::SubstepHook::moves_particles`] `false`) nothing
 //! is measured and nothing is added.
 
@@ -46,37 +49,58 @@ impl PartialEq for HookWork {
     }
 }
 
-/// Records every body's positions before a hook call.
-pub(crate) fn before_hook(world: &mut hecs::World) {
-    for p in world.query_mut::<&mut Particles>() {
-        let Particles {
-            positions, hook, ..
-        } = p;
-        hook.start.clear();
-        hook.start.extend_from_slice(positions);
+/// What a hook call changes: positions (`begin_substep`, `project`: an impulse `mᵢΔcᵢ/h`)
+/// or velocities (`end_substep`: an impulse `mᵢΔvᵢ`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Changed {
+    /// Positions, m.
+    Positions,
+    /// Velocities, m/s.
+    Velocities,
+}
+
+fn field(p: &mut Particles, changed: Changed) -> (&[Vector3<f32>], &[f32], &mut HookWork) {
+    let Particles {
+        positions,
+        velocities,
+        masses,
+        hook,
+        ..
+    } = p;
+    match changed {
+        Changed::Positions => (positions, masses, hook),
+        Changed::Velocities => (velocities, masses, hook),
     }
 }
 
-/// Adds the energy of the corrections made since [`before_hook`] to every body's hook work.
-pub(crate) fn after_hook(world: &mut hecs::World, h: f32) {
-    let inv_2h2 = 0.5 / (f64::from(h) * f64::from(h));
+/// Records every body's positions or velocities before a hook call.
+pub(crate) fn before_hook(world: &mut hecs::World, changed: Changed) {
     for p in world.query_mut::<&mut Particles>() {
-        let Particles {
-            positions,
-            masses,
-            hook,
-            ..
-        } = p;
-        if hook.start.len() != positions.len() {
+        let (now, _, hook) = field(p, changed);
+        hook.start.clear();
+        hook.start.extend_from_slice(now);
+    }
+}
+
+/// Adds the energy of the impulses of the hook call since [`before_hook`] to every body's
+/// hook work: `Σ mᵢ|Δcᵢ|²/(2h²)` for positions, `Σ mᵢ|Δvᵢ|²/2` for velocities.
+pub(crate) fn after_hook(world: &mut hecs::World, h: f32, changed: Changed) {
+    let factor = match changed {
+        Changed::Positions => 0.5 / (f64::from(h) * f64::from(h)),
+        Changed::Velocities => 0.5,
+    };
+    for p in world.query_mut::<&mut Particles>() {
+        let (now, masses, hook) = field(p, changed);
+        if hook.start.len() != now.len() {
             continue;
         }
         let mut sum = 0.0f64;
-        for ((x, s), m) in positions.iter().zip(&hook.start).zip(masses.iter()) {
+        for ((x, s), m) in now.iter().zip(&hook.start).zip(masses) {
             sum += f64::from(*m) * f64::from((x - s).norm_squared());
         }
-        // A non-finite position is the non-finite state's business, not the budget's.
+        // A non-finite state is the non-finite check's business, not the budget's.
         if sum.is_finite() {
-            hook.energy += sum * inv_2h2;
+            hook.energy += sum * factor;
         }
     }
 }
