@@ -286,6 +286,7 @@ impl SoftBodyBuilder {
                 vertex_to_particle: inverse(&particle_source),
                 source: particle_source,
                 work: WorkCopy(vec![Slot::default(); n]),
+                hook: Default::default(),
             },
             tetrahedra: Tetrahedra {
                 indices: mesh.tets,

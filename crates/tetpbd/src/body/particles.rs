@@ -40,6 +40,10 @@ pub struct Particles {
     /// The projections' working copy (scratch, see [`crate::kernels::working_copy`]).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) work: crate::kernels::slots::WorkCopy,
+    /// The kinetic energy a hook's corrections handed the families' next pass (see
+    /// [`crate::stabilisation::hook_work`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub(crate) hook: crate::stabilisation::hook_work::HookWork,
 }
 
 impl PartialEq for Particles {
@@ -56,6 +60,7 @@ impl PartialEq for Particles {
             source,
             vertex_to_particle,
             work: _,
+            hook,
         } = self;
         *positions == o.positions
             && *prev_positions == o.prev_positions
@@ -66,6 +71,7 @@ impl PartialEq for Particles {
             && *residuals == o.residuals
             && *source == o.source
             && *vertex_to_particle == o.vertex_to_particle
+            && *hook == o.hook
     }
 }
 

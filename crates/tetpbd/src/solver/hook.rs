@@ -164,10 +164,24 @@ pub trait SubstepHook {
     fn end_substep(&mut self, _world: &mut World, _substep: SubstepContext) {}
     /// Once per frame, after the last substep.
     fn end_frame(&mut self, _world: &mut World, _frame: FrameContext) {}
+    /// Whether [`SubstepHook::begin_substep`] or [`SubstepHook::project`] may move particles,
+    /// or [`SubstepHook::end_substep`] change their velocities (default `true`). For a hook
+    /// that does, the solver measures the kinetic energy its impulses hand the constraint
+    /// families (external work in the budget of
+    /// [`crate::SolverSettings::limit_correction_energy`]): one copy of the positions or
+    /// velocities and one pass over them per call. A hook that never moves a particle may return `false`
+    /// to skip that.
+    fn moves_particles(&self) -> bool {
+        true
+    }
 }
 
 /// The empty hook.
-impl SubstepHook for () {}
+impl SubstepHook for () {
+    fn moves_particles(&self) -> bool {
+        false
+    }
+}
 
 /// Two hooks run one after the other at every point (e.g. rigid coupling, then soft–soft
 /// contacts).
@@ -192,6 +206,9 @@ impl<A: SubstepHook, B: SubstepHook> SubstepHook for (A, B) {
         self.0.end_frame(world, frame);
         self.1.end_frame(world, frame);
     }
+    fn moves_particles(&self) -> bool {
+        self.0.moves_particles() || self.1.moves_particles()
+    }
 }
 
 /// A borrowed hook.
@@ -210,5 +227,8 @@ impl<H: SubstepHook + ?Sized> SubstepHook for &mut H {
     }
     fn end_frame(&mut self, world: &mut World, frame: FrameContext) {
         (**self).end_frame(world, frame);
+    }
+    fn moves_particles(&self) -> bool {
+        (**self).moves_particles()
     }
 }

@@ -12,6 +12,7 @@ use crate::solver::hook::{FrameContext, SubstepHook};
 use crate::solver::settings::SolverSettings;
 use crate::solver::stats::StepStats;
 use crate::solver::systems;
+use crate::stabilisation::hook_work::{self, Changed};
 use crate::stabilisation::{correction_energy, deformation_damping};
 
 /// Runs frames of the soft-body systems on a [`hecs::World`].
@@ -239,15 +240,21 @@ impl Solver {
         let restored = systems::predict(world, h, frame.gravity(), s.damping);
         systems::reset_lambdas(world);
         stats.predict_time += t.elapsed();
+        // The hook's corrections are external work in the correction-energy budget.
+        let measure = (s.limit_correction_energy && hook.moves_particles()).then_some(h);
         let t = Instant::now();
-        hook.begin_substep(world, frame.substep(index, 0));
+        measured(world, measure, Changed::Positions, |w| {
+            hook.begin_substep(w, frame.substep(index, 0))
+        });
         *hook_time += t.elapsed();
         let frac = (index + 1) as f32 / s.substeps as f32;
         for k in 0..s.iterations {
             self.iteration(world, h, stats);
             systems::project_grabs(world, h, frac);
             let t = Instant::now();
-            hook.project(world, frame.substep(index, k));
+            measured(world, measure, Changed::Positions, |w| {
+                hook.project(w, frame.substep(index, k))
+            });
             *hook_time += t.elapsed();
         }
         let t = Instant::now();
@@ -257,7 +264,9 @@ impl Solver {
         deformation_damping::damp_deformation(world, h);
         stats.velocity_time += t.elapsed();
         let t = Instant::now();
-        hook.end_substep(world, frame.substep(index, 0));
+        measured(world, measure, Changed::Velocities, |w| {
+            hook.end_substep(w, frame.substep(index, 0))
+        });
         *hook_time += t.elapsed();
         restored
     }
@@ -287,6 +296,23 @@ impl Solver {
             working_copy::store_bodies(world);
             stats.copy_time += t.elapsed();
         }
+    }
+}
+
+/// Runs a hook call, measuring the kinetic energy its corrections hand the families
+/// ([`crate::stabilisation::hook_work`]) in a substep of length `measure` (s), if given.
+fn measured(
+    world: &mut World,
+    measure: Option<f32>,
+    changed: Changed,
+    call: impl FnOnce(&mut World),
+) {
+    if measure.is_some() {
+        hook_work::before_hook(world, changed);
+    }
+    call(world);
+    if let Some(h) = measure {
+        hook_work::after_hook(world, h, changed);
     }
 }
 
