@@ -240,8 +240,11 @@ impl Solver {
         let restored = systems::predict(world, h, frame.gravity(), s.damping);
         systems::reset_lambdas(world);
         stats.predict_time += t.elapsed();
-        // The hook's corrections are external work in the correction-energy budget.
-        let measure = (s.limit_correction_energy && hook.moves_particles()).then_some(h);
+        // The hook's and the grabs' corrections are external work in the correction-energy
+        // budget.
+        let grabs = world.query_mut::<&crate::Grab>().into_iter().next().is_some();
+        let measure =
+            (s.limit_correction_energy && (grabs || hook.moves_particles())).then_some(h);
         let t = Instant::now();
         measured(world, measure, Changed::Positions, |w| {
             hook.begin_substep(w, frame.substep(index, 0))
@@ -250,9 +253,9 @@ impl Solver {
         let frac = (index + 1) as f32 / s.substeps as f32;
         for k in 0..s.iterations {
             self.iteration(world, h, stats);
-            systems::project_grabs(world, h, frac);
             let t = Instant::now();
             measured(world, measure, Changed::Positions, |w| {
+                systems::project_grabs(w, h, frac);
                 hook.project(w, frame.substep(index, k))
             });
             *hook_time += t.elapsed();
