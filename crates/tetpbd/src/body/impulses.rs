@@ -33,6 +33,7 @@ impl Particles {
     /// proportion to their masses: every free particle's velocity changes by `J / M_free`.
     pub fn apply_impulse(&mut self, impulse: Vector3<f32>) -> Result<(), StateError> {
         finite(&impulse, "impulse")?;
+        self.written = true;
         let free: f64 = self.free_masses().map(f64::from).sum();
         if free <= 0.0 {
             return Err(StateError::AllPinned);
@@ -55,6 +56,7 @@ impl Particles {
         point: Vector3<f32>,
     ) -> Result<PointImpulse, StateError> {
         finite(&impulse, "impulse")?;
+        self.written = true;
         finite(&point, "point")?;
         let (tetrahedron, coords) = self.holding_tetrahedron(tetrahedra, &point)?;
         let corners = tetrahedra.indices()[tetrahedron].map(|i| i as usize);
@@ -102,6 +104,7 @@ impl Particles {
                 value: speed,
             });
         }
+        self.written = true;
         let mut total = Vector3::zeros();
         for i in 0..self.positions.len() {
             let d = self.positions[i] - centre;
