@@ -332,6 +332,7 @@ impl Coupling {
                 multibody_joints: &*ctx.multibody_joints,
                 default_collider: self.settings.default_collider,
                 margin: self.settings.margin,
+                soft_margin: self.settings.soft_contacts.map(|s| s.margin),
                 max_depenetration_speed: self.settings.max_depenetration_speed,
                 stacking_mass_ratio: self.settings.stacking_mass_ratio,
                 self_weight_stacking: self.settings.self_weight_stacking,

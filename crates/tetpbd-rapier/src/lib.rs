@@ -86,6 +86,7 @@ mod response;
 mod rigid;
 mod scene;
 mod settings;
+mod sleeping;
 mod soft_collider;
 mod soft_soft;
 mod substep;

@@ -243,4 +243,16 @@ impl SubstepHook for SoftContacts {
     fn end_frame(&mut self, world: &mut World, _frame: FrameContext) {
         self.frame.finish(world, &self.gather, &mut self.stats);
     }
+
+    /// Bodies whose bounds overlap within the margin are one island (`sleeping` module
+    /// docs).
+    fn touching(&mut self, _world: &mut World, touching: &mut tetpbd::Touching) {
+        let bodies = &self.gather.bodies;
+        touching.pairs.extend(
+            self.gather
+                .pairs
+                .iter()
+                .map(|&(a, b)| (bodies[a].entity, bodies[b].entity)),
+        );
+    }
 }

@@ -448,6 +448,13 @@ impl BodyProxy {
         if load.is_some_and(|(f, t)| !(finite(&f) && finite(&t))) {
             return false;
         }
+        // Sleeping (`sleeping` module docs): rapier's own rule decides when an awake body
+        // sleeps, so an awake body is written without restarting its timer; a sleeping one
+        // is woken only by a reaction that moves it faster than its sleep threshold.
+        let wake = body.is_sleeping();
+        if wake && !crate::sleeping::moves_rigid(body, &(self.v_end + self.dv), &(self.w_end + self.dw)) {
+            return true;
+        }
         match self.kind {
             BodyKind::Dynamic => {
                 let (v, w, p) = (self.v_end + self.dv, self.w_end + self.dw, self.pose);
@@ -458,16 +465,16 @@ impl BodyProxy {
                 {
                     return false;
                 }
-                body.set_position(pose_to_glam(&p), true);
-                body.set_linvel(to_glam(&v), true);
-                body.set_angvel(to_glam(&w), true);
+                body.set_position(pose_to_glam(&p), wake);
+                body.set_linvel(to_glam(&v), wake);
+                body.set_angvel(to_glam(&w), wake);
             }
             BodyKind::Supported => {}
             BodyKind::Fixed | BodyKind::Kinematic => return true,
         }
         if let Some((force, torque)) = load {
-            body.add_force(to_glam(&force), true);
-            body.add_torque(to_glam(&torque), true);
+            body.add_force(to_glam(&force), wake);
+            body.add_torque(to_glam(&torque), wake);
         }
         true
     }
