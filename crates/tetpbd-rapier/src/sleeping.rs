@@ -83,6 +83,30 @@ impl Waking {
         soft_margin: Option<f32>,
         dt: f32,
     ) -> usize {
+        let near = |aabb: &Aabb, att: Option<&Attachments>| near_rigid(aabb, input, fast, att);
+        self.run_with(world, input.default_collider, soft_margin, dt, near)
+    }
+
+    /// The soft–soft part of [`Waking::run`] alone, for [`crate::SoftContacts`] run as the
+    /// solver's hook without a coupling.
+    pub(crate) fn run_soft(
+        &mut self,
+        world: &mut World,
+        default: &SoftCollider,
+        margin: f32,
+        dt: f32,
+    ) -> usize {
+        self.run_with(world, default, Some(margin), dt, |_, _| false)
+    }
+
+    fn run_with(
+        &mut self,
+        world: &mut World,
+        default: &SoftCollider,
+        soft_margin: Option<f32>,
+        dt: f32,
+        mut near_rigid: impl FnMut(&Aabb, Option<&Attachments>) -> bool,
+    ) -> usize {
         self.bounds.clear();
         self.woken.clear();
         let mut any_asleep = false;
@@ -94,21 +118,23 @@ impl Waking {
             Option<&Attachments>,
             Option<&Asleep>,
         )>() {
-            let sc = sc.copied().unwrap_or(*input.default_collider);
+            let sc = sc.copied().unwrap_or(*default);
             let (lo, hi) = p.aabb();
             let aabb = Aabb::new(to_glam(&lo), to_glam(&hi)).loosened(sc.thickness.max(0.0));
             let asleep = asleep.is_some();
             any_asleep |= asleep;
             let reach = if asleep { 0.0 } else { p.max_speed() * dt };
-            if asleep && sc.enabled && near_rigid(&aabb, input, fast, att) {
+            if asleep && sc.enabled && near_rigid(&aabb, att) {
                 self.woken.push(entity);
             }
-            self.bounds.push(Bounds {
-                entity,
-                aabb,
-                reach,
-                asleep,
-            });
+            if sc.enabled {
+                self.bounds.push(Bounds {
+                    entity,
+                    aabb,
+                    reach,
+                    asleep,
+                });
+            }
         }
         if !any_asleep {
             return 0;
@@ -138,9 +164,10 @@ impl Waking {
                     continue;
                 }
                 let a = self.bounds[i].aabb;
-                let near = self.bounds.iter().any(|b| {
-                    !b.asleep && b.aabb.loosened(margin + b.reach).intersects(&a)
-                });
+                let near = self
+                    .bounds
+                    .iter()
+                    .any(|b| !b.asleep && b.aabb.loosened(margin + b.reach).intersects(&a));
                 if near {
                     self.bounds[i].asleep = false;
                     self.woken.push(self.bounds[i].entity);
@@ -190,7 +217,9 @@ pub(crate) fn touching(frame: &mut Frame, bodies: &RigidBodySet, out: &mut Touch
     let mut links = std::mem::take(&mut frame.waking.links);
     links.clear();
     for s in &frame.soft {
-        let contacts = frame.contacts[s.contacts.clone()].iter().map(|c| c.collider);
+        let contacts = frame.contacts[s.contacts.clone()]
+            .iter()
+            .map(|c| c.collider);
         let corners = frame.corners[s.corners.clone()].iter().map(|c| c.collider);
         let via_colliders = contacts
             .chain(corners)

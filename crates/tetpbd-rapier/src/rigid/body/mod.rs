@@ -452,7 +452,9 @@ impl BodyProxy {
         // sleeps, so an awake body is written without restarting its timer; a sleeping one
         // is woken only by a reaction that moves it faster than its sleep threshold.
         let wake = body.is_sleeping();
-        if wake && !crate::sleeping::moves_rigid(body, &(self.v_end + self.dv), &(self.w_end + self.dw)) {
+        if wake
+            && !crate::sleeping::moves_rigid(body, &(self.v_end + self.dv), &(self.w_end + self.dw))
+        {
             return true;
         }
         match self.kind {
