@@ -13,28 +13,36 @@
 //!   repeated until nothing more wakes, so a woken body wakes the sleeping bodies it touches
 //!   in the same frame: an island wakes as one.
 //! * **Islands** ([`tetpbd::SubstepHook::touching`]): two soft bodies near the same dynamic
-//!   rigid body (a candidate contact of both) sleep and wake together; a soft body near an
-//!   awake dynamic rigid body, or one that moves kinematically, stays awake. With soft–soft
-//!   contacts on, two soft bodies whose bounds overlap within the soft margin are one island.
-//! * **rapier's bodies keep rapier's rule**: the reaction written back to an awake rigid
-//!   body does not restart its sleep timer (rapier decides from the body's own motion), and a
-//!   sleeping rigid body is written, and woken, only when the reaction would move it faster
-//!   than its own sleep threshold. A box resting on a soft pile falls asleep in rapier, then
-//!   the pile falls asleep; sleeping soft bodies gather no contacts, so nothing touches the
-//!   box until something wakes it.
+//!   rigid body (a candidate contact of both) sleep and wake together; a soft body near a
+//!   dynamic rigid body that ends the frame faster than its sleep threshold, or a kinematic
+//!   one that moves, stays awake. With soft–soft contacts on, two soft bodies whose bounds
+//!   overlap within the soft margin are one island.
+//! * **rapier's bodies sleep with their island**: a dynamic rigid body whose soft bodies all
+//!   fell asleep in a frame (it was slow, or they would not have) is written back and put to
+//!   sleep with them (`RigidBody::sleep`), as rapier puts an island to sleep; it wakes by
+//!   rapier's rules (a contact, a joint, a user call) and then wakes them. A sleeping support
+//!   of an anchored body gets its reaction, and wakes, only when it would move it faster than
+//!   its sleep threshold. Sleeping soft bodies gather no contacts, so nothing touches a
+//!   sleeping box on a sleeping pile until something wakes one of them.
+//!
+//! * **Supports going away**: a sleeping soft body remembers the rigid bodies it fell asleep
+//!   touching, with their poses, and wakes when one of them moves, wakes or is removed (a
+//!   box lifted off it, a ground teleported).
 //!
 //! Thresholds of rapier's bodies are read in metres (`length_unit` 1).
 
 use hecs::{Entity, World};
 use nalgebra::Vector3;
-use rapier3d::dynamics::{RigidBody, RigidBodySet};
+use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{Aabb, ColliderHandle};
+use rapier3d::math::Pose;
 use rapier3d::parry::bounding_volume::BoundingVolume;
 use tetpbd::{Asleep, Particles, Surface, Touching};
 
 use crate::attachments::{AttachTarget, Attachments};
 use crate::convert::to_glam;
 use crate::gather::{Frame, GatherInput};
+use crate::rigid::body::BodyProxy;
 use crate::soft_collider::SoftCollider;
 
 /// Whether a velocity change `v` (m/s), `w` (rad/s) moves a rigid body faster than its
@@ -69,6 +77,11 @@ pub(crate) struct Waking {
     woken: Vec<Entity>,
     /// Scratch of [`touching`]: `(rigid body proxy, soft entity)`.
     links: Vec<(usize, Entity)>,
+    /// The rigid bodies each sleeping soft body fell asleep touching, with their pose then:
+    /// the body wakes when one of them moves, wakes or goes away.
+    rest: Vec<(Entity, RigidBodyHandle, Pose)>,
+    /// Scratch of [`Waking::run`]: soft bodies whose resting rigid bodies changed.
+    changed: Vec<Entity>,
 }
 
 impl Waking {
@@ -83,8 +96,40 @@ impl Waking {
         soft_margin: Option<f32>,
         dt: f32,
     ) -> usize {
-        let near = |aabb: &Aabb, att: Option<&Attachments>| near_rigid(aabb, input, fast, att);
-        self.run_with(world, input.default_collider, soft_margin, dt, near)
+        let bodies = input.qp.bodies;
+        self.rest.retain(|(e, _, _)| tetpbd::is_sleeping(world, *e));
+        let mut support_changed = std::mem::take(&mut self.changed);
+        support_changed.clear();
+        support_changed.extend(self.rest.iter().filter_map(|&(e, h, pose)| {
+            let same = bodies
+                .get(h)
+                .is_some_and(|rb| *rb.position() == pose && !awake_moving(rb));
+            (!same).then_some(e)
+        }));
+        let near = |e: Entity, aabb: &Aabb, att: Option<&Attachments>| {
+            support_changed.contains(&e) || near_rigid(aabb, input, fast, att)
+        };
+        let n = self.run_with(world, input.default_collider, soft_margin, dt, near);
+        self.changed = support_changed;
+        n
+    }
+
+    /// Records the rigid bodies the soft bodies that fell asleep this frame touch (from
+    /// [`touching`]'s links), with their poses.
+    pub(crate) fn remember_rest(
+        &mut self,
+        frame_bodies: &[BodyProxy],
+        bodies: &RigidBodySet,
+        world: &World,
+    ) {
+        for &(b, e) in &self.links {
+            let h = frame_bodies[b].handle;
+            if tetpbd::is_sleeping(world, e) && !self.rest.iter().any(|r| r.0 == e && r.1 == h) {
+                if let Some(rb) = bodies.get(h) {
+                    self.rest.push((e, h, *rb.position()));
+                }
+            }
+        }
     }
 
     /// The soft–soft part of [`Waking::run`] alone, for [`crate::SoftContacts`] run as the
@@ -96,7 +141,7 @@ impl Waking {
         margin: f32,
         dt: f32,
     ) -> usize {
-        self.run_with(world, default, Some(margin), dt, |_, _| false)
+        self.run_with(world, default, Some(margin), dt, |_, _, _| false)
     }
 
     fn run_with(
@@ -105,7 +150,7 @@ impl Waking {
         default: &SoftCollider,
         soft_margin: Option<f32>,
         dt: f32,
-        mut near_rigid: impl FnMut(&Aabb, Option<&Attachments>) -> bool,
+        mut near_rigid: impl FnMut(Entity, &Aabb, Option<&Attachments>) -> bool,
     ) -> usize {
         self.bounds.clear();
         self.woken.clear();
@@ -124,7 +169,7 @@ impl Waking {
             let asleep = asleep.is_some();
             any_asleep |= asleep;
             let reach = if asleep { 0.0 } else { p.max_speed() * dt };
-            if asleep && sc.enabled && near_rigid(&aabb, att) {
+            if asleep && sc.enabled && near_rigid(entity, &aabb, att) {
                 self.woken.push(entity);
             }
             if sc.enabled {
@@ -245,7 +290,13 @@ pub(crate) fn touching(frame: &mut Frame, bodies: &RigidBodySet, out: &mut Touch
         if rb.is_fixed() {
             continue;
         }
-        if awake_moving(rb) {
+        let (v, w) = frame.bodies[b].final_velocity();
+        let moving = if rb.is_dynamic() {
+            moves_rigid(rb, &v, &w)
+        } else {
+            awake_moving(rb)
+        };
+        if moving {
             out.keep_awake.push(e);
         }
         if rb.is_dynamic() && k > first {
@@ -253,4 +304,15 @@ pub(crate) fn touching(frame: &mut Frame, bodies: &RigidBodySet, out: &mut Touch
         }
     }
     frame.waking.links = links;
+}
+
+/// Whether every soft body touching rigid body proxy `body` (as [`touching`] found them this
+/// frame) is asleep: the body falls asleep with them.
+pub(crate) fn soft_asleep(waking: &Waking, body: usize, world: &World) -> bool {
+    let from = waking.links.partition_point(|&(b, _)| b < body);
+    let mut linked = waking.links[from..]
+        .iter()
+        .take_while(|&&(b, _)| b == body)
+        .peekable();
+    linked.peek().is_some() && linked.all(|&(_, e)| tetpbd::is_sleeping(world, e))
 }

@@ -260,7 +260,10 @@ impl SubstepHook for CouplingHook<'_, '_> {
     fn end_frame(&mut self, world: &mut World, _frame: FrameContext) {
         self.frame.remember_touching();
         let frame = &mut *self.frame;
-        self.reports.clear();
+        // A sleeping body keeps reporting the contacts it fell asleep on (`sleeping` module
+        // docs); the others are reported afresh.
+        self.reports
+            .retain(|r| tetpbd::is_sleeping(world, r.entity));
         let mut max_pen = 0.0f32;
         let mut max_att = 0.0f32;
         for s in &frame.soft {

@@ -424,6 +424,11 @@ impl BodyProxy {
     /// Force (N) and torque about the centre of mass (N·m) that carry the summed soft
     /// impulse on a supported body through rapier's next step (the impulse of this frame
     /// spread over `dt`); `None` for any other body or when there is none.
+    /// Velocity (m/s) and angular velocity (rad/s) the body ends the frame with.
+    pub fn final_velocity(&self) -> (Vector3<f32>, Vector3<f32>) {
+        (self.v_end + self.dv, self.w_end + self.dw)
+    }
+
     pub fn load(&self) -> Option<(Vector3<f32>, Vector3<f32>)> {
         (self.kind == BodyKind::Supported
             && self.touched
@@ -439,7 +444,7 @@ impl BodyProxy {
     /// a velocity change of the same impulse is an impact (a 100 kg soft body resting on a
     /// 0.125 kg box hands it about 100 m/s per frame, which rapier's contacts do not cancel
     /// cleanly). Returns `false` (and writes nothing) when the result is not finite.
-    pub fn write_back(&self, body: &mut RigidBody) -> bool {
+    pub fn write_back(&self, body: &mut RigidBody, soft_asleep: bool) -> bool {
         if !self.touched {
             return true;
         }
@@ -448,15 +453,8 @@ impl BodyProxy {
         if load.is_some_and(|(f, t)| !(finite(&f) && finite(&t))) {
             return false;
         }
-        // Sleeping (`sleeping` module docs): rapier's own rule decides when an awake body
-        // sleeps, so an awake body is written without restarting its timer; a sleeping one
-        // is woken only by a reaction that moves it faster than its sleep threshold.
-        let wake = body.is_sleeping();
-        if wake
-            && !crate::sleeping::moves_rigid(body, &(self.v_end + self.dv), &(self.w_end + self.dw))
-        {
-            return true;
-        }
+        // Sleeping (`sleeping` module docs): a body whose soft bodies all fell asleep with
+        // it is written and put to sleep with them; otherwise it is written and kept awake.
         match self.kind {
             BodyKind::Dynamic => {
                 let (v, w, p) = (self.v_end + self.dv, self.w_end + self.dw, self.pose);
@@ -467,16 +465,19 @@ impl BodyProxy {
                 {
                     return false;
                 }
-                body.set_position(pose_to_glam(&p), wake);
-                body.set_linvel(to_glam(&v), wake);
-                body.set_angvel(to_glam(&w), wake);
+                body.set_position(pose_to_glam(&p), true);
+                body.set_linvel(to_glam(&v), true);
+                body.set_angvel(to_glam(&w), true);
             }
             BodyKind::Supported => {}
             BodyKind::Fixed | BodyKind::Kinematic => return true,
         }
         if let Some((force, torque)) = load {
-            body.add_force(to_glam(&force), wake);
-            body.add_torque(to_glam(&torque), wake);
+            body.add_force(to_glam(&force), true);
+            body.add_torque(to_glam(&torque), true);
+        }
+        if soft_asleep {
+            body.sleep();
         }
         true
     }
