@@ -25,6 +25,9 @@
 //!   its sleep threshold. Sleeping soft bodies gather no contacts, so nothing touches a
 //!   sleeping box on a sleeping pile until something wakes one of them.
 //!
+//! * **Losing what holds it**: a sleeping body whose surface is removed or whose collider is
+//!   disabled wakes (it no longer collides, so it falls); one still being pushed out of an
+//!   overlap never sleeps.
 //! * **Supports going away**: a sleeping soft body remembers the rigid bodies it fell asleep
 //!   touching, with their poses, and wakes when one of them moves, wakes or is removed (a
 //!   box lifted off it, a ground teleported).
@@ -181,10 +184,27 @@ impl Waking {
                 });
             }
         }
+        self.bounds.sort_unstable_by_key(|b| b.entity.to_bits());
+        // A sleeping body that can no longer collide (its surface removed, its collider
+        // disabled) lost what held it: it wakes.
+        for (entity, sc) in world
+            .query_mut::<(Entity, Option<&SoftCollider>)>()
+            .with::<(&Asleep, &Particles)>()
+        {
+            let enabled = sc.copied().unwrap_or(*default).enabled;
+            let key = entity.to_bits();
+            let found = self
+                .bounds
+                .binary_search_by_key(&key, |b| b.entity.to_bits())
+                .is_ok();
+            if !enabled || !found {
+                self.woken.push(entity);
+                any_asleep = true;
+            }
+        }
         if !any_asleep {
             return 0;
         }
-        self.bounds.sort_unstable_by_key(|b| b.entity.to_bits());
         for b in &mut self.bounds {
             if self.woken.contains(&b.entity) {
                 b.asleep = false;
@@ -276,6 +296,14 @@ pub(crate) fn touching(frame: &mut Frame, bodies: &RigidBodySet, out: &mut Touch
             links.push((b, s.entity));
         }
     }
+    // A body still being pushed out of an overlap (`depenetration` module docs) is not at
+    // rest, however slowly the push moves it.
+    out.keep_awake.extend(
+        frame
+            .depenetrating
+            .iter()
+            .filter_map(|d| Entity::from_bits(d.0)),
+    );
     links.sort_unstable_by_key(|&(b, e)| (b, e.to_bits()));
     links.dedup();
     let mut first = 0;
