@@ -27,6 +27,8 @@
 //! * Soft–soft and self contacts: on by default ([`CouplingSettings::soft_contacts`]), with
 //!   each body's [`SoftCollider`]; [`SoftContacts`] runs them on a bare `tetpbd` solver.
 //! * Hooks of the integrator's own run in the same substeps through [`Coupling::step_with`].
+//! * Scene queries against soft bodies (ray casts, point projection and containment, AABB and
+//!   shape overlap), alone or together with rapier's colliders: [`SoftQueries`].
 //!
 //! ```
 //! use nalgebra::Vector3;
@@ -81,6 +83,7 @@ mod joints;
 mod mesh_side;
 mod placement;
 pub mod prelude;
+mod queries;
 mod report;
 mod response;
 mod rigid;
@@ -96,6 +99,10 @@ pub use attachments::{AttachTarget, Attachment, Attachments};
 pub use coupling::{Coupling, RapierContext};
 pub use error::CouplingError;
 pub use placement::RapierPlacement;
+pub use queries::{
+    QueryError, ScenePointProjection, SceneRayHit, SoftLocation, SoftPointProjection, SoftQueries,
+    SoftQueryFilter, SoftRayHit, SoftVolumePoint,
+};
 pub use report::{ContactReport, CouplingStats, SoftFeature};
 pub use scene::CoupledWorld;
 pub use settings::CouplingSettings;
@@ -108,3 +115,8 @@ pub use tetpbd::DeformationDamping;
 
 pub use rapier3d;
 pub use tetpbd;
+
+/// The scene-query guide (`docs/guide/queries.md`), compiled as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/guide/queries.md")]
+pub struct QueriesGuide;

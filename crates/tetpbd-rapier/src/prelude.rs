@@ -2,8 +2,8 @@
 //!
 //! Everything of [`tetpbd::prelude`] (where tetpbd's soft body types are [`TetBody`] and
 //! [`TetBodyBuilder`], since rapier's prelude has its own `SoftBody` and `SoftBodyBuilder`)
-//! and the coupling's own types, plus [`RapierPlacement`] to place a body with rapier's
-//! glam types.
+//! and the coupling's own types (the scene queries among them: [`SoftQueries`]), plus
+//! [`RapierPlacement`] to place a body with rapier's glam types.
 //!
 //! ```
 //! use rapier3d::prelude::*;
@@ -22,6 +22,10 @@ pub use crate::attachments::{AttachTarget, Attachment, Attachments};
 pub use crate::coupling::{Coupling, RapierContext};
 pub use crate::error::CouplingError;
 pub use crate::placement::RapierPlacement;
+pub use crate::queries::{
+    QueryError, ScenePointProjection, SceneRayHit, SoftLocation, SoftPointProjection, SoftQueries,
+    SoftQueryFilter, SoftRayHit, SoftVolumePoint,
+};
 pub use crate::report::{ContactReport, CouplingStats, SoftFeature};
 pub use crate::scene::CoupledWorld;
 pub use crate::settings::CouplingSettings;

@@ -36,6 +36,19 @@ fn every_prelude_name_resolves_next_to_rapiers_prelude() -> Result<(), Box<dyn s
     let _: fn(&Surface) -> &[[u32; 3]] = Surface::triangles;
     let _: Option<(StepStats, ExternalAcceleration, Solver)> = None;
     let _: Option<(BuildError, SettingsError, StateError, StepError)> = None;
+    let (soft, rigid) = scene.queries();
+    let ray = Ray::new(Vector::new(0.0, 2.0, 0.0), Vector::new(0.0, -1.0, 0.0));
+    let filter: SoftQueryFilter = SoftQueryFilter::new();
+    let hit: Option<SceneRayHit> = soft.cast_ray_scene(&rigid, &ray, Real::MAX, true, filter)?;
+    assert!(matches!(hit, Some(SceneRayHit::Soft(SoftRayHit { entity, .. })) if entity == e));
+    let _: &SoftQueries = soft;
+    let _: Option<(
+        QueryError,
+        ScenePointProjection,
+        SoftLocation,
+        SoftPointProjection,
+        SoftVolumePoint,
+    )> = None;
     let _: Option<(
         AttachTarget,
         Attachment,

@@ -97,7 +97,7 @@ impl BodyCache {
             let aabb = Aabb::new(to_glam(&lo), to_glam(&hi));
             self.tri_bvh.insert_or_update_partially(aabb, t as u32, 0.0);
         }
-        self.tri_bvh.refit(&mut self.workspace);
+        self.tri_bvh.refit_without_opt();
     }
 
     /// Refits the tetrahedron BVH to the particle positions `p` (all particles).
@@ -111,7 +111,7 @@ impl BodyCache {
             let aabb = Aabb::new(to_glam(&lo), to_glam(&hi));
             self.tet_bvh.insert_or_update_partially(aabb, t as u32, 0.0);
         }
-        self.tet_bvh.refit(&mut self.workspace);
+        self.tet_bvh.refit_without_opt();
     }
 
     /// Builds the one-ring exclusion lists (once) for self collision.
@@ -214,6 +214,22 @@ fn ray_triangle(
     b: &Vector3<f32>,
     c: &Vector3<f32>,
 ) -> Option<f32> {
+    ray_triangle_barycentric(o, dir, [a, b, c], 0.0).map(|(t, _)| t)
+}
+
+/// Möller–Trumbore: the ray parameter `t ≥ 0` (in units of `|dir|`) at which the ray
+/// `o + t dir` meets triangle `(a, b, c)`, and the barycentric coordinates of the hit point
+/// (weights of `a`, `b`, `c`; in `[0, 1]`, summing to 1); `None` when it misses, runs
+/// parallel to the triangle's plane or the triangle is degenerate. A hit up to `slack`
+/// (dimensionless, in barycentric units) outside the triangle counts, its weights clamped
+/// back onto the triangle: with a slack of a few ulps a ray through a vertex or edge shared
+/// by several triangles meets at least one of them despite rounding.
+pub(crate) fn ray_triangle_barycentric(
+    o: &Vector3<f32>,
+    dir: &Vector3<f32>,
+    [a, b, c]: [&Vector3<f32>; 3],
+    slack: f32,
+) -> Option<(f32, [f32; 3])> {
     let e1 = b - a;
     let e2 = c - a;
     let pv = dir.cross(&e2);
@@ -224,16 +240,24 @@ fn ray_triangle(
     let inv = 1.0 / det;
     let tv = o - a;
     let u = tv.dot(&pv) * inv;
-    if !(0.0..=1.0).contains(&u) {
+    if !(-slack..=1.0 + slack).contains(&u) {
         return None;
     }
     let qv = tv.cross(&e1);
     let v = dir.dot(&qv) * inv;
-    if v < 0.0 || u + v > 1.0 {
+    if v < -slack || u + v > 1.0 + slack {
         return None;
     }
     let t = e2.dot(&qv) * inv;
-    (t >= 0.0 && t.is_finite()).then_some(t)
+    if !(t >= 0.0 && t.is_finite()) {
+        return None;
+    }
+    if slack == 0.0 {
+        return Some((t, [1.0 - u - v, u, v]));
+    }
+    let w = [1.0 - u - v, u, v].map(|w| w.max(0.0));
+    let sum = w[0] + w[1] + w[2];
+    Some((t, w.map(|w| w / sum)))
 }
 
 /// `true` when `x` lies strictly inside the tetrahedron `t` (either orientation).
@@ -250,6 +274,26 @@ pub(crate) fn in_tet(x: &Vector3<f32>, t: &[Vector3<f32>; 4]) -> bool {
         && vol(&t[0], x, &t[2], &t[3]) * s > 0.0
         && vol(&t[0], &t[1], x, &t[3]) * s > 0.0
         && vol(&t[0], &t[1], &t[2], x) * s > 0.0
+}
+
+/// Barycentric coordinates of `x` in tetrahedron `t` (weights of its four corners, summing
+/// to 1), when `x` lies inside it or on its boundary (all weights ≥ 0, either orientation);
+/// `None` outside or for a flat tetrahedron.
+pub(crate) fn tet_barycentric(x: &Vector3<f32>, t: &[Vector3<f32>; 4]) -> Option<[f32; 4]> {
+    let vol = |a: &Vector3<f32>, b: &Vector3<f32>, c: &Vector3<f32>, d: &Vector3<f32>| {
+        (b - a).dot(&(c - a).cross(&(d - a)))
+    };
+    let total = vol(&t[0], &t[1], &t[2], &t[3]);
+    if total == 0.0 || !total.is_finite() {
+        return None;
+    }
+    let w = [
+        vol(x, &t[1], &t[2], &t[3]) / total,
+        vol(&t[0], x, &t[2], &t[3]) / total,
+        vol(&t[0], &t[1], x, &t[3]) / total,
+        vol(&t[0], &t[1], &t[2], x) / total,
+    ];
+    w.iter().all(|w| *w >= 0.0 && w.is_finite()).then_some(w)
 }
 
 /// Unit normal `(b − a) × (c − a) / |…|` of a triangle, or `None` when it is degenerate.
