@@ -164,10 +164,10 @@ pub(crate) fn fall_asleep(
         }
     }
     let mut count = SleepCount::default();
-    for i in 0..nodes.len() {
+    for (i, &(entity, _)) in nodes.iter().enumerate() {
         let r = find(parent, i);
         if !blocked[r] {
-            put_to_sleep(world, nodes[i].0);
+            put_to_sleep(world, entity);
             count.fell_asleep += 1;
         }
     }
