@@ -12,6 +12,8 @@ use clap::{CommandFactory, Parser};
 
 #[path = "../examples/cli/asset_drop.rs"]
 mod asset_drop;
+#[path = "../examples/cli/integrating.rs"]
+mod integrating;
 #[path = "../examples/cli/kinematic_platform.rs"]
 mod kinematic_platform;
 #[path = "../examples/cli/recover.rs"]
@@ -29,6 +31,7 @@ mod soft_pile;
 fn commands() -> Vec<clap::Command> {
     vec![
         asset_drop::Cli::command(),
+        integrating::Cli::command(),
         kinematic_platform::Cli::command(),
         recover::Cli::command(),
         rigid_ball_on_soft::Cli::command(),
@@ -120,6 +123,14 @@ fn the_documented_invocations_parse() {
     );
     assert!(!cli.viz.renders());
 
+    // .ci/run and docs/guide/integrating.md.
+    let cli = integrating::Cli::try_parse_from(["integrating", "--frames", "60"]).unwrap();
+    assert_eq!(cli.frames, 60);
+    assert_eq!(
+        (cli.render_hz, cli.physics_hz, cli.substeps),
+        (144.0, 60.0, 10)
+    );
+
     // .ci/run and the README's gallery section.
     let cli = rigid_ball_on_soft::Cli::try_parse_from([
         "rigid_ball_on_soft",
@@ -183,7 +194,7 @@ fn the_documented_invocations_parse() {
 
 #[test]
 fn a_bad_argument_is_rejected_with_a_message_naming_it() {
-    let cases: [(clap::Command, &[&str], &str); 15] = [
+    let cases: [(clap::Command, &[&str], &str); 17] = [
         (rigid_ball_on_soft::Cli::command(), &["x", "ten"], "FRAMES"),
         (rigid_ball_on_soft::Cli::command(), &["x", "-3"], "FRAMES"),
         (soft_on_rigid_stack::Cli::command(), &["x", "1.5"], "FRAMES"),
@@ -222,6 +233,16 @@ fn a_bad_argument_is_rejected_with_a_message_naming_it() {
             asset_drop::Cli::command(),
             &["x", "a.obj", "60", "-0.1"],
             "CELL_M",
+        ),
+        (
+            integrating::Cli::command(),
+            &["x", "--render-hz", "fast"],
+            "--render-hz",
+        ),
+        (
+            integrating::Cli::command(),
+            &["x", "--frames", "-3"],
+            "--frames",
         ),
     ];
     for (command, args, name) in cases {

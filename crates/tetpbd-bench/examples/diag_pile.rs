@@ -7,10 +7,11 @@
 //! cargo run --release -p tetpbd-bench --example diag_pile -- [SUBSTEPS [DAMPING [FROM [TO [sw|nosw]]]]]
 //! ```
 //!
-//! Defaults `80 5 50 80 sw`: the run in which, at frames 56–58, a cube falling at 9 m/s
+//! `-- --help` lists the arguments. Defaults `80 5 50 80 sw`: the run in which, at frames 56–58, a cube falling at 9 m/s
 //! onto one resting on the ground drives it 15 cm into the ground and the push-out launches
 //! both at 60–160 m/s (docs/performance.md, "The spin removal").
 
+use clap::{Parser, ValueEnum};
 use nalgebra::Vector3;
 use tetpbd_bench::{build_contact, ContactEngine, ContactScene, DT};
 
@@ -19,12 +20,42 @@ fn signed_volume(p: &[Vector3<f32>], t: &[u32; 4]) -> f32 {
     (b - a).dot(&(c - a).cross(&(d - a))) / 6.0
 }
 
+/// Diagnosis of the pile scene: per frame, the bodies moving faster than 1 m/s or with an
+/// inverted tetrahedron.
+#[derive(Debug, Parser)]
+#[command(name = "diag_pile")]
+struct Cli {
+    /// Substeps per frame.
+    #[arg(default_value_t = 80)]
+    substeps: u32,
+    /// Deformation damping, 1/s.
+    #[arg(default_value_t = 5.0)]
+    damping: f32,
+    /// First frame printed.
+    #[arg(default_value_t = 50)]
+    from: usize,
+    /// Last frame run.
+    #[arg(default_value_t = 80)]
+    to: usize,
+    /// The self-weight sweep on (`sw`) or off (`nosw`).
+    #[arg(value_enum, default_value = "sw")]
+    self_weight: SelfWeight,
+}
+
+/// The self-weight sweep switch.
+#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
+enum SelfWeight {
+    /// On.
+    Sw,
+    /// Off.
+    Nosw,
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().collect();
-    let num = |i: usize, d: f32| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
-    let (substeps, damping) = (num(1, 80.0) as u32, num(2, 5.0));
-    let (from, to) = (num(3, 50.0) as usize, num(4, 80.0) as usize);
-    let self_weight = args.get(5).is_none_or(|s| s != "nosw");
+    let cli = Cli::parse();
+    let (substeps, damping) = (cli.substeps, cli.damping);
+    let (from, to) = (cli.from, cli.to);
+    let self_weight = cli.self_weight == SelfWeight::Sw;
     let scene = ContactScene::pile(to)?;
     let rest: Vec<f32> = scene
         .cube

@@ -5,16 +5,12 @@ use std::time::{Duration, Instant};
 
 use hecs::World;
 use nalgebra::Vector3;
-use rapier3d::dynamics::{
-    CCDSolver, ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet,
-    RigidBodySet, SoftBodySet,
-};
-use rapier3d::geometry::{BroadPhaseBvh, ColliderSet, NarrowPhase};
-use rapier3d::math::Vector;
-use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline, PhysicsWorld, QueryFilter};
+use rapier3d::dynamics::RigidBodySet;
+use rapier3d::pipeline::QueryFilter;
 use tetpbd::{Solver, SolverSettings, SubstepHook};
 
 use crate::contacts::support::{apply_reaction, support_reaction};
+use crate::context::RapierContext;
 use crate::convert::{to_glam, to_na};
 use crate::error::CouplingError;
 use crate::gather::Frame;
@@ -23,61 +19,6 @@ use crate::settings::CouplingSettings;
 use crate::soft_soft::settings::SoftContactSettings;
 use crate::soft_soft::SoftContacts;
 use crate::substep::CouplingHook;
-
-/// The user's rapier state, borrowed for one coupled step. Every field is the argument of
-/// the same name of [`PhysicsPipeline::step`]; the integrator keeps owning all of it.
-pub struct RapierContext<'a> {
-    /// The integrator's physics pipeline.
-    pub pipeline: &'a mut PhysicsPipeline,
-    /// Gravity, m/s²: the scene's, for the rigid and the soft bodies alike.
-    pub gravity: Vector,
-    /// Integration parameters; their `dt` is the scene's frame time, for the soft bodies too.
-    pub integration_parameters: &'a IntegrationParameters,
-    /// Islands.
-    pub islands: &'a mut IslandManager,
-    /// Broad phase; its BVH finds the colliders near each soft body.
-    pub broad_phase: &'a mut BroadPhaseBvh,
-    /// Narrow phase (its query dispatcher runs the queries).
-    pub narrow_phase: &'a mut NarrowPhase,
-    /// Rigid bodies.
-    pub bodies: &'a mut RigidBodySet,
-    /// Colliders.
-    pub colliders: &'a mut ColliderSet,
-    /// Impulse joints.
-    pub impulse_joints: &'a mut ImpulseJointSet,
-    /// Multibody joints.
-    pub multibody_joints: &'a mut MultibodyJointSet,
-    /// rapier's own soft bodies (independent of `tetpbd`'s).
-    pub soft_bodies: &'a mut SoftBodySet,
-    /// CCD solver.
-    pub ccd_solver: &'a mut CCDSolver,
-    /// Physics hooks.
-    pub hooks: &'a dyn PhysicsHooks,
-    /// Event handler.
-    pub events: &'a dyn EventHandler,
-}
-
-impl<'a> RapierContext<'a> {
-    /// Borrows every part of a rapier [`PhysicsWorld`], with no hooks and no events.
-    pub fn from_physics_world(w: &'a mut PhysicsWorld) -> Self {
-        RapierContext {
-            pipeline: &mut w.physics_pipeline,
-            gravity: w.gravity,
-            integration_parameters: &w.integration_parameters,
-            islands: &mut w.islands,
-            broad_phase: &mut w.broad_phase,
-            narrow_phase: &mut w.narrow_phase,
-            bodies: &mut w.bodies,
-            colliders: &mut w.colliders,
-            impulse_joints: &mut w.impulse_joints,
-            multibody_joints: &mut w.multibody_joints,
-            soft_bodies: &mut w.soft_bodies,
-            ccd_solver: &mut w.ccd_solver,
-            hooks: &(),
-            events: &(),
-        }
-    }
-}
 
 /// Two-way coupling of `tetpbd` soft bodies with a rapier scene.
 ///

@@ -72,6 +72,7 @@
 mod attachments;
 mod ccd;
 mod contacts;
+mod context;
 mod convert;
 mod coupling;
 mod depenetration;
@@ -96,7 +97,8 @@ mod substep;
 mod validate;
 
 pub use attachments::{AttachTarget, Attachment, Attachments};
-pub use coupling::{Coupling, RapierContext};
+pub use context::RapierContext;
+pub use coupling::Coupling;
 pub use error::CouplingError;
 pub use placement::RapierPlacement;
 pub use queries::{

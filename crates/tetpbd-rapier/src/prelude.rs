@@ -19,7 +19,8 @@
 //! ```
 
 pub use crate::attachments::{AttachTarget, Attachment, Attachments};
-pub use crate::coupling::{Coupling, RapierContext};
+pub use crate::context::RapierContext;
+pub use crate::coupling::Coupling;
 pub use crate::error::CouplingError;
 pub use crate::placement::RapierPlacement;
 pub use crate::queries::{

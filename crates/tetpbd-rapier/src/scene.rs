@@ -5,7 +5,8 @@ use hecs::World;
 use rapier3d::pipeline::{PhysicsWorld, QueryPipeline};
 use tetpbd::{SolverSettings, SubstepHook};
 
-use crate::coupling::{Coupling, RapierContext};
+use crate::context::RapierContext;
+use crate::coupling::Coupling;
 use crate::error::CouplingError;
 use crate::queries::SoftQueries;
 use crate::report::CouplingStats;

@@ -35,6 +35,7 @@ fn every_prelude_name_resolves_next_to_rapiers_prelude() -> Result<(), Box<dyn s
     let _: fn(&Tetrahedra) -> usize = Tetrahedra::len;
     let _: fn(&Surface) -> &[[u32; 3]] = Surface::triangles;
     let _: Option<(StepStats, ExternalAcceleration, Solver)> = None;
+    let _: Option<(UserForces, Grab, MaterialPoint)> = None;
     let _: Option<(BuildError, SettingsError, StateError, StepError)> = None;
     let (soft, rigid) = scene.queries();
     let ray = Ray::new(Vector::new(0.0, 2.0, 0.0), Vector::new(0.0, -1.0, 0.0));

@@ -7,27 +7,56 @@
 //! cargo run --release -p tetpbd-stability --example diag_sliver -- [CASE] [CONFIG] [net]
 //! ```
 //!
-//! `CASE` is a substring of the case name (default `slivers`), `CONFIG` one of the column
-//! labels' prefixes (`vertex-face`, `vertex-face+edges`, `edges+volume`; default
-//! `vertex-face`) optionally followed by `,soft`; `net` turns the 10 m/s safety net on.
+//! `-- --help` lists the arguments.
 
+use clap::{Parser, ValueEnum};
 use tetpbd_stability::{all_cases, run_scene_observed, Config, ConstraintSet};
 
-fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let case_name = args.first().map_or("slivers", String::as_str);
-    let config_name = args.get(1).map_or("vertex-face", String::as_str);
-    let net = args.iter().any(|a| a == "net");
-    let (set_name, soft) = match config_name.split_once(',') {
-        Some((s, rest)) => (s, rest == "soft"),
-        None => (config_name, false),
+/// Frame-by-frame trace of one case of the stability matrix under one configuration.
+#[derive(Debug, Parser)]
+#[command(name = "diag_sliver")]
+struct Cli {
+    /// A substring of the case's name.
+    #[arg(default_value = "slivers")]
+    case: String,
+    /// The configuration: a column label's prefix (`vertex-face`, `vertex-face+edges`,
+    /// `edges+volume`), optionally followed by `,soft`.
+    #[arg(default_value = "vertex-face", value_parser = parse_config)]
+    config: Config,
+    /// `net` turns the 10 m/s safety net on (default: off).
+    #[arg(value_enum)]
+    net: Option<Net>,
+}
+
+/// The safety-net switch.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum Net {
+    /// The 10 m/s safety net.
+    Net,
+}
+
+fn parse_config(text: &str) -> Result<Config, String> {
+    let (set_name, soft) = match text.split_once(',') {
+        Some((s, "soft")) => (s, true),
+        Some((_, other)) => return Err(format!("`{other}` after the comma: only `soft`")),
+        None => (text, false),
     };
     let set = match set_name {
         "edges+volume" => ConstraintSet::EdgesVolume,
         "vertex-face+edges" => ConstraintSet::VertexFaceEdges,
-        _ => ConstraintSet::VertexFace,
+        "vertex-face" => ConstraintSet::VertexFace,
+        other => {
+            return Err(format!(
+                "`{other}`: one of vertex-face, vertex-face+edges, edges+volume"
+            ))
+        }
     };
-    let config = Config { set, soft };
+    Ok(Config { set, soft })
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let (case_name, config, net) = (cli.case.as_str(), cli.config, cli.net.is_some());
     let cases = all_cases(net.then_some(10.0));
     let Some(case) = cases.iter().find(|c| c.name.contains(case_name)) else {
         eprintln!("no case matches {case_name:?}");

@@ -59,12 +59,7 @@ impl Scene {
             mesh,
             pinned: Vec::new(),
             start: Start::Rest,
-            // The uncoupled matrix measures free bodies with the correction-energy limit on
-            // (opt-in in the library: it misreads contact work, see its docs).
-            settings: SolverSettings {
-                limit_correction_energy: true,
-                ..SolverSettings::default()
-            },
+            settings: SolverSettings::default(),
             frames: 60,
             compliance_scale: 1.0,
             epsilon: SoftBodyBuilder::DEFAULT_EPSILON,

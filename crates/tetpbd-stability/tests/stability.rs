@@ -84,6 +84,11 @@ const KNOWN_LIMITS: &[(&str, &str)] = &[
     ),
     ("300 m/s, 5 tets/cell, 10 substeps", "edges+volume, soft"),
     ("300 m/s, 5 tets/cell, 10 substeps", "vertex-face, soft"),
+    // Vertex–face alone cannot hold a shape crushed at 300 m/s (four heights fix four of six
+    // shape degrees of freedom); the ground's impulses are external work in the energy
+    // limit's budget, and part of the crush comes back as particle speed (354 m/s, the body's
+    // centre rebounds at 36 m/s).
+    ("300 m/s, 5 tets/cell, 10 substeps", "vertex-face, α=0"),
 ];
 
 fn known_limit(case: &tetpbd_stability::Case, config: &Config) -> bool {

@@ -230,6 +230,27 @@ pub enum StateError {
         /// The value given.
         value: f32,
     },
+    /// Tetrahedron index out of range.
+    TetrahedronOutOfRange {
+        /// The offending index.
+        index: usize,
+        /// Number of tetrahedra.
+        len: usize,
+    },
+    /// Barycentric coordinates that are not finite, clearly negative, or do not sum to 1.
+    BadBarycentric {
+        /// The coordinates given.
+        coords: [f32; 4],
+    },
+    /// A per-particle component was made for a body with another number of particles.
+    LengthMismatch {
+        /// Which component.
+        what: &'static str,
+        /// Its length.
+        len: usize,
+        /// The body's number of particles.
+        particles: usize,
+    },
 }
 
 impl fmt::Display for StateError {
@@ -249,6 +270,21 @@ impl fmt::Display for StateError {
             StateError::BadParameter { what, value } => {
                 write!(f, "{what} is out of range: {value}")
             }
+            StateError::TetrahedronOutOfRange { index, len } => {
+                write!(f, "tetrahedron {index} out of range ({len} tetrahedra)")
+            }
+            StateError::BadBarycentric { coords } => write!(
+                f,
+                "barycentric coordinates {coords:?} must be finite, >= 0 and sum to 1"
+            ),
+            StateError::LengthMismatch {
+                what,
+                len,
+                particles,
+            } => write!(
+                f,
+                "{what} has {len} entries but the body has {particles} particles"
+            ),
         }
     }
 }

@@ -7,7 +7,10 @@
 //! ([`EdgeConstraints`], [`VertexFaceConstraints`], [`VolumeConstraints`]): a body pays only
 //! for the families it has. A [`Solver`] steps every body of a `hecs::World` with
 //! [`SolverSettings`], runs a [`SubstepHook`] (contacts, attachments of a coupling crate)
-//! inside its substep loop and returns [`StepStats`]. [`constraints`] holds the constraint
+//! inside its substep loop and returns [`StepStats`]. Interaction: impulses on
+//! [`Particles`] (`apply_impulse`, `apply_impulse_at_point`, `apply_radial_impulse`), forces
+//! in the [`UserForces`] component (integrated like gravity, kept until reset), and the
+//! [`Grab`] component holding a [`MaterialPoint`] to a moving target (mouse picking). [`constraints`] holds the constraint
 //! math as pure functions and [`systems`] the solver's steps as plain functions over
 //! `&mut hecs::World`, for an integrator who builds a different schedule.
 //!
@@ -55,8 +58,11 @@ mod stabilisation;
 pub use body::activation::{Activation, Asleep};
 pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
 pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};
+pub use body::forces::UserForces;
 pub use body::generators;
+pub use body::grab::Grab;
 pub use body::impulses::PointImpulse;
+pub use body::material_point::MaterialPoint;
 pub use body::mesh::{Surface, Tetrahedra};
 pub use body::particles::{ExternalAcceleration, Particles};
 pub use body::placement::Placement;

@@ -14,7 +14,10 @@
 
 pub use crate::body::activation::{Activation, Asleep};
 pub use crate::body::builder::{SoftBody as TetBody, SoftBodyBuilder as TetBodyBuilder, TetMesh};
+pub use crate::body::forces::UserForces;
 pub use crate::body::generators;
+pub use crate::body::grab::Grab;
+pub use crate::body::material_point::MaterialPoint;
 pub use crate::body::mesh::{Surface, Tetrahedra};
 pub use crate::body::particles::{ExternalAcceleration, Particles};
 pub use crate::body::placement::Placement;

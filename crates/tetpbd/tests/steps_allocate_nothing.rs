@@ -57,12 +57,20 @@ fn steps_after_the_first_allocate_nothing() {
         .build()
         .unwrap()
         .spawn(&mut world);
-    SoftBodyBuilder::new(ball(0.5, 3, CellSplit::Five).unwrap())
+    let ball = SoftBodyBuilder::new(ball(0.5, 3, CellSplit::Five).unwrap())
         .vertex_face(1e-6)
         .translation(Vector3::new(3.0, 0.0, 0.0))
         .build()
-        .unwrap()
-        .spawn(&mut world);
+        .unwrap();
+    // Interaction components: a force at a point and a grab.
+    let mut forces = tetpbd::UserForces::new(&ball.particles);
+    let at = Vector3::new(3.0, 0.0, 0.0);
+    forces
+        .add_force_at_point(&ball.particles, &ball.tetrahedra, Vector3::x(), at)
+        .unwrap();
+    let grab = tetpbd::Grab::at(&ball.particles, &ball.tetrahedra, at, 1e-4, 100.0).unwrap();
+    let e = ball.spawn(&mut world);
+    world.insert(e, (forces, grab)).unwrap();
     for measure in [false, true] {
         let mut solver = Solver::new(SolverSettings {
             measure_error: measure,

@@ -167,9 +167,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         doc,
         "The *recovery* rows repeat the initial-state rows on both grid splits (5 and 6 tetrahedra per \
          cell) at {SWEEP_SUBSTEPS:?} substeps; the *impact* rows throw a cube at immovable ground at 100 and \
-         300 m/s on both splits at the same substep counts. Both sweeps run at default settings only. Every \
-         uncoupled row runs with `SolverSettings::limit_correction_energy` on (opt-in in the \
-         library); the coupled rows at the library defaults.\n"
+         300 m/s on both splits at the same substep counts. Both sweeps run at default settings only, \
+         the correction-energy limit included.\n"
     )?;
 
     let tables: Vec<(&str, Vec<_>)> = [

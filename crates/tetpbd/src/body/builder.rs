@@ -288,6 +288,7 @@ impl SoftBodyBuilder {
                 source: particle_source,
                 work: WorkCopy(vec![Slot::default(); n]),
                 written: false,
+                hook: Default::default(),
             },
             tetrahedra: Tetrahedra {
                 indices: mesh.tets,

@@ -7,14 +7,13 @@
 //! At a point `p` inside tetrahedron `t` with barycentric coordinates `bₖ` (`Σ bₖ = 1`,
 //! `Σ bₖ xₖ = p`), corner `k` receives `bₖ J`: the momentum changes by `J` and the angular
 //! momentum about any origin by `p × J`, as for a rigid body hit at `p`. A point outside the
-//! body goes to the tetrahedron that holds it most nearly (largest smallest coordinate), its
-//! coordinates clamped to `[0, 1]` and renormalised.
+//! body goes to the tetrahedron that holds it most nearly ([`MaterialPoint::locate`]).
 
 use nalgebra::Vector3;
 
+use crate::body::material_point::MaterialPoint;
 use crate::body::mesh::Tetrahedra;
 use crate::body::particles::Particles;
-use crate::constraints::signed_volume;
 use crate::error::StateError;
 
 /// Where [`Particles::apply_impulse_at_point`] put an impulse.
@@ -57,26 +56,13 @@ impl Particles {
     ) -> Result<PointImpulse, StateError> {
         finite(&impulse, "impulse")?;
         self.written = true;
-        finite(&point, "point")?;
-        let (tetrahedron, coords) = self.holding_tetrahedron(tetrahedra, &point)?;
-        let corners = tetrahedra.indices()[tetrahedron].map(|i| i as usize);
-        let inside = coords.iter().all(|b| *b >= 0.0);
-        let mut weights = coords.map(|b| b.max(0.0));
-        for (w, &i) in weights.iter_mut().zip(&corners) {
-            if self.inv_masses[i] == 0.0 {
-                *w = 0.0;
-            }
-        }
-        let sum: f64 = weights.iter().sum();
-        if sum <= 0.0 {
-            return Err(StateError::AllPinned);
-        }
-        let weights = weights.map(|w| (w / sum) as f32);
+        let (at, inside) = MaterialPoint::locate(self, tetrahedra, point)?;
+        let (corners, weights) = at.free_shares(self, tetrahedra)?;
         for (w, &i) in weights.iter().zip(&corners) {
             self.velocities[i] += impulse * (*w * self.inv_masses[i]);
         }
         Ok(PointImpulse {
-            tetrahedron,
+            tetrahedron: at.tetrahedron(),
             weights,
             inside,
         })
@@ -119,63 +105,16 @@ impl Particles {
         Ok(total)
     }
 
-    fn free_masses(&self) -> impl Iterator<Item = f32> + '_ {
+    pub(crate) fn free_masses(&self) -> impl Iterator<Item = f32> + '_ {
         self.masses
             .iter()
             .zip(&self.inv_masses)
             .filter(|(_, w)| **w > 0.0)
             .map(|(m, _)| *m)
     }
-
-    /// The tetrahedron holding `p` most nearly and `p`'s barycentric coordinates in it (f64).
-    fn holding_tetrahedron(
-        &self,
-        tetrahedra: &Tetrahedra,
-        p: &Vector3<f32>,
-    ) -> Result<(usize, [f64; 4]), StateError> {
-        let n = self.positions.len();
-        let mut best: Option<(usize, [f64; 4], f64)> = None;
-        for (t, tet) in tetrahedra.indices().iter().enumerate() {
-            if let Some(&i) = tet.iter().find(|i| **i as usize >= n) {
-                return Err(StateError::ParticleOutOfRange {
-                    index: i as usize,
-                    len: n,
-                });
-            }
-            let Some(b) = barycentric(tet.map(|i| self.positions[i as usize]), p) else {
-                continue;
-            };
-            let smallest = b.iter().copied().fold(f64::INFINITY, f64::min);
-            if best.is_none_or(|(_, _, s)| smallest > s) {
-                best = Some((t, b, smallest));
-            }
-        }
-        best.map(|(t, b, _)| (t, b)).ok_or(StateError::NoTetrahedra)
-    }
 }
 
-/// Barycentric coordinates of `p` in the tetrahedron `x` (ratios of signed volumes), or `None`
-/// for a flat tetrahedron.
-fn barycentric(x: [Vector3<f32>; 4], p: &Vector3<f32>) -> Option<[f64; 4]> {
-    // Relative to the first corner, in f64: far from the origin the f32 coordinates would
-    // cancel.
-    let o = x[0].cast::<f64>();
-    let x = x.map(|c| c.cast::<f64>() - o);
-    let p = &(p.cast::<f64>() - o);
-    let v = signed_volume::<f64>;
-    let total = v(&x[0], &x[1], &x[2], &x[3]);
-    if total == 0.0 || !total.is_finite() {
-        return None;
-    }
-    Some([
-        v(p, &x[1], &x[2], &x[3]) / total,
-        v(&x[0], p, &x[2], &x[3]) / total,
-        v(&x[0], &x[1], p, &x[3]) / total,
-        v(&x[0], &x[1], &x[2], p) / total,
-    ])
-}
-
-fn finite(v: &Vector3<f32>, what: &'static str) -> Result<(), StateError> {
+pub(crate) fn finite(v: &Vector3<f32>, what: &'static str) -> Result<(), StateError> {
     if v.iter().all(|c| c.is_finite()) {
         Ok(())
     } else {

@@ -9,8 +9,11 @@
 pub(crate) mod activation;
 pub(crate) mod builder;
 pub(crate) mod families;
+pub(crate) mod forces;
 pub mod generators;
+pub(crate) mod grab;
 pub(crate) mod impulses;
+pub(crate) mod material_point;
 pub(crate) mod mesh;
 pub(crate) mod particles;
 pub(crate) mod placement;

@@ -45,6 +45,10 @@ pub struct Particles {
     /// compared nor serialized.
     #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) written: bool,
+    /// The kinetic energy a hook's corrections handed the families' next pass (see
+    /// [`crate::stabilisation::hook_work`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub(crate) hook: crate::stabilisation::hook_work::HookWork,
 }
 
 impl PartialEq for Particles {
@@ -62,6 +66,7 @@ impl PartialEq for Particles {
             vertex_to_particle,
             work: _,
             written: _,
+            hook,
         } = self;
         *positions == o.positions
             && *prev_positions == o.prev_positions
@@ -72,6 +77,7 @@ impl PartialEq for Particles {
             && *residuals == o.residuals
             && *source == o.source
             && *vertex_to_particle == o.vertex_to_particle
+            && *hook == o.hook
     }
 }
 

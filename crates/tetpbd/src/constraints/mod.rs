@@ -19,7 +19,7 @@
 //! Lagrange multiplier, reset to zero at the start of every substep. With `α = 0` this is
 //! the hard PBD projection of Müller et al. 2006, which removes `C` to first order in one
 //! step. The potential energy behind a compliant constraint is `U = C² / (2α)`, so `α` has the
-//! units of `C² / J`: m/N for the two length constraints, m⁵/N for the volume constraint.
+//! units of `C² / J`: m/N for the two length constraints and the grab, m⁵/N for the volume constraint.
 //!
 //! # Where each constraint lives
 //!
@@ -28,17 +28,20 @@
 //!   [`vertex_face_bounded()`], the degeneracy-aware form the solver runs
 //!   (`vertex_face_bounded.rs`);
 //! * [`volume()`] — signed volume (`volume.rs`);
+//! * [`grab()`] — a material point held to a target with a bounded force (`grab.rs`);
 //! * [`xpbd_delta_lambda`], [`bounded_step`] and [`apply()`] — the XPBD update (`xpbd.rs`).
 
 use nalgebra::{RealField, Vector3};
 
 mod edge;
+mod grab;
 mod vertex_face;
 mod vertex_face_bounded;
 mod volume;
 mod xpbd;
 
 pub use edge::edge;
+pub use grab::{grab, grab_delta_lambda};
 pub use vertex_face::{
     signed_height, vertex_face, vertex_face_step_bound, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER,
 };

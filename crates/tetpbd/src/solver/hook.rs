@@ -170,10 +170,24 @@ pub trait SubstepHook {
     /// sleeping, [`crate::Activation`]). The default adds nothing: every body is its own
     /// island.
     fn touching(&mut self, _world: &mut World, _touching: &mut Touching) {}
+    /// Whether [`SubstepHook::begin_substep`] or [`SubstepHook::project`] may move particles,
+    /// or [`SubstepHook::end_substep`] change their velocities (default `true`). For a hook
+    /// that does, the solver measures the kinetic energy its impulses hand the constraint
+    /// families (external work in the budget of
+    /// [`crate::SolverSettings::limit_correction_energy`]): one copy of the positions or
+    /// velocities and one pass over them per call. A hook that never moves a particle may return `false`
+    /// to skip that.
+    fn moves_particles(&self) -> bool {
+        true
+    }
 }
 
 /// The empty hook.
-impl SubstepHook for () {}
+impl SubstepHook for () {
+    fn moves_particles(&self) -> bool {
+        false
+    }
+}
 
 /// Two hooks run one after the other at every point (e.g. rigid coupling, then soft–soft
 /// contacts).
@@ -202,6 +216,9 @@ impl<A: SubstepHook, B: SubstepHook> SubstepHook for (A, B) {
         self.0.touching(world, touching);
         self.1.touching(world, touching);
     }
+    fn moves_particles(&self) -> bool {
+        self.0.moves_particles() || self.1.moves_particles()
+    }
 }
 
 /// A borrowed hook.
@@ -223,5 +240,8 @@ impl<H: SubstepHook + ?Sized> SubstepHook for &mut H {
     }
     fn touching(&mut self, world: &mut World, touching: &mut Touching) {
         (**self).touching(world, touching);
+    }
+    fn moves_particles(&self) -> bool {
+        (**self).moves_particles()
     }
 }

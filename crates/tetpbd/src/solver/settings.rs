@@ -56,16 +56,18 @@ pub struct SolverSettings {
     /// [`crate::StepStats::spin_time`] instead of [`crate::StepStats::copy_time`].
     pub conserve_angular_momentum: bool,
     /// Keep the families' corrections from adding more kinetic energy to a body than the
-    /// elastic energy their compliant constraints release (default **off**): a violation that
+    /// elastic energy their compliant constraints release (default **on**): a violation that
     /// was there before the substep (a tangled or collapsed start, a body crushed by an
     /// impact) is corrected in position without becoming velocity, so hard constraints never
-    /// add energy. One scale per body and iteration keeps linear and angular momentum. Cost:
-    /// a few multiply–adds per particle in the copy back from the working copy, plus a pass
-    /// in iterations where it acts (counted in [`crate::StepStats::energy_limited`]). Theory
-    /// in `stabilisation::correction_energy`. Off by default because it cannot yet tell a
-    /// hook's contact work from a violation already there: with it on, bodies resting or
-    /// sliding on contacts keep jittering or drag (see `docs/decisions/correction-energy.md`).
-    /// Turn it on for free bodies that may start tangled or collapsed.
+    /// add energy. One scale per body and iteration keeps linear and angular momentum. A
+    /// hook's impulses (contacts, attachments: what it moves in `begin_substep`/`project`
+    /// and changes in `end_substep`) are external work added to the budget, so bodies resting
+    /// and sliding on contacts move as without the limit; corrections at the rounding of the
+    /// positions are left alone. Cost: a few multiply–adds per particle in the copy back from
+    /// the working copy, a pass in iterations where it acts (counted in
+    /// [`crate::StepStats::energy_limited`]), and one copy and pass over the particles per
+    /// hook call that moves them ([`crate::SubstepHook::moves_particles`]). Theory in
+    /// `stabilisation::correction_energy` and `stabilisation::hook_work`.
     pub limit_correction_energy: bool,
     /// Scalar or SIMD projection kernels (default SIMD; they agree to rounding).
     pub kernel: systems::Kernel,
@@ -130,7 +132,7 @@ impl Default for SolverSettings {
             order: Family::ALL,
             max_correction_speed: None,
             conserve_angular_momentum: true,
-            limit_correction_energy: false,
+            limit_correction_energy: true,
             kernel: systems::Kernel::Simd,
             measure_error: false,
             measure_before: false,

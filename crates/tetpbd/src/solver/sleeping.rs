@@ -62,13 +62,21 @@ pub fn wake(world: &mut World, entity: Entity) -> bool {
 pub(crate) fn wake_written(world: &mut World, scratch: &mut Vec<(Entity, bool)>) -> usize {
     scratch.clear();
     let mut woken = 0;
-    for (e, p, a, marked) in
-        world.query_mut::<(Entity, &Particles, &mut Activation, Option<&Asleep>)>()
-    {
-        if p.written && a.sleeping() {
+    for (e, p, a, marked, grab, forces) in world.query_mut::<(
+        Entity,
+        &Particles,
+        &mut Activation,
+        Option<&Asleep>,
+        Option<&crate::Grab>,
+        Option<&crate::UserForces>,
+    )>() {
+        // A grabbed body, or one with a user force on it, is driven like a written one.
+        let pushed = forces.is_some_and(|f| f.forces().iter().any(|f| *f != Vector3::zeros()));
+        let driven = p.written || grab.is_some() || pushed;
+        if driven && a.sleeping() {
             a.set_sleeping(false);
             woken += 1;
-        } else if p.written {
+        } else if driven {
             a.restart();
         }
         if a.sleeping() != marked.is_some() {
@@ -192,6 +200,7 @@ fn put_to_sleep(world: &mut World, entity: Entity) {
         p.velocities.fill(Vector3::zeros());
         p.prev_positions.copy_from_slice(&p.positions);
         p.residuals.fill(Vector3::zeros());
+        p.hook.energy = 0.0;
         a.set_sleeping(true);
     }
     let _ = world.insert_one(entity, Asleep);

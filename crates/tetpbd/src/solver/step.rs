@@ -14,21 +14,24 @@ use crate::solver::settings::SolverSettings;
 use crate::solver::sleeping;
 use crate::solver::stats::StepStats;
 use crate::solver::systems;
+use crate::stabilisation::hook_work::{self, Changed};
 use crate::stabilisation::{correction_energy, deformation_damping};
 
 /// Runs frames of the soft-body systems on a [`hecs::World`].
 ///
 /// ```text
 /// for each of `substeps` substeps (h = dt / substeps):
-///     predict            x_prev ← x; v ← (v + h(g + a))·damping; x ← x + h v
+///     predict            x_prev ← x; v ← (v + h(g + a + F/m))·damping; x ← x + h v
 ///     reset λ
 ///     repeat `iterations` times:
 ///         copy the particles into the projections' working copy (crate::kernels::working_copy)
 ///         project families in `order` on it, remove the rigid rotation of their
 ///         corrections (conserve_angular_momentum), limit the kinetic energy they add
-///         (limit_correction_energy), copy back, then hook.project
+///         (limit_correction_energy), copy back, project the grabs (Grab), then
+///         hook.project
 ///     update velocities  v ← (x − x_prev) / h, then damp deformation (DeformationDamping)
 ///     hook.end_substep
+/// after the last substep: the grabs' targets roll on (systems::roll_grab_targets)
 /// ```
 ///
 /// Threads (feature `parallel`): a step runs its parallel passes on the pool given to
@@ -216,6 +219,7 @@ impl Solver {
             restored.count += r.count;
             restored.first = restored.first.or(r.first);
         }
+        systems::roll_grab_targets(world);
         let t = Instant::now();
         hook.end_frame(world, frame);
         hook.touching(world, &mut sleep.touching);
@@ -265,13 +269,27 @@ impl Solver {
         let restored = systems::predict(world, h, frame.gravity(), s.damping);
         systems::reset_lambdas(world);
         stats.predict_time += t.elapsed();
+        // The hook's and the grabs' corrections are external work in the correction-energy
+        // budget.
+        let grabs = world
+            .query_mut::<&crate::Grab>()
+            .into_iter()
+            .next()
+            .is_some();
+        let measure = (s.limit_correction_energy && (grabs || hook.moves_particles())).then_some(h);
         let t = Instant::now();
-        hook.begin_substep(world, frame.substep(index, 0));
+        measured(world, measure, Changed::Positions, |w| {
+            hook.begin_substep(w, frame.substep(index, 0))
+        });
         *hook_time += t.elapsed();
+        let frac = (index + 1) as f32 / s.substeps as f32;
         for k in 0..s.iterations {
             self.iteration(world, h, stats);
             let t = Instant::now();
-            hook.project(world, frame.substep(index, k));
+            measured(world, measure, Changed::Positions, |w| {
+                systems::project_grabs(w, h, frac);
+                hook.project(w, frame.substep(index, k))
+            });
             *hook_time += t.elapsed();
         }
         let t = Instant::now();
@@ -281,7 +299,9 @@ impl Solver {
         deformation_damping::damp_deformation(world, h);
         stats.velocity_time += t.elapsed();
         let t = Instant::now();
-        hook.end_substep(world, frame.substep(index, 0));
+        measured(world, measure, Changed::Velocities, |w| {
+            hook.end_substep(w, frame.substep(index, 0))
+        });
         *hook_time += t.elapsed();
         restored
     }
@@ -320,6 +340,23 @@ struct SleepScratch {
     entities: Vec<(hecs::Entity, bool)>,
     islands: sleeping::Islands,
     touching: sleeping::Touching,
+}
+
+/// Runs a hook call, measuring the kinetic energy its corrections hand the families
+/// ([`crate::stabilisation::hook_work`]) in a substep of length `measure` (s), if given.
+fn measured(
+    world: &mut World,
+    measure: Option<f32>,
+    changed: Changed,
+    call: impl FnOnce(&mut World),
+) {
+    if measure.is_some() {
+        hook_work::before_hook(world, changed);
+    }
+    call(world);
+    if let Some(h) = measure {
+        hook_work::after_hook(world, h, changed);
+    }
 }
 
 /// Counts the bodies, and the particles and constraints of the awake ones.

@@ -2,9 +2,11 @@
 //!
 //! [`crate::Solver`] calls them in this order every substep of length `h`:
 //! [`predict`], the family projections (`iterations` times, in
-//! [`crate::SolverSettings::order`]), [`update_velocities`], [`damp_deformation`]. They are
-//! public so that an integrator can build a different schedule. Each skips the bodies that
-//! sleep ([`crate::Asleep`]); [`measure`] alone visits them.
+//! [`crate::SolverSettings::order`], each iteration followed by [`project_grabs`]),
+//! [`update_velocities`], [`damp_deformation`]; after the last substep of a frame,
+//! [`roll_grab_targets`]. They are public so that an integrator can build a different
+//! schedule. Each skips the bodies that sleep ([`crate::Asleep`]); [`measure`] alone visits
+//! them.
 
 use hecs::World;
 use nalgebra::Vector3;
@@ -12,6 +14,8 @@ use nalgebra::Vector3;
 use crate::body::activation::Asleep;
 use crate::body::families::Family;
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+pub use crate::body::forces::integrate_user_forces;
+pub use crate::body::grab::{project_grabs, reset_grabs, roll_grab_targets};
 use crate::body::mesh::Tetrahedra;
 use crate::body::particles::{ExternalAcceleration, Particles};
 use crate::constraints::{self, VERTEX_FACE_ORDER};
@@ -26,7 +30,8 @@ use crate::solver::stats::{ErrorAccumulator, ErrorStats};
 pub use crate::stabilisation::deformation_damping::damp_deformation;
 
 /// Saves `x` as the substep start, applies gravity plus each body's
-/// [`ExternalAcceleration`] and the linear damping `v ← v · max(0, 1 − damping·h)` to free
+/// [`ExternalAcceleration`] and [`crate::UserForces`] ([`integrate_user_forces`]) and the
+/// linear damping `v ← v · max(0, 1 − damping·h)` to free
 /// particles, then moves every particle to its prediction `x + h v`.
 ///
 /// Pinned particles (inverse mass 0) keep their velocity: one set by the user moves them
@@ -42,6 +47,7 @@ pub fn predict(
 ) -> crate::solver::non_finite::Restored {
     let keep = (1.0 - damping * h).max(0.0);
     let mut restored = crate::solver::non_finite::Restored::default();
+    integrate_user_forces(world, h);
     for (entity, p, extra) in world
         .query_mut::<(hecs::Entity, &mut Particles, Option<&ExternalAcceleration>)>()
         .without::<&Asleep>()
@@ -80,8 +86,9 @@ pub fn predict(
     restored
 }
 
-/// Sets every multiplier λ to zero (start of a substep).
+/// Sets every multiplier λ to zero (start of a substep), the [`crate::Grab`]s' too.
 pub fn reset_lambdas(world: &mut World) {
+    reset_grabs(world);
     for e in world
         .query_mut::<&mut EdgeConstraints>()
         .without::<&Asleep>()

@@ -146,7 +146,14 @@ pub(crate) fn store_measured(
     // The work was summed with velocities relative to `v0`: Σ m v·Δ = Σ m (v − v0)·Δ + v0·Σ m Δ
     // (the last term vanishes on a free body, not on a pinned one).
     sums.work += v0.cast::<f64>().dot(&sums.push);
-    let scale = crate::stabilisation::correction_energy::velocity_scale(&sums, c, theta, h, budget);
+    let scale = crate::stabilisation::correction_energy::velocity_scale(
+        &sums,
+        o.norm(),
+        c,
+        theta,
+        h,
+        budget,
+    );
     if theta == Vector3::zeros() && scale == 1.0 {
         return false;
     }

@@ -64,13 +64,15 @@ use crate::stabilisation::rigid_fit::Moments;
 use nalgebra::Vector3;
 
 /// The fraction `s ∈ [0, 1]` of the families' corrections that may become velocity (see the
-/// module docs), from the store pass's sums, the spin removal's centre `c` and rotation
+/// module docs), from the store pass's sums (taken about a point at distance `origin`, m,
+/// from the world origin), the spin removal's centre `c` and rotation
 /// `θ` (zero when not removed), the substep `h` (s) and the budget (J, asked only when the
 /// corrections add energy at all; its arguments are the body's largest inverse mass, 1/kg,
 /// the work term `A` and the gain `ΔK(1)`, J: it may stop summing once it has reached the
 /// gain).
 pub(crate) fn velocity_scale(
     sums: &Moments<f64>,
+    origin: f32,
     c: Vector3<f64>,
     theta: Vector3<f64>,
     h: f32,
@@ -85,8 +87,8 @@ pub(crate) fn velocity_scale(
     let square = (sums.square - theta.dot(&r_cross_d)).max(0.0);
     let (a, q) = (work / h, square / (2.0 * h * h));
     let gain = a + q;
-    // No gain, or a NaN one: nothing to limit.
-    if gain.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+    // No gain, or a NaN one, or one within rounding: nothing to limit.
+    if gain.partial_cmp(&rounding_floor(sums, origin, h)) != Some(std::cmp::Ordering::Greater) {
         return 1.0;
     }
     let e = budget(sums.inv_mass as f32, a, gain).max(0.0);
@@ -103,6 +105,26 @@ pub(crate) fn velocity_scale(
         s.clamp(0.0, 1.0) as f32
     } else {
         1.0
+    }
+}
+
+/// The kinetic energy (J) of corrections at the rounding of the positions: a particle at
+/// distance `L` from the world origin is stored to about `ε L` (`ε` = f32's epsilon), and
+/// corrections of a few `ε L` are rounding, not violation; scaling them changes nothing
+/// physical but would make the limit act on every substep of a moving body. With `L` the
+/// body's distance plus its radius of gyration, the floor is `M (4 ε L)² / (2h²)`.
+fn rounding_floor(sums: &Moments<f64>, origin: f32, h: f64) -> f64 {
+    if !(sums.mass > 0.0) {
+        return 0.0;
+    }
+    let spread = (sums.second[0] + sums.second[1] + sums.second[2]) / sums.mass;
+    let l = f64::from(origin) + spread.max(0.0).sqrt();
+    let d = 4.0 * f64::from(f32::EPSILON) * l;
+    let floor = sums.mass * d * d / (2.0 * h * h);
+    if floor.is_finite() {
+        floor
+    } else {
+        0.0
     }
 }
 
@@ -201,11 +223,15 @@ pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: b
             crate::kernels::working_copy::store(p);
             continue;
         }
+        // What a hook's corrections handed this pass is external work, spent here.
+        let hook = std::mem::take(&mut p.hook.energy);
         let budget = |w_max: f32, work: f64, gain: f64| {
-            if limit {
-                elastic_release([h, w_max], [work, gain], e, t, vf, vol)
-            } else {
+            if !limit {
                 f64::INFINITY
+            } else if hook >= gain {
+                hook
+            } else {
+                hook + elastic_release([h, w_max], [work, gain - hook], e, t, vf, vol)
             }
         };
         if crate::stabilisation::angular_momentum::store_measured(p, h, spin, budget) {

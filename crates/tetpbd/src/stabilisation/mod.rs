@@ -5,7 +5,8 @@
 //!   ([`crate::SolverSettings::conserve_angular_momentum`], on by default);
 //! * [`correction_energy`] — keeping the families' corrections from adding more kinetic
 //!   energy than their compliant constraints release
-//!   ([`crate::SolverSettings::limit_correction_energy`], on by default);
+//!   ([`crate::SolverSettings::limit_correction_energy`], on by default), counting what a
+//!   hook's position corrections hand them as external work ([`hook_work`]);
 //! * [`momentum_restoration`] — giving back, as a rigid velocity change, the momentum the
 //!   correction-speed safety net ([`crate::SolverSettings::max_correction_speed`]) clamped;
 //! * [`ground_up`] — one more sweep ordered from a body's supports outwards, for heavy loads
@@ -22,5 +23,6 @@ pub(crate) mod deformation_damping;
 pub(crate) mod ground_up;
 pub(crate) mod ground_up_levels;
 pub(crate) mod ground_up_sweep;
+pub(crate) mod hook_work;
 pub(crate) mod momentum_restoration;
 pub(crate) mod rigid_fit;

@@ -51,17 +51,19 @@ impl Moments<f32> {
         self.work += mv.dot(&d);
         self.square += m * d.norm_squared();
         self.push += d * m;
+        // Mass and spread are kept without the spin too: the energy limit's rounding floor
+        // needs the body's size.
+        let mx = x * m;
+        self.mass += m;
+        self.second[0] += mx.x * x.x;
+        self.second[1] += mx.y * x.y;
+        self.second[2] += mx.z * x.z;
         if !SPIN {
             return;
         }
         self.momentum_moment += x.cross(&mv);
         self.momentum += mv;
-        let mx = x * m;
-        self.mass += m;
         self.first += mx;
-        self.second[0] += mx.x * x.x;
-        self.second[1] += mx.y * x.y;
-        self.second[2] += mx.z * x.z;
         self.second[3] += mx.x * x.y;
         self.second[4] += mx.x * x.z;
         self.second[5] += mx.y * x.z;

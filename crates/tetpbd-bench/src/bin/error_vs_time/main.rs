@@ -1,4 +1,5 @@
 //! `cargo run --release -p tetpbd-bench --bin error_vs_time [-- [--quick] [--out DIR]]`
+//! (`-- --help` lists the options)
 //!
 //! Error against run time, tetpbd next to rapier 0.36's built-in soft bodies, on the scenes of
 //! four scenes: a) a hanging beam settling to static equilibrium, b) a block squashed to 50 %
@@ -29,6 +30,7 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::Instant;
 
+use clap::Parser;
 use rapier3d::prelude::{SoftBodyCellModel, SoftBodySolver};
 use tetpbd_viz::Progress;
 
@@ -38,37 +40,33 @@ use reference::{converged, exact_rest, Reference};
 use report::Row;
 use scenes::{Scene, SceneKind};
 
-/// What the command was asked to do.
+/// Error against run time, tetpbd next to rapier 0.36's built-in soft bodies: a hanging beam,
+/// a squashed block, a soft cube dropped on rigid ground and a pile of nine cubes. Writes the
+/// report's tables, plots and summary.
+#[derive(Debug, Parser)]
+#[command(name = "error_vs_time")]
 struct Args {
+    /// A smoke run: fewer models, budgets and frames (seconds instead of minutes).
+    #[arg(long)]
     quick: bool,
-    out: PathBuf,
+    /// Directory to write the report to (default: docs/error-vs-time, or
+    /// target/error-vs-time-quick with --quick, so a smoke run never overwrites the committed
+    /// report).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
 }
 
-fn parse_args() -> Result<Args, String> {
-    let mut args = Args {
-        quick: false,
-        out: PathBuf::new(),
-    };
-    let mut it = std::env::args().skip(1);
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--quick" => args.quick = true,
-            "--out" => args.out = it.next().ok_or("--out needs a directory")?.into(),
-            "-h" | "--help" => {
-                return Err("usage: error_vs_time [--quick] [--out DIR]".to_string());
-            }
-            other => return Err(format!("unknown argument `{other}` (try --help)")),
-        }
+impl Args {
+    /// The output directory, its default resolved.
+    fn out_dir(&self) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| {
+            PathBuf::from(if self.quick {
+                "target/error-vs-time-quick"
+            } else {
+                "docs/error-vs-time"
+            })
+        })
     }
-    if args.out.as_os_str().is_empty() {
-        // A smoke run must not overwrite the committed report.
-        args.out = PathBuf::from(if args.quick {
-            "target/error-vs-time-quick"
-        } else {
-            "docs/error-vs-time"
-        });
-    }
-    Ok(args)
 }
 
 /// The swept models: every tetpbd constraint set at α = 0 and soft, and rapier's cell models
@@ -227,13 +225,8 @@ fn all_references(scenes: &[Scene], quick: bool) -> Vec<Reference> {
 }
 
 fn main() {
-    let args = match parse_args() {
-        Ok(a) => a,
-        Err(e) => {
-            eprintln!("{e}");
-            std::process::exit(2);
-        }
-    };
+    let args = Args::parse();
+    let out = args.out_dir();
     let started = Instant::now();
     let load_start = report::load_average();
     let scenes = [Scene::hanging_beam(args.quick), Scene::squash(args.quick)];
@@ -294,15 +287,15 @@ fn main() {
         load_end: report::load_average(),
     };
     if let Err(e) = report::write_all(
-        &args.out,
+        &out,
         &scenes,
         &rows,
         &references,
         (&contact_scenes, &contact_rows),
         &info,
     ) {
-        eprintln!("writing {}: {e}", args.out.display());
+        eprintln!("writing {}: {e}", out.display());
         std::process::exit(1);
     }
-    eprintln!("wrote {} in {elapsed:.0} s", args.out.display());
+    eprintln!("wrote {} in {elapsed:.0} s", out.display());
 }
