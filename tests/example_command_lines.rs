@@ -20,6 +20,8 @@ mod kinematic_platform;
 mod recover;
 #[path = "../examples/cli/rigid_ball_on_soft.rs"]
 mod rigid_ball_on_soft;
+#[path = "../examples/cli/sleeping_pile.rs"]
+mod sleeping_pile;
 #[path = "../examples/cli/soft_on_rigid_stack.rs"]
 mod soft_on_rigid_stack;
 #[path = "../examples/cli/soft_pile.rs"]
@@ -35,6 +37,7 @@ fn commands() -> Vec<clap::Command> {
         rigid_ball_on_soft::Cli::command(),
         soft_on_rigid_stack::Cli::command(),
         soft_pile::Cli::command(),
+        sleeping_pile::Cli::command(),
     ]
 }
 
@@ -159,6 +162,16 @@ fn the_documented_invocations_parse() {
     let cli = soft_pile::Cli::try_parse_from(["soft_pile", "soft", "2"]).unwrap();
     assert_eq!((cli.ground, cli.seconds), (soft_pile::Ground::Soft, 2));
     assert!(cli.viz.export.is_none());
+
+    // .ci/run and docs/performance.md.
+    let cli = sleeping_pile::Cli::try_parse_from(["sleeping_pile"]).unwrap();
+    assert_eq!((cli.scene, cli.cubes), (sleeping_pile::Scene::Pile, 20));
+    let cli =
+        sleeping_pile::Cli::try_parse_from(["sleeping_pile", "pile", "6", "--frames-after", "30"])
+            .unwrap();
+    assert_eq!((cli.cubes, cli.frames_after), (6, 30));
+    let cli = sleeping_pile::Cli::try_parse_from(["sleeping_pile", "field", "200"]).unwrap();
+    assert_eq!((cli.scene, cli.cubes), (sleeping_pile::Scene::Field, 200));
 
     // docs/guide/building-bodies.md.
     let cli = asset_drop::Cli::try_parse_from(["asset_drop"]).unwrap();

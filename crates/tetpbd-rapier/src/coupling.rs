@@ -206,7 +206,8 @@ impl Coupling {
         &mut self.settings
     }
 
-    /// The soft–rigid contacts of the last step.
+    /// The soft–rigid contacts of the last step; a sleeping soft body's are those it fell
+    /// asleep on.
     pub fn contacts(&self) -> &[ContactReport] {
         &self.reports
     }
@@ -273,6 +274,7 @@ impl Coupling {
                 multibody_joints: &*ctx.multibody_joints,
                 default_collider: self.settings.default_collider,
                 margin: self.settings.margin,
+                soft_margin: self.settings.soft_contacts.map(|s| s.margin),
                 max_depenetration_speed: self.settings.max_depenetration_speed,
                 stacking_mass_ratio: self.settings.stacking_mass_ratio,
                 self_weight_stacking: self.settings.self_weight_stacking,
@@ -292,7 +294,9 @@ impl Coupling {
                 .step_frame(world, dt, gravity, &mut (hook, (soft_contacts, extra)))?
         };
         let mut stats = std::mem::take(&mut self.frame.stats);
-        self.write_back(ctx.bodies, &mut stats);
+        self.write_back(world, ctx.bodies, &mut stats);
+        let (waking, proxies) = (&mut self.frame.waking, &self.frame.bodies);
+        waking.remember_rest(proxies, ctx.bodies, world);
         stats.soft = soft;
         stats.bodies_without_surface = without_surface;
         if self.settings.soft_contacts.is_some() {
@@ -305,17 +309,16 @@ impl Coupling {
 
     /// Hands the soft reaction to the rapier bodies the soft bodies touched (module docs of
     /// [`Coupling`], step 3), and the anchored bodies' reaction to their dynamic supports.
-    fn write_back(&mut self, bodies: &mut RigidBodySet, stats: &mut CouplingStats) {
+    fn write_back(&mut self, world: &World, bodies: &mut RigidBodySet, stats: &mut CouplingStats) {
         // Only the bodies that get a reaction are borrowed mutably: `get_mut` marks a body
         // as modified for rapier's next step.
-        for b in self
-            .frame
-            .bodies
-            .iter()
-            .filter(|b| b.is_dynamic() && b.touched)
-        {
+        for (i, b) in self.frame.bodies.iter().enumerate() {
+            if !(b.is_dynamic() && b.touched) {
+                continue;
+            }
+            let asleep = crate::sleeping::soft_asleep(&self.frame.waking, i, world);
             if let Some(rb) = bodies.get_mut(b.handle) {
-                if b.write_back(rb) {
+                if b.write_back(rb, asleep) {
                     stats.bodies_written += 1;
                     if let Some((force, torque)) = b.load() {
                         self.frame.loads.push((b.handle, force, torque));

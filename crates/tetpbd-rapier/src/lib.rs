@@ -90,6 +90,7 @@ mod response;
 mod rigid;
 mod scene;
 mod settings;
+mod sleeping;
 mod soft_collider;
 mod soft_soft;
 mod substep;

@@ -32,6 +32,8 @@ pub(crate) struct CouplingHook<'q, 'a> {
     pub multibody_joints: &'a MultibodyJointSet,
     pub default_collider: SoftCollider,
     pub margin: f32,
+    /// The soft–soft contact margin, m (`None`: soft–soft contacts off).
+    pub soft_margin: Option<f32>,
     pub max_depenetration_speed: f32,
     /// `CouplingSettings::stacking_mass_ratio`.
     pub stacking_mass_ratio: f32,
@@ -57,6 +59,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             multibody_joints: self.multibody_joints,
             default_collider: &self.default_collider,
             margin: self.margin,
+            soft_margin: self.soft_margin,
         };
         self.frame.gather(world, &input);
     }
@@ -250,10 +253,17 @@ impl SubstepHook for CouplingHook<'_, '_> {
         }
     }
 
+    fn touching(&mut self, _world: &mut World, touching: &mut tetpbd::Touching) {
+        crate::sleeping::touching(self.frame, self.qp.bodies, touching);
+    }
+
     fn end_frame(&mut self, world: &mut World, _frame: FrameContext) {
         self.frame.remember_touching();
         let frame = &mut *self.frame;
-        self.reports.clear();
+        // A sleeping body keeps reporting the contacts it fell asleep on (`sleeping` module
+        // docs); the others are reported afresh.
+        self.reports
+            .retain(|r| tetpbd::is_sleeping(world, r.entity));
         let mut max_pen = 0.0f32;
         let mut max_att = 0.0f32;
         for s in &frame.soft {

@@ -55,6 +55,7 @@ pub mod prelude;
 mod solver;
 mod stabilisation;
 
+pub use body::activation::{Activation, Asleep};
 pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
 pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};
 pub use body::forces::UserForces;
@@ -70,6 +71,7 @@ pub use ordering::ColourClasses;
 pub use solver::hook::{FrameContext, SubstepContext, SubstepHook};
 pub use solver::non_finite::Restored;
 pub use solver::settings::{ParallelSettings, SolverSettings};
+pub use solver::sleeping::{is_sleeping, wake, Touching};
 pub use solver::stats::{ErrorAccumulator, ErrorStats, FamilyStats, StepStats};
 pub use solver::step::Solver;
 pub use solver::systems;

@@ -12,6 +12,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub use crate::body::activation::{Activation, Asleep};
 pub use crate::body::builder::{SoftBody as TetBody, SoftBodyBuilder as TetBodyBuilder, TetMesh};
 pub use crate::body::forces::UserForces;
 pub use crate::body::generators;

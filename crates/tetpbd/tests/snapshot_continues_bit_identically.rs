@@ -7,8 +7,8 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use tetpbd::generators::{ball, CellSplit};
 use tetpbd::{
-    EdgeConstraints, Particles, SoftBodyBuilder, Solver, SolverSettings, Surface, Tetrahedra,
-    VertexFaceConstraints, VolumeConstraints,
+    Activation, EdgeConstraints, Particles, SoftBodyBuilder, Solver, SolverSettings, Surface,
+    Tetrahedra, VertexFaceConstraints, VolumeConstraints,
 };
 
 /// One body's components, as an application would store them.
@@ -20,6 +20,7 @@ struct Snapshot {
     edges: Option<EdgeConstraints>,
     vertex_face: Option<VertexFaceConstraints>,
     volume: Option<VolumeConstraints>,
+    activation: Option<Activation>,
     settings: SolverSettings,
 }
 
@@ -37,6 +38,7 @@ fn take(world: &World, e: Entity, settings: &SolverSettings) -> Snapshot {
             .get::<&VolumeConstraints>(e)
             .ok()
             .map(|c| (*c).clone()),
+        activation: world.get::<&Activation>(e).ok().map(|a| *a),
         settings: settings.clone(),
     }
 }
@@ -52,6 +54,9 @@ fn restore(s: Snapshot, world: &mut World) -> (Entity, SolverSettings) {
     }
     if let Some(c) = s.volume {
         b.add(c);
+    }
+    if let Some(a) = s.activation {
+        b.add(a);
     }
     (world.spawn(b.build()), s.settings)
 }

@@ -260,7 +260,17 @@ pub(crate) fn apply_reaction(body: &mut RigidBody, j: &Vector3<f32>, l: &Vector3
     if !(j.iter().chain(l.iter()).all(|c| c.is_finite())) {
         return false;
     }
-    body.apply_impulse(to_glam(j), true);
-    body.apply_torque_impulse(to_glam(l), true);
+    // A sleeping support is woken only by a reaction that moves it faster than its sleep
+    // threshold; an awake one keeps rapier's sleep timer (`sleeping` module docs).
+    let wake = body.is_sleeping();
+    if wake {
+        let m = body.mass();
+        let dv = if m > 0.0 { j / m } else { Vector3::zeros() };
+        if !crate::sleeping::moves_rigid(body, &dv, &Vector3::zeros()) {
+            return true;
+        }
+    }
+    body.apply_impulse(to_glam(j), wake);
+    body.apply_torque_impulse(to_glam(l), wake);
     true
 }

@@ -51,14 +51,20 @@ impl Frame {
             input.margin,
         );
         let dt = self.dt;
+        self.waking
+            .run(world, input, &self.fast, input.soft_margin, dt);
         let fall = 0.5 * self.gravity * dt * dt;
-        for (entity, p, surface, sc, att) in world.query_mut::<(
-            Entity,
-            &Particles,
-            &Surface,
-            Option<&SoftCollider>,
-            Option<&Attachments>,
-        )>() {
+        // Sleeping bodies take no part (`sleeping` module docs).
+        for (entity, p, surface, sc, att) in world
+            .query_mut::<(
+                Entity,
+                &Particles,
+                &Surface,
+                Option<&SoftCollider>,
+                Option<&Attachments>,
+            )>()
+            .without::<&tetpbd::Asleep>()
+        {
             let sc = sc.copied().unwrap_or(*input.default_collider);
             let c0 = self.contacts.len();
             let k0 = self.corners.len();

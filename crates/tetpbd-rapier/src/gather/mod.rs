@@ -99,6 +99,8 @@ pub(crate) struct Frame {
     pub active_colliders: Vec<usize>,
     /// Impact episodes in progress (kept across frames).
     pub episodes: Episodes,
+    /// Scratch of the waking pass (`sleeping` module docs).
+    pub waking: crate::sleeping::Waking,
     /// Frame length, s (the solver's, `begin_frame`).
     pub dt: f32,
     /// Magnitude of the frame's gravity, m/s².
@@ -114,6 +116,8 @@ pub(crate) struct GatherInput<'q, 'a> {
     pub multibody_joints: &'q MultibodyJointSet,
     pub default_collider: &'q SoftCollider,
     pub margin: f32,
+    /// The soft–soft contact margin, m (`None`: soft–soft contacts off).
+    pub soft_margin: Option<f32>,
 }
 
 impl Frame {

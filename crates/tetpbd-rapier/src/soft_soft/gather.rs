@@ -84,6 +84,8 @@ pub(crate) struct Gather {
     list: Vec<(u64, Entity, bool, SoftCollider)>,
     order: Vec<usize>,
     pub pairs: Vec<(usize, usize)>,
+    /// Entity bits of the sleeping bodies (scratch of `list_bodies`).
+    sleeping: Vec<u64>,
     /// Contact properties of each pair of `pairs`.
     pub pair_props: Vec<SoftPair>,
     deep_a: Vec<Vector3<f32>>,
@@ -117,6 +119,7 @@ impl Gather {
         self.bodies.clear();
         self.pairs.clear();
         self.pair_props.clear();
+        self.sleeping.clear();
         self.list_bodies(world, default);
         if self.list.len() < 2 && !self.list.iter().any(|l| l.2) {
             // Nothing can touch: no pair and no self collision.
@@ -171,26 +174,34 @@ impl Gather {
     }
 
     /// Lists the enabled soft bodies of `world` by entity bits and drops the caches of bodies
-    /// gone.
+    /// gone. Sleeping bodies are listed (their caches kept) but take no part: the coupling
+    /// woke every sleeping body an awake one comes near (`sleeping` module docs).
     fn list_bodies(&mut self, world: &mut World, default: &SoftCollider) {
         self.list.clear();
-        for (e, _, _, _, sc, collider) in world.query_mut::<(
+        for (e, _, _, _, sc, collider, asleep) in world.query_mut::<(
             Entity,
             &Particles,
             &Surface,
             &Tetrahedra,
             Option<&SelfCollision>,
             Option<&SoftCollider>,
+            Option<&tetpbd::Asleep>,
         )>() {
             let collider = *collider.unwrap_or(default);
             if collider.is_enabled() {
+                if asleep.is_some() {
+                    self.sleeping.push(e.to_bits().get());
+                    continue;
+                }
                 self.list
                     .push((e.to_bits().get(), e, sc.is_some(), collider));
             }
         }
         self.list.sort_unstable_by_key(|l| l.0);
+        self.sleeping.sort_unstable();
         for c in &mut self.caches {
-            c.seen = self.list.binary_search_by_key(&c.key, |l| l.0).is_ok();
+            c.seen = self.list.binary_search_by_key(&c.key, |l| l.0).is_ok()
+                || self.sleeping.binary_search(&c.key).is_ok();
         }
         self.caches.retain(|c| c.seen);
     }

@@ -144,6 +144,8 @@ pub struct SoftContacts {
     separation: Separation,
     restitution: BodyRestitution,
     stats: SoftContactStats,
+    /// Scratch of the waking pass (`sleeping` module docs).
+    waking: crate::sleeping::Waking,
 }
 
 impl SoftContacts {
@@ -156,6 +158,7 @@ impl SoftContacts {
             gather: Gather::default(),
             frame: ContactFrame::default(),
             separation: Separation::default(),
+            waking: crate::sleeping::Waking::default(),
             restitution: BodyRestitution::default(),
             stats: SoftContactStats::default(),
         })
@@ -203,6 +206,9 @@ impl std::fmt::Debug for SoftContacts {
 impl SubstepHook for SoftContacts {
     fn begin_frame(&mut self, world: &mut World, frame: FrameContext) {
         self.stats = SoftContactStats::default();
+        let margin = self.settings.margin;
+        self.waking
+            .run_soft(world, &self.default_collider, margin, frame.dt());
         self.gather.run(
             world,
             frame.dt(),
@@ -242,5 +248,17 @@ impl SubstepHook for SoftContacts {
 
     fn end_frame(&mut self, world: &mut World, _frame: FrameContext) {
         self.frame.finish(world, &self.gather, &mut self.stats);
+    }
+
+    /// Bodies whose bounds overlap within the margin are one island (`sleeping` module
+    /// docs).
+    fn touching(&mut self, _world: &mut World, touching: &mut tetpbd::Touching) {
+        let bodies = &self.gather.bodies;
+        touching.pairs.extend(
+            self.gather
+                .pairs
+                .iter()
+                .map(|&(a, b)| (bodies[a].entity, bodies[b].entity)),
+        );
     }
 }

@@ -46,6 +46,7 @@ impl SoftBody {
     pub fn spawn(self, world: &mut World) -> Entity {
         let mut b = hecs::EntityBuilder::new();
         b.add(self.particles).add(self.tetrahedra).add(self.surface);
+        b.add(crate::Activation::default());
         if let Some(e) = self.edges {
             b.add(e);
         }
@@ -286,6 +287,7 @@ impl SoftBodyBuilder {
                 vertex_to_particle: inverse(&particle_source),
                 source: particle_source,
                 work: WorkCopy(vec![Slot::default(); n]),
+                written: false,
                 hook: Default::default(),
             },
             tetrahedra: Tetrahedra {

@@ -210,7 +210,10 @@ impl UserForces {
 /// every free particle. [`crate::systems::predict`] runs it first, so the forces are
 /// integrated as gravity is.
 pub fn integrate_user_forces(world: &mut hecs::World, h: f32) {
-    for (p, f) in world.query_mut::<(&mut Particles, &UserForces)>() {
+    for (p, f) in world
+        .query_mut::<(&mut Particles, &UserForces)>()
+        .without::<&crate::Asleep>()
+    {
         let Particles {
             velocities,
             inv_masses,

@@ -160,7 +160,10 @@ pub fn reset_grabs(world: &mut hecs::World) {
 /// One projection of every body's [`Grab`] in a substep of length `h` (s) that ends at
 /// `frac` of the frame (the target stands at `previous + frac (target − previous)`).
 pub fn project_grabs(world: &mut hecs::World, h: f32, frac: f32) {
-    for (p, tets, g) in world.query_mut::<(&mut Particles, &Tetrahedra, &mut Grab)>() {
+    for (p, tets, g) in world
+        .query_mut::<(&mut Particles, &Tetrahedra, &mut Grab)>()
+        .without::<&crate::Asleep>()
+    {
         let Some(corners) = g.point.corners(p, tets) else {
             continue;
         };

@@ -32,6 +32,7 @@ impl Particles {
     /// proportion to their masses: every free particle's velocity changes by `J / M_free`.
     pub fn apply_impulse(&mut self, impulse: Vector3<f32>) -> Result<(), StateError> {
         finite(&impulse, "impulse")?;
+        self.written = true;
         let free: f64 = self.free_masses().map(f64::from).sum();
         if free <= 0.0 {
             return Err(StateError::AllPinned);
@@ -54,6 +55,7 @@ impl Particles {
         point: Vector3<f32>,
     ) -> Result<PointImpulse, StateError> {
         finite(&impulse, "impulse")?;
+        self.written = true;
         let (at, inside) = MaterialPoint::locate(self, tetrahedra, point)?;
         let (corners, weights) = at.free_shares(self, tetrahedra)?;
         for (w, &i) in weights.iter().zip(&corners) {
@@ -88,6 +90,7 @@ impl Particles {
                 value: speed,
             });
         }
+        self.written = true;
         let mut total = Vector3::zeros();
         for i in 0..self.positions.len() {
             let d = self.positions[i] - centre;

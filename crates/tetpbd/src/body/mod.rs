@@ -6,6 +6,7 @@
 //! [`Tetrahedra`](mesh::Tetrahedra), [`Surface`](mesh::Surface) and one optional component per
 //! constraint family ([`families`]): a body pays only for the families it has.
 
+pub(crate) mod activation;
 pub(crate) mod builder;
 pub(crate) mod families;
 pub(crate) mod forces;

@@ -40,6 +40,11 @@ pub struct Particles {
     /// The projections' working copy (scratch, see [`crate::kernels::working_copy`]).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) work: crate::kernels::slots::WorkCopy,
+    /// Whether the particles were written through a public accessor since the end of the
+    /// last step (wakes a sleeping body, `body::activation` module docs). Not state: neither
+    /// compared nor serialized.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub(crate) written: bool,
     /// The kinetic energy a hook's corrections handed the families' next pass (see
     /// [`crate::stabilisation::hook_work`]).
     #[cfg_attr(feature = "serde", serde(default))]
@@ -60,6 +65,7 @@ impl PartialEq for Particles {
             source,
             vertex_to_particle,
             work: _,
+            written: _,
             hook,
         } = self;
         *positions == o.positions
@@ -93,7 +99,11 @@ impl Particles {
 
     /// Current positions for writing, m. Writing a non-finite value is the caller's bug; use
     /// [`Particles::set_position`] for a checked write.
+    ///
+    /// Borrowing them wakes a sleeping body at the next step (as does every other write
+    /// below: velocities, pinning, impulses).
     pub fn positions_mut(&mut self) -> &mut [Vector3<f32>] {
+        self.written = true;
         &mut self.positions
     }
 
@@ -109,6 +119,7 @@ impl Particles {
 
     /// Velocities for writing, m/s.
     pub fn velocities_mut(&mut self) -> &mut [Vector3<f32>] {
+        self.written = true;
         &mut self.velocities
     }
 
@@ -147,6 +158,7 @@ impl Particles {
             .masses
             .get(i)
             .ok_or(StateError::ParticleOutOfRange { index: i, len: n })?;
+        self.written = true;
         self.inv_masses[i] = if pinned || m <= 0.0 { 0.0 } else { 1.0 / m };
         Ok(())
     }
@@ -169,6 +181,7 @@ impl Particles {
                 index: i,
             });
         }
+        self.written = true;
         self.positions[i] = p;
         self.prev_positions[i] = p;
         Ok(())
@@ -186,8 +199,15 @@ impl Particles {
                 index: i,
             });
         }
+        self.written = true;
         self.velocities[i] = v;
         Ok(())
+    }
+
+    /// Whether the particles were written through a public accessor since the end of the
+    /// last step (such a write wakes a sleeping body at the next step).
+    pub fn written(&self) -> bool {
+        self.written
     }
 
     /// Total mass of all particles, pinned ones included, kg.

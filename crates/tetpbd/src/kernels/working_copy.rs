@@ -70,7 +70,8 @@ type Swept<'a> = (
 
 /// Runs `f` on every body a family system sweeps.
 pub(crate) fn for_each_swept(world: &mut World, mut f: impl FnMut(&mut Particles)) {
-    for (p, e, t, vf, vol) in world.query_mut::<Swept<'_>>() {
+    let swept = world.query_mut::<Swept<'_>>();
+    for (p, e, t, vf, vol) in swept.without::<&crate::Asleep>() {
         if e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some())) {
             f(p);
         }

@@ -29,6 +29,7 @@ use nalgebra::Vector3;
 use crate::body::families::Family;
 use crate::kernels::count::Kernel;
 use crate::solver::settings::SolverSettings;
+use crate::solver::sleeping::Touching;
 
 /// The frame a [`SubstepHook`] runs in, as the solver runs it: its length and gravity (the
 /// ones passed to [`Solver::step_frame`](crate::Solver::step_frame), which are the settings'
@@ -164,6 +165,11 @@ pub trait SubstepHook {
     fn end_substep(&mut self, _world: &mut World, _substep: SubstepContext) {}
     /// Once per frame, after the last substep.
     fn end_frame(&mut self, _world: &mut World, _frame: FrameContext) {}
+    /// Once per frame, after [`SubstepHook::end_frame`]: adds the soft bodies that touch
+    /// each other, and those something awake keeps awake, to `touching` (the islands of
+    /// sleeping, [`crate::Activation`]). The default adds nothing: every body is its own
+    /// island.
+    fn touching(&mut self, _world: &mut World, _touching: &mut Touching) {}
     /// Whether [`SubstepHook::begin_substep`] or [`SubstepHook::project`] may move particles,
     /// or [`SubstepHook::end_substep`] change their velocities (default `true`). For a hook
     /// that does, the solver measures the kinetic energy its impulses hand the constraint
@@ -206,6 +212,10 @@ impl<A: SubstepHook, B: SubstepHook> SubstepHook for (A, B) {
         self.0.end_frame(world, frame);
         self.1.end_frame(world, frame);
     }
+    fn touching(&mut self, world: &mut World, touching: &mut Touching) {
+        self.0.touching(world, touching);
+        self.1.touching(world, touching);
+    }
     fn moves_particles(&self) -> bool {
         self.0.moves_particles() || self.1.moves_particles()
     }
@@ -227,6 +237,9 @@ impl<H: SubstepHook + ?Sized> SubstepHook for &mut H {
     }
     fn end_frame(&mut self, world: &mut World, frame: FrameContext) {
         (**self).end_frame(world, frame);
+    }
+    fn touching(&mut self, world: &mut World, touching: &mut Touching) {
+        (**self).touching(world, touching);
     }
     fn moves_particles(&self) -> bool {
         (**self).moves_particles()

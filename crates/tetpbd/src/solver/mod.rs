@@ -7,6 +7,7 @@
 pub(crate) mod hook;
 pub(crate) mod non_finite;
 pub(crate) mod settings;
+pub(crate) mod sleeping;
 pub(crate) mod stats;
 pub(crate) mod step;
 pub mod systems;

@@ -65,9 +65,18 @@ pub struct FamilyStats {
 /// What one frame of the solver did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StepStats {
-    /// Number of soft bodies stepped.
+    /// Number of soft bodies in the world, asleep or not.
     pub bodies: usize,
-    /// Number of particles over all bodies.
+    /// Bodies asleep during the step: the systems skipped them (their particles and
+    /// constraints are in no other count of these statistics).
+    pub bodies_asleep: usize,
+    /// Bodies woken at the start of the step (by a write of their particles) or by a hook.
+    pub bodies_woken: usize,
+    /// Bodies that fell asleep at the end of the step.
+    pub bodies_fell_asleep: usize,
+    /// Bodies asleep at the end of the step.
+    pub bodies_asleep_after: usize,
+    /// Number of particles over the awake bodies.
     pub particles: usize,
     /// Substeps run.
     pub substeps: u32,

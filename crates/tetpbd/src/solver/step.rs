@@ -6,10 +6,12 @@ use std::time::{Duration, Instant};
 use hecs::World;
 use nalgebra::Vector3;
 
+use crate::body::activation::Asleep;
 use crate::error::{SettingsError, StepError};
 use crate::kernels::working_copy::{self, CopyMode};
 use crate::solver::hook::{FrameContext, SubstepHook};
 use crate::solver::settings::SolverSettings;
+use crate::solver::sleeping;
 use crate::solver::stats::StepStats;
 use crate::solver::systems;
 use crate::stabilisation::hook_work::{self, Changed};
@@ -45,6 +47,8 @@ pub struct Solver {
     /// thread is in.
     #[cfg(feature = "parallel")]
     thread_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
+    /// Scratch of the sleeping systems, kept so that a step allocates nothing.
+    sleep: SleepScratch,
 }
 
 impl Solver {
@@ -55,6 +59,7 @@ impl Solver {
             settings,
             #[cfg(feature = "parallel")]
             thread_pool: None,
+            sleep: SleepScratch::default(),
         })
     }
 
@@ -95,6 +100,20 @@ impl Solver {
     ) -> Result<StepStats, StepError> {
         self.settings.validate_frame(dt, gravity)?;
         let frame = FrameContext::new(&self.settings, dt, gravity);
+        let mut sleep = std::mem::take(&mut self.sleep);
+        let out = self.run_step_in_pool(world, frame, hook, &mut sleep);
+        self.sleep = sleep;
+        out
+    }
+
+    /// [`Solver::run_step`] in the solver's pool (feature `parallel`).
+    fn run_step_in_pool(
+        &self,
+        world: &mut World,
+        frame: FrameContext,
+        hook: &mut dyn SubstepHook,
+        sleep: &mut SleepScratch,
+    ) -> Result<StepStats, StepError> {
         #[cfg(feature = "parallel")]
         {
             let p = self.settings.parallel;
@@ -105,13 +124,13 @@ impl Solver {
             if p.keep_helpers_awake && crate::parallel::sweeps::any_parallel(world) {
                 let move_off = p.move_helpers_off_step_core;
                 return crate::parallel::team::with_team(move_off, || {
-                    self.run_step(world, frame, hook)
+                    self.run_step(world, frame, hook, sleep)
                 });
             }
-            self.run_step(world, frame, hook)
+            self.run_step(world, frame, hook, sleep)
         }
         #[cfg(not(feature = "parallel"))]
-        self.run_step(world, frame, hook)
+        self.run_step(world, frame, hook, sleep)
     }
 
     /// A dedicated pool of `num_threads` threads for this solver's parallel passes (0: rayon's
@@ -170,6 +189,7 @@ impl Solver {
         world: &mut World,
         frame: FrameContext,
         hook: &mut dyn SubstepHook,
+        sleep: &mut SleepScratch,
     ) -> Result<StepStats, StepError> {
         let s = &self.settings;
         let mut restored = crate::solver::non_finite::Restored::default();
@@ -179,6 +199,8 @@ impl Solver {
             iterations: s.iterations,
             ..StepStats::default()
         };
+        sleep.touching.clear();
+        stats.bodies_woken = sleeping::wake_written(world, &mut sleep.entities);
         count_constraints(world, &mut stats);
         if s.measure_before {
             let m = systems::measure(world);
@@ -189,6 +211,9 @@ impl Solver {
         let t = Instant::now();
         hook.begin_frame(world, frame);
         let mut hook_time = t.elapsed();
+        let asleep = count_asleep(world);
+        stats.bodies_woken += stats.bodies_asleep.saturating_sub(asleep);
+        stats.bodies_asleep = asleep;
         for i in 0..s.substeps {
             let r = self.substep(world, hook, frame, i, &mut stats, &mut hook_time);
             restored.count += r.count;
@@ -197,8 +222,12 @@ impl Solver {
         systems::roll_grab_targets(world);
         let t = Instant::now();
         hook.end_frame(world, frame);
+        hook.touching(world, &mut sleep.touching);
         hook_time += t.elapsed();
         stats.hook_time = hook_time;
+        let slept = sleeping::fall_asleep(world, frame.dt(), &sleep.touching, &mut sleep.islands);
+        stats.bodies_fell_asleep = slept.fell_asleep;
+        stats.bodies_asleep_after = slept.asleep;
         if s.measure_error {
             let t = Instant::now();
             let m = systems::measure(world);
@@ -242,9 +271,12 @@ impl Solver {
         stats.predict_time += t.elapsed();
         // The hook's and the grabs' corrections are external work in the correction-energy
         // budget.
-        let grabs = world.query_mut::<&crate::Grab>().into_iter().next().is_some();
-        let measure =
-            (s.limit_correction_energy && (grabs || hook.moves_particles())).then_some(h);
+        let grabs = world
+            .query_mut::<&crate::Grab>()
+            .into_iter()
+            .next()
+            .is_some();
+        let measure = (s.limit_correction_energy && (grabs || hook.moves_particles())).then_some(h);
         let t = Instant::now();
         measured(world, measure, Changed::Positions, |w| {
             hook.begin_substep(w, frame.substep(index, 0))
@@ -302,6 +334,14 @@ impl Solver {
     }
 }
 
+/// Scratch of the sleeping systems for one frame.
+#[derive(Clone, Debug, Default)]
+struct SleepScratch {
+    entities: Vec<(hecs::Entity, bool)>,
+    islands: sleeping::Islands,
+    touching: sleeping::Touching,
+}
+
 /// Runs a hook call, measuring the kinetic energy its corrections hand the families
 /// ([`crate::stabilisation::hook_work`]) in a substep of length `measure` (s), if given.
 fn measured(
@@ -319,19 +359,32 @@ fn measured(
     }
 }
 
+/// Counts the bodies, and the particles and constraints of the awake ones.
 fn count_constraints(world: &mut World, stats: &mut StepStats) {
     use crate::{EdgeConstraints, Particles, VertexFaceConstraints, VolumeConstraints};
-    for p in world.query_mut::<&Particles>() {
+    for (p, asleep) in world.query_mut::<(&Particles, Option<&Asleep>)>() {
         stats.bodies += 1;
-        stats.particles += p.len();
+        if asleep.is_some() {
+            stats.bodies_asleep += 1;
+        } else {
+            stats.particles += p.len();
+        }
     }
-    for e in world.query_mut::<&EdgeConstraints>() {
+    for e in world.query_mut::<&EdgeConstraints>().without::<&Asleep>() {
         stats.edge.count += e.len();
     }
-    for v in world.query_mut::<&VertexFaceConstraints>() {
+    for v in world
+        .query_mut::<&VertexFaceConstraints>()
+        .without::<&Asleep>()
+    {
         stats.vertex_face.count += v.len();
     }
-    for v in world.query_mut::<&VolumeConstraints>() {
+    for v in world.query_mut::<&VolumeConstraints>().without::<&Asleep>() {
         stats.volume.count += v.len();
     }
+}
+
+/// The bodies asleep.
+fn count_asleep(world: &mut World) -> usize {
+    world.query_mut::<&Asleep>().into_iter().count()
 }

@@ -4,12 +4,14 @@
 //! [`predict`], the family projections (`iterations` times, in
 //! [`crate::SolverSettings::order`], each iteration followed by [`project_grabs`]),
 //! [`update_velocities`], [`damp_deformation`]; after the last substep of a frame,
-//! [`roll_grab_targets`]. They are
-//! public so that an integrator can build a different schedule.
+//! [`roll_grab_targets`]. They are public so that an integrator can build a different
+//! schedule. Each skips the bodies that sleep ([`crate::Asleep`]); [`measure`] alone visits
+//! them.
 
 use hecs::World;
 use nalgebra::Vector3;
 
+use crate::body::activation::Asleep;
 use crate::body::families::Family;
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 pub use crate::body::forces::integrate_user_forces;
@@ -46,8 +48,9 @@ pub fn predict(
     let keep = (1.0 - damping * h).max(0.0);
     let mut restored = crate::solver::non_finite::Restored::default();
     integrate_user_forces(world, h);
-    for (entity, p, extra) in
-        world.query_mut::<(hecs::Entity, &mut Particles, Option<&ExternalAcceleration>)>()
+    for (entity, p, extra) in world
+        .query_mut::<(hecs::Entity, &mut Particles, Option<&ExternalAcceleration>)>()
+        .without::<&Asleep>()
     {
         let a = gravity + extra.map_or(Vector3::zeros(), |e| e.0);
         let Particles {
@@ -86,13 +89,22 @@ pub fn predict(
 /// Sets every multiplier λ to zero (start of a substep), the [`crate::Grab`]s' too.
 pub fn reset_lambdas(world: &mut World) {
     reset_grabs(world);
-    for e in world.query_mut::<&mut EdgeConstraints>() {
+    for e in world
+        .query_mut::<&mut EdgeConstraints>()
+        .without::<&Asleep>()
+    {
         zero(&mut e.lambdas);
     }
-    for v in world.query_mut::<&mut VertexFaceConstraints>() {
+    for v in world
+        .query_mut::<&mut VertexFaceConstraints>()
+        .without::<&Asleep>()
+    {
         zero(&mut v.lambdas);
     }
-    for v in world.query_mut::<&mut VolumeConstraints>() {
+    for v in world
+        .query_mut::<&mut VolumeConstraints>()
+        .without::<&Asleep>()
+    {
         zero(&mut v.lambdas);
     }
 }
@@ -163,16 +175,16 @@ pub(crate) fn project_family(
     let mut count = ProjectionCount::default();
     match family {
         Family::Edge => {
-            for (p, e) in world.query_mut::<(&mut Particles, &mut EdgeConstraints)>() {
+            let q = world.query_mut::<(&mut Particles, &mut EdgeConstraints)>();
+            for (p, e) in q.without::<&Asleep>() {
                 let alpha_tilde = e.compliance / (h * h);
                 count +=
                     working_copy::with_access(p, mode, |acc| edges_of(acc, e, alpha_tilde, kernel));
             }
         }
         Family::VertexFace => {
-            for (p, tets, vf) in
-                world.query_mut::<(&mut Particles, &Tetrahedra, &mut VertexFaceConstraints)>()
-            {
+            let q = world.query_mut::<(&mut Particles, &Tetrahedra, &mut VertexFaceConstraints)>();
+            for (p, tets, vf) in q.without::<&Asleep>() {
                 let alpha_tilde = vf.compliance / (h * h);
                 count += working_copy::with_access(p, mode, |acc| {
                     vertex_faces_of(acc, tets, vf, alpha_tilde, kernel)
@@ -180,9 +192,8 @@ pub(crate) fn project_family(
             }
         }
         Family::Volume => {
-            for (p, tets, vol) in
-                world.query_mut::<(&mut Particles, &Tetrahedra, &mut VolumeConstraints)>()
-            {
+            let q = world.query_mut::<(&mut Particles, &Tetrahedra, &mut VolumeConstraints)>();
+            for (p, tets, vol) in q.without::<&Asleep>() {
                 let alpha_tilde = vol.compliance / (h * h);
                 count += working_copy::with_access(p, mode, |acc| {
                     volumes_of(acc, tets, vol, alpha_tilde, kernel)
@@ -295,7 +306,7 @@ pub fn update_velocities(
     max_correction_speed: Option<f32>,
 ) -> VelocityUpdate {
     let mut out = VelocityUpdate::default();
-    for p in world.query_mut::<&mut Particles>() {
+    for p in world.query_mut::<&mut Particles>().without::<&Asleep>() {
         let Particles {
             positions,
             prev_positions,

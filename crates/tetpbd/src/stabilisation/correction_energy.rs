@@ -206,13 +206,16 @@ pub(crate) fn elastic_release(
 /// is set. Returns the number of bodies the limit acted on.
 pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: bool) -> u64 {
     let mut limited = 0;
-    for (p, e, t, vf, vol) in world.query_mut::<(
-        &mut crate::Particles,
-        Option<&EdgeConstraints>,
-        Option<&Tetrahedra>,
-        Option<&VertexFaceConstraints>,
-        Option<&VolumeConstraints>,
-    )>() {
+    for (p, e, t, vf, vol) in world
+        .query_mut::<(
+            &mut crate::Particles,
+            Option<&EdgeConstraints>,
+            Option<&Tetrahedra>,
+            Option<&VertexFaceConstraints>,
+            Option<&VolumeConstraints>,
+        )>()
+        .without::<&crate::Asleep>()
+    {
         if !(e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some()))) {
             continue;
         }

@@ -61,7 +61,8 @@ impl DeformationDamping {
 /// Damps the deformation of every body with a [`DeformationDamping`] for a substep of length
 /// `h` (s). [`crate::Solver`] runs it right after the velocity update.
 pub fn damp_deformation(world: &mut World, h: f32) {
-    for (p, d) in world.query_mut::<(&mut Particles, &DeformationDamping)>() {
+    let q = world.query_mut::<(&mut Particles, &DeformationDamping)>();
+    for (p, d) in q.without::<&crate::Asleep>() {
         damp(p, d.rate, h);
     }
 }

@@ -75,7 +75,10 @@ fn field(p: &mut Particles, changed: Changed) -> (&[Vector3<f32>], &[f32], &mut 
 
 /// Records every body's positions or velocities before a hook call.
 pub(crate) fn before_hook(world: &mut hecs::World, changed: Changed) {
-    for p in world.query_mut::<&mut Particles>() {
+    for p in world
+        .query_mut::<&mut Particles>()
+        .without::<&crate::Asleep>()
+    {
         let (now, _, hook) = field(p, changed);
         hook.start.clear();
         hook.start.extend_from_slice(now);
@@ -89,7 +92,10 @@ pub(crate) fn after_hook(world: &mut hecs::World, h: f32, changed: Changed) {
         Changed::Positions => 0.5 / (f64::from(h) * f64::from(h)),
         Changed::Velocities => 0.5,
     };
-    for p in world.query_mut::<&mut Particles>() {
+    for p in world
+        .query_mut::<&mut Particles>()
+        .without::<&crate::Asleep>()
+    {
         let (now, masses, hook) = field(p, changed);
         if hook.start.len() != now.len() {
             continue;

@@ -424,6 +424,11 @@ impl BodyProxy {
     /// Force (N) and torque about the centre of mass (N·m) that carry the summed soft
     /// impulse on a supported body through rapier's next step (the impulse of this frame
     /// spread over `dt`); `None` for any other body or when there is none.
+    /// Velocity (m/s) and angular velocity (rad/s) the body ends the frame with.
+    pub fn final_velocity(&self) -> (Vector3<f32>, Vector3<f32>) {
+        (self.v_end + self.dv, self.w_end + self.dw)
+    }
+
     pub fn load(&self) -> Option<(Vector3<f32>, Vector3<f32>)> {
         (self.kind == BodyKind::Supported
             && self.touched
@@ -439,7 +444,7 @@ impl BodyProxy {
     /// a velocity change of the same impulse is an impact (a 100 kg soft body resting on a
     /// 0.125 kg box hands it about 100 m/s per frame, which rapier's contacts do not cancel
     /// cleanly). Returns `false` (and writes nothing) when the result is not finite.
-    pub fn write_back(&self, body: &mut RigidBody) -> bool {
+    pub fn write_back(&self, body: &mut RigidBody, soft_asleep: bool) -> bool {
         if !self.touched {
             return true;
         }
@@ -448,6 +453,8 @@ impl BodyProxy {
         if load.is_some_and(|(f, t)| !(finite(&f) && finite(&t))) {
             return false;
         }
+        // Sleeping (`sleeping` module docs): a body whose soft bodies all fell asleep with
+        // it is written and put to sleep with them; otherwise it is written and kept awake.
         match self.kind {
             BodyKind::Dynamic => {
                 let (v, w, p) = (self.v_end + self.dv, self.w_end + self.dw, self.pose);
@@ -468,6 +475,9 @@ impl BodyProxy {
         if let Some((force, torque)) = load {
             body.add_force(to_glam(&force), true);
             body.add_torque(to_glam(&torque), true);
+        }
+        if soft_asleep {
+            body.sleep();
         }
         true
     }
