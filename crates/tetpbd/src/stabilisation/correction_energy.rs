@@ -114,7 +114,7 @@ pub(crate) fn velocity_scale(
 /// physical but would make the limit act on every substep of a moving body. With `L` the
 /// body's distance plus its radius of gyration, the floor is `M (4 ε L)² / (2h²)`.
 fn rounding_floor(sums: &Moments<f64>, origin: f32, h: f64) -> f64 {
-    if !(sums.mass > 0.0) {
+    if sums.mass.is_nan() || sums.mass <= 0.0 {
         return 0.0;
     }
     let spread = (sums.second[0] + sums.second[1] + sums.second[2]) / sums.mass;
