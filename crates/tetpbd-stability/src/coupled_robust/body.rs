@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use rapier3d::prelude::{
     SoftBodyBuilder as RapierBuilder, SoftBodyCellModel, SoftBodyHandle, SoftBodySolver,
 };
-use tetpbd::{unique_edges, Particles, SoftBodyBuilder, SolverSettings, TetMesh};
+use tetpbd::{unique_edges, Activation, Particles, SoftBodyBuilder, SolverSettings, TetMesh};
 use tetpbd_bench::{lumped_masses, rapier_material, to_rapier};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider};
 
@@ -58,8 +58,8 @@ fn signed(p: &[Vector3<f32>], t: &[u32; 4]) -> f32 {
 
 impl Soft {
     /// Spawns `mesh` (rest pose, m) moved by `at`, at `density` kg/m³ and `velocity` m/s.
-    /// `tetpbd`: the configuration's families and the default [`SoftCollider`]; rapier: hard
-    /// edges and volumes, never sleeping.
+    /// `tetpbd`: the configuration's families and the default [`SoftCollider`], never
+    /// sleeping; rapier: hard edges and volumes, never sleeping.
     pub(crate) fn spawn(
         s: &mut CoupledWorld,
         engine: Engine,
@@ -81,8 +81,9 @@ impl Soft {
                     .velocity(velocity);
                 let body = config.apply(b, 1.0).build().map_err(|e| e.to_string())?;
                 let e = body.spawn(&mut s.soft);
+                // Watched awake, as rapier's bodies here: the suite measures the dynamics.
                 s.soft
-                    .insert_one(e, SoftCollider::default())
+                    .insert(e, (SoftCollider::default(), Activation::never_sleeps()))
                     .map_err(|e| e.to_string())?;
                 SoftKind::Tetpbd(e)
             }
