@@ -11,7 +11,7 @@ use rapier3d::prelude::{
     ColliderBuilder, PhysicsWorld, RigidBodyBuilder, SoftBodyBuilder as RapierBuilder,
     SoftBodyCellModel, SoftBodyHandle, SoftBodySolver,
 };
-use tetpbd::{hecs, unique_edges, Particles, SoftBodyBuilder, SolverSettings};
+use tetpbd::{hecs, unique_edges, Activation, Particles, SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping};
 
 use crate::clock::thread_cpu_ms;
@@ -163,6 +163,8 @@ pub fn tetpbd_contact_world(
             .translation(*at)
             .build()?
             .spawn(&mut scene.soft);
+        // Benchmarks time the solver on awake bodies: sleeping would end the work being measured.
+        scene.soft.insert_one(e, Activation::never_sleeps())?;
         if damping > 0.0 {
             scene
                 .soft

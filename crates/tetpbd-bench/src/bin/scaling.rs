@@ -112,7 +112,11 @@ fn body(
         built.tetrahedra.classes().phase_count(),
     );
     let mut world = hecs::World::new();
-    built.spawn(&mut world);
+    let e = built.spawn(&mut world);
+    // Benchmarks time the solver on awake bodies: sleeping would end the work being measured.
+    world
+        .insert_one(e, tetpbd::Activation::never_sleeps())
+        .expect("entity");
     let solver = Solver::new(SolverSettings {
         substeps: 10,
         parallel: tetpbd::ParallelSettings {

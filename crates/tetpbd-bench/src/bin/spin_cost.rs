@@ -44,6 +44,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             };
             let mut world = hecs::World::new();
             let e = b.build()?.spawn(&mut world);
+            // Benchmarks time the solver on awake bodies: sleeping would end the work being measured.
+            world.insert_one(e, tetpbd::Activation::never_sleeps())?;
             {
                 // A slow spin, so the corrections are not zero.
                 let mut p = world.get::<&mut tetpbd::Particles>(e)?;

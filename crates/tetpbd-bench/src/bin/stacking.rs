@@ -64,7 +64,11 @@ fn run(
     }
     .build()?;
     let e = body.spawn(&mut s.soft);
-    s.soft.insert_one(e, SoftCollider::default())?;
+    // Benchmarks time the solver on awake bodies: sleeping would end the work being measured.
+    s.soft.insert(
+        e,
+        (SoftCollider::default(), tetpbd::Activation::never_sleeps()),
+    )?;
     let (rb, _) = s.physics.insert(
         RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 0.403 + 0.25 + 0.005, 0.0)),
         ColliderBuilder::cuboid(0.25, 0.25, 0.25).mass(1000.0),

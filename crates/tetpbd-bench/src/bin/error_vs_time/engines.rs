@@ -212,7 +212,11 @@ pub fn ours_settings(scene: &Scene, substeps: u32, iterations: u32) -> SolverSet
 impl Ours {
     fn new(set: ConstraintSet, soft: bool, scene: &Scene, substeps: u32, iterations: u32) -> Ours {
         let mut world = hecs::World::new();
-        ours_body(set, soft, scene).spawn(&mut world);
+        let e = ours_body(set, soft, scene).spawn(&mut world);
+        // The error is measured on the moving body: sleeping would freeze it.
+        world
+            .insert_one(e, tetpbd::Activation::never_sleeps())
+            .expect("entity");
         let solver =
             Solver::new(ours_settings(scene, substeps, iterations)).expect("valid settings");
         Ours {
