@@ -34,6 +34,10 @@ fn bodies_resting_on_the_ground_are_still_with_the_energy_limit_on() {
                 Vector3::new(0.0, size / 2.0 + 0.05, 0.0),
                 SoftCollider::default(),
             );
+            // Watched awake: sleeping would zero the motion this test measures.
+            s.soft
+                .insert_one(e, tetpbd::Activation::never_sleeps())
+                .expect("entity");
             let mut limited = 0;
             for _ in 0..150 {
                 limited += s.step().expect("step").soft.energy_limited;
