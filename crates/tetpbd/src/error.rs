@@ -75,6 +75,8 @@ pub enum BuildError {
         /// The value given.
         value: f32,
     },
+    /// A plasticity setting is out of range.
+    Plasticity(PlasticityError),
     /// A generator parameter is out of range.
     BadGeneratorParameter {
         /// Parameter name.
@@ -137,6 +139,7 @@ impl fmt::Display for BuildError {
             BuildError::BadScale { value } => {
                 write!(f, "scale must be finite and positive, got {value}")
             }
+            BuildError::Plasticity(e) => write!(f, "{e}"),
             BuildError::BadGeneratorParameter { name, value } => {
                 write!(f, "generator parameter `{name}` is out of range: {value}")
             }
@@ -348,5 +351,50 @@ impl std::error::Error for StepError {
 impl From<SettingsError> for StepError {
     fn from(e: SettingsError) -> Self {
         StepError::Settings(e)
+    }
+}
+
+/// Why plasticity settings were rejected ([`crate::PlasticitySettings::validate`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PlasticityError {
+    /// The yield strain must be finite and ≥ 0.
+    BadYieldStrain {
+        /// The value given (dimensionless).
+        value: f32,
+    },
+    /// The flow rate must be ≥ 0 (1/s; infinity allowed).
+    BadFlowRate {
+        /// The value given, 1/s.
+        value: f32,
+    },
+    /// The maximum plastic strain must be finite, ≥ 0 and < 1.
+    BadMaxPlasticStrain {
+        /// The value given (dimensionless).
+        value: f32,
+    },
+}
+
+impl fmt::Display for PlasticityError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PlasticityError::BadYieldStrain { value } => {
+                write!(f, "yield strain must be finite and >= 0, got {value}")
+            }
+            PlasticityError::BadFlowRate { value } => {
+                write!(f, "plastic flow rate must be >= 0 1/s, got {value}")
+            }
+            PlasticityError::BadMaxPlasticStrain { value } => write!(
+                f,
+                "maximum plastic strain must be finite, >= 0 and < 1, got {value}"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for PlasticityError {}
+
+impl From<PlasticityError> for BuildError {
+    fn from(e: PlasticityError) -> Self {
+        BuildError::Plasticity(e)
     }
 }

@@ -39,6 +39,8 @@ pub struct SoftBody {
     pub vertex_face: Option<VertexFaceConstraints>,
     /// Volume family, if chosen.
     pub volume: Option<VolumeConstraints>,
+    /// Plastic flow, if chosen.
+    pub plasticity: Option<crate::Plasticity>,
 }
 
 impl SoftBody {
@@ -55,6 +57,9 @@ impl SoftBody {
         }
         if let Some(v) = self.volume {
             b.add(v);
+        }
+        if let Some(p) = self.plasticity {
+            b.add(p);
         }
         world.spawn(b.build())
     }
@@ -76,6 +81,7 @@ pub struct SoftBodyBuilder {
     edge: Option<f32>,
     vertex_face: Option<f32>,
     volume: Option<f32>,
+    plasticity: Option<crate::PlasticitySettings>,
     pinned: Vec<u32>,
     placement: Placement,
     epsilon: f32,
@@ -100,6 +106,7 @@ impl SoftBodyBuilder {
             edge: None,
             vertex_face: None,
             volume: None,
+            plasticity: None,
             pinned: Vec::new(),
             placement: Placement::default(),
             epsilon: Self::DEFAULT_EPSILON,
@@ -134,6 +141,14 @@ impl SoftBodyBuilder {
     /// Adds the volume family with compliance `alpha` (m⁵/N).
     pub fn volume(mut self, alpha: f32) -> Self {
         self.volume = Some(alpha);
+        self
+    }
+
+    /// Gives the body plastic flow (a [`crate::Plasticity`] component): the rest state of
+    /// every family it has follows the shape it is held in past `settings.yield_strain`.
+    /// Checked by [`Self::build`] ([`BuildError::Plasticity`]).
+    pub fn plasticity(mut self, settings: crate::PlasticitySettings) -> Self {
+        self.plasticity = Some(settings);
         self
     }
 
@@ -224,6 +239,7 @@ impl SoftBodyBuilder {
             edge,
             vertex_face,
             volume,
+            plasticity,
             pinned,
             placement,
             epsilon,
@@ -275,6 +291,15 @@ impl SoftBodyBuilder {
             lambdas: vec![0.0; mesh.tets.len()],
             compliance: alpha,
         });
+        let tetrahedra = Tetrahedra {
+            indices: mesh.tets,
+            rest_volumes,
+            source,
+            classes: tet_classes,
+        };
+        let plasticity = plasticity
+            .map(|s| crate::Plasticity::new(s, &tetrahedra, edges.as_ref()))
+            .transpose()?;
         Ok(SoftBody {
             particles: Particles {
                 prev_positions: positions.clone(),
@@ -290,16 +315,12 @@ impl SoftBodyBuilder {
                 written: false,
                 hook: Default::default(),
             },
-            tetrahedra: Tetrahedra {
-                indices: mesh.tets,
-                rest_volumes,
-                source,
-                classes: tet_classes,
-            },
+            tetrahedra,
             surface,
             edges,
             vertex_face,
             volume,
+            plasticity,
         })
     }
 
@@ -325,6 +346,9 @@ impl SoftBodyBuilder {
                     return Err(BuildError::BadCompliance { family, value: a });
                 }
             }
+        }
+        if let Some(s) = &self.plasticity {
+            s.validate()?;
         }
         self.placement.check()
     }

@@ -4,7 +4,8 @@
 //! (vertices and tetrahedra, from a file or a [`generators`] function) into the components of
 //! one body: [`Particles`](particles::Particles) (one flat array per quantity),
 //! [`Tetrahedra`](mesh::Tetrahedra), [`Surface`](mesh::Surface) and one optional component per
-//! constraint family ([`families`]): a body pays only for the families it has.
+//! constraint family ([`families`]): a body pays only for the families it has, and for
+//! [`Plasticity`](plasticity::Plasticity) only if it has it.
 
 pub(crate) mod activation;
 pub(crate) mod builder;
@@ -17,3 +18,5 @@ pub(crate) mod material_point;
 pub(crate) mod mesh;
 pub(crate) mod particles;
 pub(crate) mod placement;
+pub(crate) mod plastic_rest;
+pub(crate) mod plasticity;

@@ -6,6 +6,7 @@
 
 pub(crate) mod hook;
 pub(crate) mod non_finite;
+pub(crate) mod plastic_flow;
 pub(crate) mod settings;
 pub(crate) mod sleeping;
 pub(crate) mod stats;

@@ -31,7 +31,8 @@ use crate::stabilisation::{correction_energy, deformation_damping};
 ///         hook.project
 ///     update velocities  v ← (x − x_prev) / h, then damp deformation (DeformationDamping)
 ///     hook.end_substep
-/// after the last substep: the grabs' targets roll on (systems::roll_grab_targets)
+/// after the last substep: the grabs' targets roll on (systems::roll_grab_targets), rest
+///     shapes flow (systems::flow_plastically, bodies with a Plasticity)
 /// ```
 ///
 /// Threads (feature `parallel`): a step runs its parallel passes on the pool given to
@@ -220,6 +221,7 @@ impl Solver {
             restored.first = restored.first.or(r.first);
         }
         systems::roll_grab_targets(world);
+        systems::flow_plastically(world, frame.dt());
         let t = Instant::now();
         hook.end_frame(world, frame);
         hook.touching(world, &mut sleep.touching);

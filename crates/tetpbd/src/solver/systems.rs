@@ -4,7 +4,7 @@
 //! [`predict`], the family projections (`iterations` times, in
 //! [`crate::SolverSettings::order`], each iteration followed by [`project_grabs`]),
 //! [`update_velocities`], [`damp_deformation`]; after the last substep of a frame,
-//! [`roll_grab_targets`]. They are public so that an integrator can build a different
+//! [`roll_grab_targets`] and [`flow_plastically`]. They are public so that an integrator can build a different
 //! schedule. Each skips the bodies that sleep ([`crate::Asleep`]); [`measure`] alone visits
 //! them.
 
@@ -16,6 +16,7 @@ use crate::body::families::Family;
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 pub use crate::body::forces::integrate_user_forces;
 pub use crate::body::grab::{project_grabs, reset_grabs, roll_grab_targets};
+pub use crate::solver::plastic_flow::flow_plastically;
 use crate::body::mesh::Tetrahedra;
 use crate::body::particles::{ExternalAcceleration, Particles};
 use crate::constraints::{self, VERTEX_FACE_ORDER};
