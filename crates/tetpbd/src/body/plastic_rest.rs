@@ -85,7 +85,8 @@ impl RestState<'_> {
                 .iter()
                 .all(|&(t, _)| plastic.stretch[t as usize] == identity)
             {
-                e.rest_lengths[k] = (rest_positions[i as usize] - rest_positions[j as usize]).norm();
+                e.rest_lengths[k] =
+                    (rest_positions[i as usize] - rest_positions[j as usize]).norm();
                 continue;
             }
             let mut sum = 0.0f64;

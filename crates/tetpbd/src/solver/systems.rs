@@ -16,7 +16,6 @@ use crate::body::families::Family;
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 pub use crate::body::forces::integrate_user_forces;
 pub use crate::body::grab::{project_grabs, reset_grabs, roll_grab_targets};
-pub use crate::solver::plastic_flow::flow_plastically;
 use crate::body::mesh::Tetrahedra;
 use crate::body::particles::{ExternalAcceleration, Particles};
 use crate::constraints::{self, VERTEX_FACE_ORDER};
@@ -27,6 +26,7 @@ pub use crate::kernels::particle_runs::VelocityUpdate;
 use crate::kernels::particle_runs::{PredictRun, VelocityRun};
 use crate::kernels::slots::WorkAccess;
 use crate::kernels::working_copy::{self, CopyMode};
+pub use crate::solver::plastic_flow::flow_plastically;
 use crate::solver::stats::{ErrorAccumulator, ErrorStats};
 pub use crate::stabilisation::deformation_damping::damp_deformation;
 
