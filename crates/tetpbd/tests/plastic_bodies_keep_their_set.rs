@@ -586,3 +586,67 @@ fn instant_flow_without_yield_makes_the_held_shape_the_rest_shape() {
         assert!(m.volume.max < 1e-9, "{families:?}: {m:?}");
     }
 }
+
+/// After a flow, `Plasticity::reset` gives every family its built rest values back, bit for
+/// bit.
+#[test]
+fn reset_gives_back_the_built_rest_state() {
+    for families in [Families::EdgesVolume, Families::EdgesVertexFace] {
+        let bar = Bar {
+            length: 1.0,
+            cells: 4,
+            substeps: 5,
+            families,
+        };
+        let mut world = World::new();
+        let e = spawn_bar(&mut world, bar, Some(PlasticitySettings::default()));
+        let built_edges = world
+            .get::<&EdgeConstraints>(e)
+            .unwrap()
+            .rest_lengths()
+            .to_vec();
+        let built_volumes = world.get::<&Tetrahedra>(e).unwrap().rest_volumes().to_vec();
+        let built_heights = world
+            .get::<&VertexFaceConstraints>(e)
+            .ok()
+            .map(|v| v.rest_heights().to_vec());
+        let rest: Vec<Vector3<f32>> = world
+            .get::<&Particles>(e)
+            .unwrap()
+            .rest_positions()
+            .to_vec();
+        let held: Vec<Vector3<f32>> = rest.iter().map(|x| arc(*x, bar.length, 2.0)).collect();
+        mould(&mut world, e, &held, true);
+        let mut solver = solver(bar.substeps, 0.0);
+        for _ in 0..10 {
+            solver.step(&mut world).unwrap();
+        }
+        assert_ne!(
+            world.get::<&EdgeConstraints>(e).unwrap().rest_lengths(),
+            &built_edges[..]
+        );
+        let (p, t, plastic, vf, edges) = world
+            .query_one_mut::<(
+                &Particles,
+                &mut Tetrahedra,
+                &mut Plasticity,
+                Option<&mut VertexFaceConstraints>,
+                Option<&mut EdgeConstraints>,
+            )>(e)
+            .unwrap();
+        assert!(plastic.reset(p, t, vf, edges));
+        assert_eq!(
+            world.get::<&EdgeConstraints>(e).unwrap().rest_lengths(),
+            &built_edges[..]
+        );
+        assert_eq!(
+            world.get::<&Tetrahedra>(e).unwrap().rest_volumes(),
+            &built_volumes[..]
+        );
+        let heights = world
+            .get::<&VertexFaceConstraints>(e)
+            .ok()
+            .map(|v| v.rest_heights().to_vec());
+        assert_eq!(heights, built_heights);
+    }
+}

@@ -297,24 +297,25 @@ impl SoftBodyBuilder {
             source,
             classes: tet_classes,
         };
+        let particles = Particles {
+            prev_positions: positions.clone(),
+            positions,
+            velocities,
+            inv_masses,
+            masses,
+            rest_positions: mesh.vertices,
+            residuals: vec![Vector3::zeros(); n],
+            vertex_to_particle: inverse(&particle_source),
+            source: particle_source,
+            work: WorkCopy(vec![Slot::default(); n]),
+            written: false,
+            hook: Default::default(),
+        };
         let plasticity = plasticity
-            .map(|s| crate::Plasticity::new(s, &tetrahedra, edges.as_ref()))
+            .map(|s| crate::Plasticity::new(s, &particles, &tetrahedra, edges.as_ref()))
             .transpose()?;
         Ok(SoftBody {
-            particles: Particles {
-                prev_positions: positions.clone(),
-                positions,
-                velocities,
-                inv_masses,
-                masses,
-                rest_positions: mesh.vertices,
-                residuals: vec![Vector3::zeros(); n],
-                vertex_to_particle: inverse(&particle_source),
-                source: particle_source,
-                work: WorkCopy(vec![Slot::default(); n]),
-                written: false,
-                hook: Default::default(),
-            },
+            particles,
             tetrahedra,
             surface,
             edges,

@@ -51,6 +51,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::body::families::EdgeConstraints;
 use crate::body::mesh::Tetrahedra;
+use crate::body::particles::Particles;
 use crate::error::PlasticityError;
 
 /// Largest relative change of a tetrahedron's rest volume under volume-preserving flow:
@@ -120,6 +121,9 @@ pub struct Plasticity {
     pub(crate) settings: PlasticitySettings,
     /// Plastic stretch `P` of each tetrahedron, in solver order (dimensionless).
     pub(crate) stretch: Vec<Matrix3<f64>>,
+    /// `(P D⁰)⁻¹` of each tetrahedron, 1/m: the deformation gradient `F = Dₛ (P D⁰)⁻¹` in one
+    /// product, for the flow pass's quick test of the yield.
+    pub(crate) inv_rest: Vec<Matrix3<f32>>,
     /// For each edge of the body's [`EdgeConstraints`], in their order, the range of
     /// `edge_corners` that lists it; empty when the body has no edge family.
     pub(crate) edge_offsets: Vec<u32>,
@@ -128,10 +132,11 @@ pub struct Plasticity {
 }
 
 impl Plasticity {
-    /// The plastic state of a body with these tetrahedra and edge family, at its built rest
-    /// shape (no flow yet). Errors: a bad setting ([`PlasticitySettings::validate`]).
+    /// The plastic state of a body with these particles, tetrahedra and edge family, at its
+    /// built rest shape (no flow yet). Errors: a bad setting ([`PlasticitySettings::validate`]).
     pub fn new(
         settings: PlasticitySettings,
+        particles: &Particles,
         tetrahedra: &Tetrahedra,
         edges: Option<&EdgeConstraints>,
     ) -> Result<Plasticity, PlasticityError> {
@@ -140,12 +145,40 @@ impl Plasticity {
             Some(e) => edge_incidence(&tetrahedra.indices, &e.edges),
             None => (Vec::new(), Vec::new()),
         };
-        Ok(Plasticity {
+        let mut plastic = Plasticity {
             settings,
             stretch: vec![Matrix3::identity(); tetrahedra.len()],
+            inv_rest: vec![Matrix3::zeros(); tetrahedra.len()],
             edge_offsets,
             edge_corners,
-        })
+        };
+        for t in 0..tetrahedra.len() {
+            plastic.set_stretch(
+                t,
+                Matrix3::identity(),
+                tetrahedra,
+                &particles.rest_positions,
+            );
+        }
+        Ok(plastic)
+    }
+
+    /// Sets tetrahedron `t`'s plastic stretch and the inverse of its rest edge matrix.
+    pub(crate) fn set_stretch(
+        &mut self,
+        t: usize,
+        stretch: Matrix3<f64>,
+        tetrahedra: &Tetrahedra,
+        rest_positions: &[Vector3<f32>],
+    ) {
+        self.stretch[t] = stretch;
+        let dm = stretch * built_edge_matrix(tetrahedra.indices[t], rest_positions);
+        // The builder rejects degenerate tetrahedra and the flow keeps `P` regular, so the
+        // inverse exists; zeros would only make the quick test defer to the full one.
+        self.inv_rest[t] = dm
+            .try_inverse()
+            .unwrap_or_else(Matrix3::zeros)
+            .cast::<f32>();
     }
 
     /// The settings.
@@ -165,7 +198,9 @@ impl Plasticity {
     pub fn fits(&self, tetrahedra: &Tetrahedra, edges: Option<&EdgeConstraints>) -> bool {
         let edge_count = edges.map_or(0, |e| e.len());
         let listed = self.edge_offsets.len().saturating_sub(1);
-        self.stretch.len() == tetrahedra.len() && listed == edge_count
+        self.stretch.len() == tetrahedra.len()
+            && self.inv_rest.len() == tetrahedra.len()
+            && listed == edge_count
     }
 
     /// Plastic stretch `P` of each tetrahedron (dimensionless), in the order of
@@ -191,22 +226,34 @@ impl Plasticity {
         self.stretch[t] * built_edge_matrix(tetrahedra.indices[t], rest_positions)
     }
 
-    /// Puts every rest shape back to the built one (`P = I`) and with it the rest values
-    /// of every family; the particles stay where they are and spring back from there.
+    /// Puts every rest shape of the body back to the built one (`P = I`) and with it the
+    /// rest values of every family it has, exactly as built; the particles stay where they
+    /// are and spring back from there. Does nothing and returns `false` when this state
+    /// does not [fit](Self::fits) the body.
     pub fn reset(
         &mut self,
+        particles: &Particles,
         tetrahedra: &mut Tetrahedra,
-        rest_positions: &[Vector3<f32>],
         vertex_face: Option<&mut crate::VertexFaceConstraints>,
         edges: Option<&mut EdgeConstraints>,
-    ) {
-        self.stretch.fill(Matrix3::identity());
+    ) -> bool {
+        let vf_fits = vertex_face
+            .as_ref()
+            .is_none_or(|v| v.rest_heights.len() == tetrahedra.len());
+        if !(self.fits(tetrahedra, edges.as_deref()) && vf_fits) {
+            return false;
+        }
+        let rest_positions = &particles.rest_positions;
+        for t in 0..tetrahedra.len() {
+            self.set_stretch(t, Matrix3::identity(), tetrahedra, rest_positions);
+        }
         let rest = crate::body::plastic_rest::RestState {
             tetrahedra,
             vertex_face,
             edges,
         };
         rest.refresh_all(self, rest_positions);
+        true
     }
 }
 
@@ -256,7 +303,8 @@ mod tests {
         let mesh = box_grid(Vector3::new(2.0, 1.0, 1.0), [3, 2, 2], CellSplit::Five).unwrap();
         let body = SoftBodyBuilder::new(mesh).edges(0.0).build().unwrap();
         let e = body.edges.as_ref().unwrap();
-        let p = Plasticity::new(Default::default(), &body.tetrahedra, Some(e)).unwrap();
+        let (particles, tets) = (&body.particles, &body.tetrahedra);
+        let p = Plasticity::new(Default::default(), particles, tets, Some(e)).unwrap();
         assert!(p.fits(&body.tetrahedra, Some(e)));
         assert!(!p.fits(&body.tetrahedra, None));
         for (k, &[i, j]) in e.edges.iter().enumerate() {
