@@ -39,6 +39,7 @@ pub fn flow_plastically(world: &mut World, dt: f32) -> usize {
         };
         let settings = plastic.settings;
         let quick = quick_bound(settings.yield_strain);
+        let quick_sq = if quick > 0.0 { quick * quick } else { -1.0 };
         let mut body_flowed = 0;
         for t in 0..rest.tetrahedra.len() {
             let tet = rest.tetrahedra.indices[t];
@@ -47,7 +48,7 @@ pub fn flow_plastically(world: &mut World, dt: f32) -> usize {
             let x = tet.map(|i| p.positions[i as usize]);
             let ds = Matrix3::from_columns(&[x[1] - x[0], x[2] - x[0], x[3] - x[0]]);
             let f = ds * plastic.inv_rest[t];
-            if (f.tr_mul(&f) - Matrix3::identity()).norm() <= quick {
+            if green_norm_sq(&f) <= quick_sq {
                 continue;
             }
             let d0 = built_edge_matrix(tet, &p.rest_positions);
@@ -129,6 +130,15 @@ pub(crate) fn flow(
 /// matrices (negative, so never met, for a yield below the margin).
 fn quick_bound(y: f32) -> f32 {
     y - 1e-4 * (1.0 + y)
+}
+
+/// `‖FᵀF − I‖²_F` from the six distinct entries of the symmetric `FᵀF`.
+#[inline]
+fn green_norm_sq(f: &Matrix3<f32>) -> f32 {
+    let [a, b, c] = [f.column(0), f.column(1), f.column(2)];
+    let (caa, cbb, ccc) = (a.dot(&a) - 1.0, b.dot(&b) - 1.0, c.dot(&c) - 1.0);
+    let (cab, cac, cbc) = (a.dot(&b), a.dot(&c), b.dot(&c));
+    caa * caa + cbb * cbb + ccc * ccc + 2.0 * (cab * cab + cac * cac + cbc * cbc)
 }
 
 /// `p` scaled to determinant 1, or `None` if its determinant is not positive.
@@ -222,5 +232,13 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The quick test's norm is the full one's `‖FᵀF − I‖²`.
+    #[test]
+    fn quick_norm_matches_the_matrix_norm() {
+        let f = Matrix3::new(1.1f32, 0.2, -0.3, 0.05, 0.9, 0.4, -0.2, 0.1, 1.3);
+        let full = (f.tr_mul(&f) - Matrix3::identity()).norm_squared();
+        assert!((green_norm_sq(&f) - full).abs() < 1e-5 * full);
     }
 }
