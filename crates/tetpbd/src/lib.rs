@@ -10,7 +10,9 @@
 //! inside its substep loop and returns [`StepStats`]. Interaction: impulses on
 //! [`Particles`] (`apply_impulse`, `apply_impulse_at_point`, `apply_radial_impulse`), forces
 //! in the [`UserForces`] component (integrated like gravity, kept until reset), and the
-//! [`Grab`] component holding a [`MaterialPoint`] to a moving target (mouse picking). [`constraints`] holds the constraint
+//! [`Grab`] component holding a [`MaterialPoint`] to a moving target (mouse picking). The
+//! optional [`Plasticity`] component lets a body's rest shape flow past a yield (bodies that
+//! stay bent), every family's rest values following. [`constraints`] holds the constraint
 //! math as pure functions and [`systems`] the solver's steps as plain functions over
 //! `&mut hecs::World`, for an integrator who builds a different schedule.
 //!
