@@ -1,48 +1,6 @@
 //! Plasticity: a body whose rest shape flows toward the shape it is held in.
 //!
-//! # Model
-//!
-//! Each tetrahedron `t` carries a *plastic stretch* `Pₜ` (3 × 3, identity when built). Its
-//! rest edge matrix is `Dₜ = Pₜ D⁰ₜ`, with `D⁰ₜ = [r₁ − r₀, r₂ − r₀, r₃ − r₀]` the columns of
-//! its built rest corners ([`crate::Particles::rest_positions`], never changed). Every rest
-//! value of every family the body has is read from the `Dₜ`:
-//!
-//! - rest volume (in [`crate::Tetrahedra`]): `Vₜ = det(Dₜ) / 6 = det(Pₜ) V⁰ₜ`;
-//! - vertex–face rest heights ([`crate::VertexFaceConstraints`]): each corner's signed height
-//!   above its opposite face, corners at `0` and the columns of `Dₜ`;
-//! - edge rest lengths ([`crate::EdgeConstraints`]): the length of the edge in each incident
-//!   tetrahedron's rest shape, averaged over those tetrahedra.
-//!
-//! A family that needs a rest shape of its own (a material model's `Dₜ⁻¹`) reads it the
-//! same way, from [`Plasticity::rest_edge_matrix`].
-//!
-//! # Flow rule
-//!
-//! Once per frame (length `dt`, s) the solver reads each tetrahedron's deformation against its
-//! current rest shape, `F = Dₛ Dₜ⁻¹` (`Dₛ`: current edge matrix), and its stretch
-//! `U = √(FᵀF)` (rotation removed). The elastic strain is `ε = U − I` (dimensionless), or its
-//! deviatoric part `ε − tr(ε)/3 · I` with [`PlasticitySettings::volume_preserving`]. When
-//! `‖ε‖_F` exceeds the yield `y`, a fraction of the excess flows into the rest shape:
-//!
-//! ```text
-//! γ = min(1, rate · dt) · (‖ε‖ − y) / ‖ε‖,   P ← (I + γ ε) P
-//! ```
-//!
-//! so an infinite rate leaves exactly the yield strain, and a finite one creeps at `rate`
-//! (1/s). An inverted tetrahedron (`det F ≤ 0`) does not flow.
-//!
-//! # Bounds (the rest state stays valid)
-//!
-//! The accumulated flow is capped: `‖P − I‖_F ≤ m` ([`PlasticitySettings::max_plastic_strain`],
-//! `0 ≤ m < 1`), a flow past it is scaled back onto the bound. Since the spectral norm is at
-//! most the Frobenius norm, every singular value of `P` lies in `[1 − m, 1 + m]`: a rest shape
-//! is never inverted nor flattened, its volume stays within `[(1 − m)³, (1 + m)³]` of the built
-//! one, and its condition number grows by at most `(1 + m)/(1 − m)`. With
-//! [`PlasticitySettings::volume_preserving`], `P` is scaled to `det P = 1` after each flow
-//! (a uniform scale, so the singular-value bound on the shape's condition number holds), and
-//! every rest volume stays within [`VOLUME_PRESERVING_TOLERANCE`] of its built value.
-//!
-//! The stretch is kept in `f64`, so the rounding of one flow never accumulates into the next.
+//! The model, its flow rule and its bounds are documented on [`Plasticity`].
 
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
@@ -58,7 +16,7 @@ use crate::error::PlasticityError;
 /// `|Vₜ / V⁰ₜ − 1| ≤ 1e-6` (the `f32` rounding of the stored volume, with margin).
 pub const VOLUME_PRESERVING_TOLERANCE: f32 = 1e-6;
 
-/// The settings of a body's plastic flow (see the [module documentation](self)).
+/// The settings of a body's plastic flow (see [`Plasticity`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct PlasticitySettings {
@@ -111,6 +69,50 @@ impl PlasticitySettings {
 
 /// A body's plastic state (a hecs component): its [`PlasticitySettings`] and the plastic
 /// stretch of each tetrahedron. A body without it never flows and pays nothing.
+///
+/// # Model
+///
+/// Each tetrahedron `t` carries a *plastic stretch* `Pₜ` (3 × 3, identity when built). Its
+/// rest edge matrix is `Dₜ = Pₜ D⁰ₜ`, with `D⁰ₜ = [r₁ − r₀, r₂ − r₀, r₃ − r₀]` the columns of
+/// its built rest corners ([`crate::Particles::rest_positions`], never changed). Every rest
+/// value of every family the body has is read from the `Dₜ`:
+///
+/// - rest volume (in [`crate::Tetrahedra`]): `Vₜ = det(Dₜ) / 6 = det(Pₜ) V⁰ₜ`;
+/// - vertex–face rest heights ([`crate::VertexFaceConstraints`]): each corner's signed height
+///   above its opposite face, corners at `0` and the columns of `Dₜ`;
+/// - edge rest lengths ([`crate::EdgeConstraints`]): the length of the edge in each incident
+///   tetrahedron's rest shape, averaged over those tetrahedra.
+///
+/// A family that needs a rest shape of its own (a material model's `Dₜ⁻¹`) reads it the
+/// same way, from [`Plasticity::rest_edge_matrix`].
+///
+/// # Flow rule
+///
+/// Once per frame (length `dt`, s) the solver reads each tetrahedron's deformation against its
+/// current rest shape, `F = Dₛ Dₜ⁻¹` (`Dₛ`: current edge matrix), and its stretch
+/// `U = √(FᵀF)` (rotation removed). The elastic strain is `ε = U − I` (dimensionless), or its
+/// deviatoric part `ε − tr(ε)/3 · I` with [`PlasticitySettings::volume_preserving`]. When
+/// `‖ε‖_F` exceeds the yield `y`, a fraction of the excess flows into the rest shape:
+///
+/// ```text
+/// γ = min(1, rate · dt) · (‖ε‖ − y) / ‖ε‖,   P ← (I + γ ε) P
+/// ```
+///
+/// so an infinite rate leaves exactly the yield strain, and a finite one creeps at `rate`
+/// (1/s). An inverted tetrahedron (`det F ≤ 0`) does not flow.
+///
+/// # Bounds (the rest state stays valid)
+///
+/// The accumulated flow is capped: `‖P − I‖_F ≤ m` ([`PlasticitySettings::max_plastic_strain`],
+/// `0 ≤ m < 1`), a flow past it is scaled back onto the bound. Since the spectral norm is at
+/// most the Frobenius norm, every singular value of `P` lies in `[1 − m, 1 + m]`: a rest shape
+/// is never inverted nor flattened, its volume stays within `[(1 − m)³, (1 + m)³]` of the built
+/// one, and its condition number grows by at most `(1 + m)/(1 − m)`. With
+/// [`PlasticitySettings::volume_preserving`], `P` is scaled to `det P = 1` after each flow
+/// (a uniform scale, so the singular-value bound on the shape's condition number holds), and
+/// every rest volume stays within [`VOLUME_PRESERVING_TOLERANCE`] of its built value.
+///
+/// The stretch is kept in `f64`, so the rounding of one flow never accumulates into the next.
 ///
 /// Made by [`crate::SoftBodyBuilder::plasticity`], or by [`Plasticity::new`] for a body
 /// already built. A `Plasticity` made for another body (another number of tetrahedra or

@@ -1,7 +1,9 @@
 //! The plastic flow system: once per frame, each tetrahedron of a body with a
 //! [`Plasticity`] strained past its yield moves its rest shape toward its current shape, and
 //! the body's families take their rest values from the new rest shapes (the model, the rule and
-//! its bounds are in [`crate::Plasticity`]'s module documentation).
+//! its bounds are documented on [`crate::Plasticity`]).
+
+use std::cmp::Ordering;
 
 use hecs::World;
 use nalgebra::Matrix3;
@@ -84,7 +86,7 @@ pub(crate) fn flow(
     let identity = Matrix3::<f64>::identity();
     let y = f64::from(s.yield_strain);
     let f = ds * (stretch * d0).try_inverse()?;
-    if !(f.determinant() > 0.0) {
+    if f.determinant().partial_cmp(&0.0) != Some(Ordering::Greater) {
         return None;
     }
     let c = f.transpose() * f;
@@ -102,11 +104,11 @@ pub(crate) fn flow(
         strain -= identity * (strain.trace() / 3.0);
     }
     let norm = strain.norm();
-    if !(norm > y) {
+    if norm.partial_cmp(&y) != Some(Ordering::Greater) {
         return None;
     }
     let gamma = (f64::from(s.flow_rate) * dt).min(1.0) * (norm - y) / norm;
-    if !(gamma > 0.0) {
+    if gamma.partial_cmp(&0.0) != Some(Ordering::Greater) {
         return None;
     }
     let mut next = (identity + strain * gamma) * stretch;
