@@ -109,9 +109,9 @@ fn mould(world: &mut World, e: Entity, held: &[Vector3<f32>], hold: bool) {
 /// Holds `bar` bent to a fibre strain of `peak_strain` at its faces in a mould for 1 s,
 /// releases it for 3 s with damping, and returns the bend angle left over the bend angle
 /// held, and the largest plastic strain of a tetrahedron.
-fn residual_bend(bar: Bar, peak_strain: f32) -> (f32, f32) {
+fn residual_bend(bar: Bar, peak_strain: f32, settings: PlasticitySettings) -> (f32, f32) {
     let mut world = World::new();
-    let e = spawn_bar(&mut world, bar, Some(PlasticitySettings::default()));
+    let e = spawn_bar(&mut world, bar, Some(settings));
     let angle = peak_strain * bar.length / (bar.length / 10.0);
     let mut solver = solver(bar.substeps, 2.0);
     let rest: Vec<Vector3<f32>> = world
@@ -163,12 +163,12 @@ fn bars(rng: &mut Rng, count: usize) -> Vec<Bar> {
 fn bend_sweep(seed: u64, count: usize) {
     let yield_strain = PlasticitySettings::default().yield_strain;
     for bar in bars(&mut Rng::new(seed), count) {
-        let (kept, _) = residual_bend(bar, 6.0 * yield_strain);
+        let (kept, _) = residual_bend(bar, 6.0 * yield_strain, PlasticitySettings::default());
         assert!(
             (0.3..1.02).contains(&kept),
             "{bar:?}: past the yield kept {kept} of the bend"
         );
-        let (back, flow) = residual_bend(bar, yield_strain / 3.0);
+        let (back, flow) = residual_bend(bar, yield_strain / 3.0, PlasticitySettings::default());
         assert_eq!(flow, 0.0, "{bar:?}: flowed below the yield");
         assert!(
             back < 0.05,
@@ -184,6 +184,31 @@ fn bend_sweep(seed: u64, count: usize) {
 #[test]
 fn bar_bent_past_yield_keeps_its_bend_and_below_yield_springs_back() {
     bend_sweep(7, 2);
+}
+
+/// Full (not volume-preserving) flow absorbs the whole bending strain past the yield: a bar
+/// held to six times the yield keeps about `1 − 1/6` of its bend, more than volume-preserving
+/// flow does.
+#[test]
+fn full_flow_keeps_more_of_a_bend() {
+    let full = PlasticitySettings {
+        volume_preserving: false,
+        ..Default::default()
+    };
+    for bar in bars(&mut Rng::new(13), 2) {
+        let peak = 6.0 * full.yield_strain;
+        let (kept, _) = residual_bend(bar, peak, full);
+        let (kept_vp, _) = residual_bend(bar, peak, PlasticitySettings::default());
+        println!("bend kept, full flow: {bar:?}: {kept:.3} (volume-preserving {kept_vp:.3})");
+        assert!(
+            (0.65..1.02).contains(&kept),
+            "{bar:?}: full flow kept {kept}"
+        );
+        assert!(
+            kept > kept_vp,
+            "{bar:?}: full {kept}, volume-preserving {kept_vp}"
+        );
+    }
 }
 
 #[test]
