@@ -212,20 +212,36 @@ impl Plasticity {
     }
 
     /// Plastic strain `‖P − I‖_F` of tetrahedron `t` (dimensionless; at most
-    /// [`PlasticitySettings::max_plastic_strain`]).
-    pub fn plastic_strain(&self, t: usize) -> f32 {
-        (self.stretch[t] - Matrix3::identity()).norm() as f32
+    /// [`PlasticitySettings::max_plastic_strain`], or slightly more after the unit-determinant
+    /// scaling of volume-preserving flow), or `None` if there is no tetrahedron `t`.
+    pub fn plastic_strain(&self, t: usize) -> Option<f32> {
+        let p = self.stretch.get(t)?;
+        Some((p - Matrix3::identity()).norm() as f32)
+    }
+
+    /// The largest plastic strain of any tetrahedron (0 for a body that never flowed).
+    pub fn max_plastic_strain(&self) -> f32 {
+        self.stretch
+            .iter()
+            .map(|p| (p - Matrix3::identity()).norm() as f32)
+            .fold(0.0, f32::max)
     }
 
     /// The current rest edge matrix `Dₜ = Pₜ D⁰ₜ` of tetrahedron `t` (columns `q₁ − q₀`,
-    /// `q₂ − q₀`, `q₃ − q₀` of its rest corners, m), from the body's rest positions.
+    /// `q₂ − q₀`, `q₃ − q₀` of its rest corners, m) of the body with these particles and
+    /// tetrahedra, or `None` if `t` is out of range or this state does not fit the body.
     pub fn rest_edge_matrix(
         &self,
         t: usize,
+        particles: &Particles,
         tetrahedra: &Tetrahedra,
-        rest_positions: &[Vector3<f32>],
-    ) -> Matrix3<f64> {
-        self.stretch[t] * built_edge_matrix(tetrahedra.indices[t], rest_positions)
+    ) -> Option<Matrix3<f64>> {
+        let (p, tet) = (self.stretch.get(t)?, tetrahedra.indices.get(t)?);
+        let rest = &particles.rest_positions;
+        if tet.iter().any(|&i| i as usize >= rest.len()) {
+            return None;
+        }
+        Some(p * built_edge_matrix(*tet, rest))
     }
 
     /// Puts every rest shape of the body back to the built one (`P = I`) and with it the

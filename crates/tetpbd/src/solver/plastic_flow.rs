@@ -191,7 +191,7 @@ mod tests {
         }
     }
 
-    /// Strain within the yield, an inverted shape and a zero rate never flow.
+    /// Strain within the yield, an inverted or non-finite shape and a zero rate never flow.
     #[test]
     fn nothing_flows_within_the_yield_or_inverted() {
         let d0 = Matrix3::identity();
@@ -206,6 +206,10 @@ mod tests {
         };
         let big = Matrix3::from_diagonal(&Vector3::new(2.0, 1.0, 1.0));
         assert!(flow(&Matrix3::identity(), &d0, &big, &stopped, 0.1).is_none());
+        for bad in [f64::NAN, f64::INFINITY] {
+            let ds = Matrix3::from_diagonal(&Vector3::new(bad, 1.0, 1.0));
+            assert!(flow(&Matrix3::identity(), &d0, &ds, &s, 0.1).is_none());
+        }
     }
 
     /// However far a tetrahedron is crushed, again and again, its plastic stretch stays
