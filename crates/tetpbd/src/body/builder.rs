@@ -291,38 +291,38 @@ impl SoftBodyBuilder {
             lambdas: vec![0.0; mesh.tets.len()],
             compliance: alpha,
         });
-        let tetrahedra = Tetrahedra {
-            indices: mesh.tets,
-            rest_volumes,
-            source,
-            classes: tet_classes,
-        };
-        let particles = Particles {
-            prev_positions: positions.clone(),
-            positions,
-            velocities,
-            inv_masses,
-            masses,
-            rest_positions: mesh.vertices,
-            residuals: vec![Vector3::zeros(); n],
-            vertex_to_particle: inverse(&particle_source),
-            source: particle_source,
-            work: WorkCopy(vec![Slot::default(); n]),
-            written: false,
-            hook: Default::default(),
-        };
-        let plasticity = plasticity
-            .map(|s| crate::Plasticity::new(s, &particles, &tetrahedra, edges.as_ref()))
-            .transpose()?;
-        Ok(SoftBody {
-            particles,
-            tetrahedra,
+        let mut body = SoftBody {
+            particles: Particles {
+                prev_positions: positions.clone(),
+                positions,
+                velocities,
+                inv_masses,
+                masses,
+                rest_positions: mesh.vertices,
+                residuals: vec![Vector3::zeros(); n],
+                vertex_to_particle: inverse(&particle_source),
+                source: particle_source,
+                work: WorkCopy(vec![Slot::default(); n]),
+                written: false,
+                hook: Default::default(),
+            },
+            tetrahedra: Tetrahedra {
+                indices: mesh.tets,
+                rest_volumes,
+                source,
+                classes: tet_classes,
+            },
             surface,
             edges,
             vertex_face,
             volume,
-            plasticity,
-        })
+            plasticity: None,
+        };
+        if let Some(settings) = plasticity {
+            let (p, t, e) = (&body.particles, &body.tetrahedra, body.edges.as_ref());
+            body.plasticity = Some(crate::Plasticity::new(settings, p, t, e)?);
+        }
+        Ok(body)
     }
 
     /// Checks the parameters that do not depend on the mesh's geometry.
