@@ -2,6 +2,8 @@
 //! test bodies and their deformed starts.
 #![allow(dead_code)]
 
+pub mod plastic;
+
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Particles, TetMesh};
