@@ -69,12 +69,15 @@ fn residual_bend(bar: Bar, peak_strain: f32, settings: PlasticitySettings) -> (f
     (kept, most)
 }
 
-fn bars(rng: &mut Rng, count: usize) -> Vec<Bar> {
+/// `count` bars of seeded lengths (0.5–3 m), cycling through `cells` along the length, then
+/// `substeps`, alternating the family sets.
+fn bars(seed: u64, count: usize, cells: &[u32], substeps: &[u32]) -> Vec<Bar> {
+    let mut rng = Rng::new(seed);
     (0..count)
         .map(|k| Bar {
             length: rng.range(0.5, 3.0) as f32,
-            cells: [8, 12, 16][k % 3],
-            substeps: [5, 10, 20][(k / 3) % 3],
+            cells: cells[k % cells.len()],
+            substeps: substeps[(k / cells.len()) % substeps.len()],
             families: if k % 2 == 0 {
                 Families::EdgesVolume
             } else {
@@ -85,10 +88,12 @@ fn bars(rng: &mut Rng, count: usize) -> Vec<Bar> {
 }
 
 /// Past the yield (a peak fibre strain of six times the default yield) a bar keeps a bend
-/// (about half of it: volume-preserving flow absorbs the deviatoric part of the strain); below it (a third of the yield) it springs back to straight.
-fn bend_sweep(seed: u64, count: usize) {
+/// (about half of it: volume-preserving flow absorbs the deviatoric part of the strain);
+/// below it (a third of the yield) nothing flows and it springs back to within `straight` of
+/// its bend (what is left is the elastic solve still converging: nothing flowed).
+fn bend_sweep(bars: Vec<Bar>, straight: f32) {
     let yield_strain = PlasticitySettings::default().yield_strain;
-    for bar in bars(&mut Rng::new(seed), count) {
+    for bar in bars {
         let (kept, _) = residual_bend(bar, 6.0 * yield_strain, PlasticitySettings::default());
         assert!(
             (0.3..1.02).contains(&kept),
@@ -97,7 +102,7 @@ fn bend_sweep(seed: u64, count: usize) {
         let (back, flow) = residual_bend(bar, yield_strain / 3.0, PlasticitySettings::default());
         assert_eq!(flow, 0.0, "{bar:?}: flowed below the yield");
         assert!(
-            back < 0.05,
+            back < straight,
             "{bar:?}: below the yield kept {back} of the bend"
         );
         println!(
@@ -108,8 +113,8 @@ fn bend_sweep(seed: u64, count: usize) {
 }
 
 #[test]
-fn bar_bent_past_yield_keeps_its_bend_and_below_yield_springs_back() {
-    bend_sweep(7, 2);
+fn bars_bent_past_yield_keep_a_bend_and_below_yield_spring_back() {
+    bend_sweep(bars(11, 18, &[8, 12, 16], &[5, 10, 20]), 0.05);
 }
 
 /// Full (not volume-preserving) flow absorbs the whole bending strain past the yield: a bar
@@ -121,7 +126,7 @@ fn full_flow_keeps_more_of_a_bend() {
         volume_preserving: false,
         ..Default::default()
     };
-    for bar in bars(&mut Rng::new(13), 2) {
+    for bar in bars(13, 2, &[8, 12, 16], &[5, 10, 20]) {
         let peak = 6.0 * full.yield_strain;
         let (kept, _) = residual_bend(bar, peak, full);
         let (kept_vp, _) = residual_bend(bar, peak, PlasticitySettings::default());
@@ -138,9 +143,10 @@ fn full_flow_keeps_more_of_a_bend() {
 }
 
 #[test]
-#[ignore = "slow: the full bar sweep (run in release)"]
-fn bars_of_every_size_resolution_and_substep_count_keep_bends_past_yield_only() {
-    bend_sweep(11, 18);
+#[ignore = "slow: fine bars at up to 40 substeps (run in release)"]
+fn fine_bars_at_many_substeps_keep_bends_past_yield_only() {
+    // A fine bar at 5 substeps converges slowly: 0.045 of its bend is left after 3 s.
+    bend_sweep(bars(17, 8, &[24, 32], &[5, 10, 20, 40]), 0.08);
 }
 
 /// Kinetic energy plus the compliant constraints' energy `Σ C²/(2α)` (J), against the
