@@ -106,7 +106,7 @@ fn main() -> Res<()> {
     };
     let top = *bodies.last().ok_or("no body")?;
     let frames = (seconds / DT).round() as usize;
-    let from = frames.saturating_sub((10.0 / DT) as usize);
+    let from = frames.saturating_sub((10.0 / DT) as usize).max(1);
     let (mut last_second, mut drift) = (0.0f32, 0.0f32);
     let mut reference: Option<Vec<Vector3<f32>>> = None;
     for f in 1..=frames {
