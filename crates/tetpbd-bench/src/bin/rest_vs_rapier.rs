@@ -12,7 +12,8 @@
 //! Each engine runs each scene twice. **Awake** (sleeping off in both engines: the rest is
 //! the solver's): the time after which the largest particle speed (displacement over a frame
 //! / dt) stays below 1e-3 m/s to the end of the run ("—": not at rest by then), that speed
-//! over the last second, how far any particle of the top body moves over the last 10 s
+//! over the last second and its largest value after the time the scene should be at rest by
+//! (a late topple shows there), how far any particle of the top body moves over the last 10 s
 //! (from 3 s on for the stack, 6 s on for the pile), and the deepest interpenetration of two
 //! bodies over the whole run (a surface particle inside another body's tetrahedra, m).
 //! **Sleeping** (each engine's defaults: tetpbd's `Activation`, rapier's `can_sleep`): the
@@ -224,6 +225,7 @@ impl Sim for Theirs {
 struct Rest {
     at: Option<f32>,
     last_second: f32,
+    after_rest_by: f32,
     top_drift: f32,
     interpenetration: f32,
 }
@@ -248,6 +250,7 @@ fn awake_run(sim: &mut dyn Sim, l: &Layout, measure: &ContactScene) -> Res<Rest>
     let from = (l.rest_by / DT).round() as usize;
     let mut prev = sim.positions();
     let (mut moving_until, mut last_second, mut inter) = (0usize, 0.0f32, 0.0f32);
+    let mut after_rest_by = 0.0f32;
     let mut reference: Option<(usize, Vec<Vector3<f32>>)> = None;
     let mut drift = 0.0f32;
     for f in 1..=frames {
@@ -264,6 +267,9 @@ fn awake_run(sim: &mut dyn Sim, l: &Layout, measure: &ContactScene) -> Res<Rest>
         }
         if f + 60 > frames {
             last_second = last_second.max(speed);
+        }
+        if f > from {
+            after_rest_by = after_rest_by.max(speed);
         }
         // Every other frame while things land, then every 10th.
         if f % if f < from { 2 } else { 10 } == 0 || f == frames {
@@ -282,6 +288,7 @@ fn awake_run(sim: &mut dyn Sim, l: &Layout, measure: &ContactScene) -> Res<Rest>
     Ok(Rest {
         at: (moving_until < frames).then_some(moving_until as f32 * DT),
         last_second,
+        after_rest_by,
         top_drift: drift,
         interpenetration: inter,
     })
@@ -357,10 +364,11 @@ fn compare(cube: &TetMesh, l: &Layout, substeps: u32) -> Res<()> {
         l.name, l.seconds, l.rest_by
     );
     println!(
-        "{:8} {:>10} {:>12} {:>12} {:>12} {:>10} {:>12} {:>12} {:>8}",
+        "{:8} {:>10} {:>12} {:>12} {:>12} {:>12} {:>10} {:>12} {:>12} {:>8}",
         "engine",
         "rest at",
         "|v| last 1s",
+        "|v| after",
         "top moves",
         "interpen.",
         "asleep at",
@@ -379,9 +387,10 @@ fn compare(cube: &TetMesh, l: &Layout, substeps: u32) -> Res<()> {
         let rest = awake_run(build(false)?.as_mut(), l, &measure)?;
         let sleep = sleep_run(build(true)?.as_mut(), l)?;
         println!(
-            "{engine:8} {:>10} {:>12.2e} {:>10.2} mm {:>9.2} mm {:>10} {:>12.3} {:>12.3} {:>8.1}",
+            "{engine:8} {:>10} {:>12.2e} {:>12.2e} {:>10.2} mm {:>9.2} mm {:>10} {:>12.3} {:>12.3} {:>8.1}",
             secs(rest.at),
             rest.last_second,
+            rest.after_rest_by,
             rest.top_drift * 1e3,
             rest.interpenetration * 1e3,
             secs(sleep.at),
