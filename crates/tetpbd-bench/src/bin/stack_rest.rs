@@ -17,8 +17,10 @@
 //! * `--touching`: the cubes start at the contact thickness instead of 2 cm apart.
 //!
 //! Prints every `--every-frames` frames the largest particle speed per body (bottom first) and
-//! the top body's centre, then the largest speed over the last second and how far any
-//! particle of the top body moved over the last 10 s.
+//! the top body's centre, then the largest speed over the last second, how far any particle of
+//! the top body moved over the last 10 s, and per interface of two cubes the largest change of
+//! their horizontal offset over those 10 s (the upper cube's bottom-face centre against the
+//! lower cube's top-face centre: slip and rocking at the contact).
 
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
@@ -109,12 +111,21 @@ fn main() -> Res<()> {
     let from = frames.saturating_sub((10.0 / DT) as usize).max(1);
     let (mut last_second, mut drift) = (0.0f32, 0.0f32);
     let mut reference: Option<Vec<Vector3<f32>>> = None;
+    let mut offsets0: Vec<Vector3<f32>> = Vec::new();
+    let mut slip = vec![0.0f32; bodies.len().saturating_sub(1)];
     for f in 1..=frames {
         w.step()?;
         let speeds: Vec<f32> = bodies.iter().map(|&e| speed(&w, e)).collect::<Res<_>>()?;
         let max = speeds.iter().copied().fold(0.0f32, f32::max);
         if f + 60 > frames {
             last_second = last_second.max(max);
+        }
+        let offsets = interface_offsets(&w, &bodies)?;
+        if f == from {
+            offsets0 = offsets.clone();
+        }
+        for ((s, o), o0) in slip.iter_mut().zip(&offsets).zip(&offsets0) {
+            *s = s.max((o - o0).norm());
         }
         let p = w.soft.get::<&Particles>(top)?;
         if f == from {
@@ -142,5 +153,31 @@ fn main() -> Res<()> {
         drift * 1e3,
         (frames - from) as f32 * DT
     );
+    let slip: Vec<String> = slip.iter().map(|s| format!("{:.2}", s * 1e3)).collect();
+    println!(
+        "interfaces, bottom first: horizontal offset changed by [{}] mm",
+        slip.join(" ")
+    );
     Ok(())
+}
+
+/// Per pair of consecutive bodies: the horizontal offset of the upper body's lowest particles'
+/// centre from the lower body's highest particles' centre, m.
+fn interface_offsets(w: &CoupledWorld, bodies: &[hecs::Entity]) -> Res<Vec<Vector3<f32>>> {
+    let face = |e: hecs::Entity, top: bool| -> Res<Vector3<f32>> {
+        let p = w.soft.get::<&Particles>(e)?;
+        let y = |x: &Vector3<f32>| if top { x.y } else { -x.y };
+        let far = p
+            .positions()
+            .iter()
+            .map(y)
+            .fold(f32::NEG_INFINITY, f32::max);
+        let face: Vec<&Vector3<f32>> = p.positions().iter().filter(|x| y(x) > far - 0.02).collect();
+        let c = face.iter().copied().sum::<Vector3<f32>>() / face.len().max(1) as f32;
+        Ok(Vector3::new(c.x, 0.0, c.z))
+    };
+    bodies
+        .windows(2)
+        .map(|pair| Ok(face(pair[1], false)? - face(pair[0], true)?))
+        .collect()
 }
