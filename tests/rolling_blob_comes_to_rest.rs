@@ -10,7 +10,7 @@
 mod asset_drop_common;
 
 use asset_drop_common::{asset_drop, AssetDrop};
-use tetpbd::{Particles, Tetrahedra};
+use tetpbd::{Activation, Particles, Tetrahedra};
 use tetpbd_rapier::SoftColliderBuilder;
 
 /// Cell size of the tetrahedralization, m (coarser than the example's 0.07 m for speed).
@@ -46,6 +46,8 @@ fn drop_blob(rolling: Option<f32>, frames: usize) -> Rest {
         0.4,
         collider.build().expect("collider"),
     );
+    // Watched awake: the rest measured is the solver's, not sleeping's.
+    *scene.soft.get::<&mut Activation>(e).expect("body") = Activation::never_sleeps();
     let mut rest = Rest {
         speed: 0.0,
         penetration: 0.0,

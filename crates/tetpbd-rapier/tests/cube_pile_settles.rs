@@ -20,7 +20,7 @@ use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 use soft_soft_common::penetration;
 use tetpbd::generators::{box_grid, CellSplit};
-use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
+use tetpbd::{Activation, Particles, SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, DeformationDamping};
 
 const DT: f32 = 1.0 / 60.0;
@@ -50,6 +50,8 @@ fn scene(substeps: u32, damping: f32, at: &[Vector3<f32>]) -> (CoupledWorld, Vec
                 .build()
                 .expect("body")
                 .spawn(&mut w.soft);
+            // Watched awake: the rest measured is the solver's, not sleeping's.
+            *w.soft.get::<&mut Activation>(e).expect("body") = Activation::never_sleeps();
             if damping > 0.0 {
                 let d = DeformationDamping::new(damping).expect("rate");
                 w.soft.insert_one(e, d).expect("entity");

@@ -71,6 +71,11 @@ fn static_friction_holds_a_soft_cube_on_a_20_degree_incline() {
             awake_moved * 1e3
         );
         assert!(moved.abs() < 1e-3, "{size} m: crept {moved} m");
+        // Awake, the hold is friction's alone (sleeping would freeze a slow creep).
+        assert!(
+            awake_moved.abs() < 1e-3,
+            "{size} m: crept {awake_moved} m never sleeping"
+        );
         assert!(asleep, "{size} m: held by friction, the cube falls asleep");
     }
 }

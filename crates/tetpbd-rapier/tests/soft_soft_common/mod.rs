@@ -9,7 +9,9 @@ use rapier3d::math::Vector;
 use rapier3d::parry::query::PointQuery;
 use rapier3d::parry::shape::Triangle;
 use tetpbd::generators::{self, CellSplit};
-use tetpbd::{Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats, Surface, Tetrahedra};
+use tetpbd::{
+    Activation, Particles, SoftBodyBuilder, Solver, SolverSettings, StepStats, Surface, Tetrahedra,
+};
 use tetpbd_rapier::{SoftContactSettings, SoftContactStats, SoftContacts};
 
 /// A scene: soft bodies, the core solver at 60 Hz and the soft contacts.
@@ -92,14 +94,15 @@ pub fn soft_box(
     edge: f32,
 ) -> Entity {
     let mesh = generators::box_grid(size, cells, CellSplit::Six).expect("mesh");
-    SoftBodyBuilder::new(mesh)
+    let e = SoftBodyBuilder::new(mesh)
         .density(1000.0)
         .edges(edge)
         .volume(0.0)
         .translation(at)
         .build()
         .expect("body")
-        .spawn(world)
+        .spawn(world);
+    awake(world, e)
 }
 
 /// A soft slab of `size` (m) whose top face is at `top` (m), with every particle of its
@@ -114,7 +117,7 @@ pub fn pinned_slab(world: &mut World, size: Vector3<f32>, cells: [u32; 3], top: 
             v.y < -h.y + tol || v.x.abs() > h.x - tol || v.z.abs() > h.z - tol
         })
         .collect();
-    SoftBodyBuilder::new(mesh)
+    let e = SoftBodyBuilder::new(mesh)
         .density(1000.0)
         .edges(0.0)
         .volume(0.0)
@@ -122,7 +125,8 @@ pub fn pinned_slab(world: &mut World, size: Vector3<f32>, cells: [u32; 3], top: 
         .translation(Vector3::new(0.0, top - h.y, 0.0))
         .build()
         .expect("slab")
-        .spawn(world)
+        .spawn(world);
+    awake(world, e)
 }
 
 /// A soft ball of `radius` (m) centred at `at` with velocity `v` (m/s).
@@ -134,7 +138,7 @@ pub fn soft_ball(
     v: Vector3<f32>,
 ) -> Entity {
     let mesh = generators::ball(radius, cells, CellSplit::Six).expect("mesh");
-    SoftBodyBuilder::new(mesh)
+    let e = SoftBodyBuilder::new(mesh)
         .density(1000.0)
         .edges(0.0)
         .volume(0.0)
@@ -142,7 +146,15 @@ pub fn soft_ball(
         .velocity(v)
         .build()
         .expect("ball")
-        .spawn(world)
+        .spawn(world);
+    awake(world, e)
+}
+
+/// Makes `e` never sleep and returns it: these scenes watch the contacts and the rest they
+/// bring, which sleeping would freeze.
+pub fn awake(world: &mut World, e: Entity) -> Entity {
+    *world.get::<&mut Activation>(e).expect("soft body") = Activation::never_sleeps();
+    e
 }
 
 /// Independent measure (brute force, parry's triangle distance): the surface particles of

@@ -1,0 +1,183 @@
+//! Does a stack of soft cubes on rigid ground come to rest, awake? The probe behind
+//! `docs/decisions/resting-contacts.md`: default settings, sleeping off, and switches that
+//! take one ingredient away at a time.
+//!
+//! ```text
+//! cargo run --release -p tetpbd-bench --bin stack_rest -- [--cubes 5] [--size-mm 500]
+//!     [--substeps 10] [--iterations 1] [--seconds 13] [--column] [--damping RATE]
+//!     [--soft-friction-off] [--skin-speed-mm-s 100] [--touching] [--every-frames 30]
+//! ```
+//!
+//! * `--column`: one body as tall as the stack (4 × 4·cubes × 4 cells) instead of cubes;
+//! * `--damping RATE`: `DeformationDamping` (1/s) on every body;
+//! * `--soft-friction-off`: friction 0 between the soft bodies (each body's `SoftCollider`
+//!   friction 0, the ground's 1, so the ground contact keeps the default 0.5 by the average
+//!   combine rule);
+//! * `--skin-speed-mm-s`: `SoftContactSettings::skin_speed` in mm/s (default 100);
+//! * `--touching`: the cubes start at the contact thickness instead of 2 cm apart.
+//!
+//! Prints every `--every-frames` frames the largest particle speed per body (bottom first) and
+//! the top body's centre, then the largest speed over the last second, how far any particle of
+//! the top body moved over the last 10 s, and per interface of two cubes the largest change of
+//! their horizontal offset over those 10 s (the upper cube's bottom-face centre against the
+//! lower cube's top-face centre: slip and rocking at the contact).
+
+use nalgebra::Vector3;
+use rapier3d::math::Vector;
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
+use tetpbd::generators::{box_grid, CellSplit};
+use tetpbd::{hecs, Activation, DeformationDamping, Particles, SoftBodyBuilder, SolverSettings};
+use tetpbd_bench::{arg, arg_str, flag, DT};
+use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftColliderBuilder};
+
+type Res<T> = Result<T, Box<dyn std::error::Error>>;
+
+fn main() -> Res<()> {
+    let n = arg("--cubes", 5).max(1);
+    let size = arg("--size-mm", 500) as f32 * 1e-3;
+    let substeps = arg("--substeps", 10) as u32;
+    let iterations = arg("--iterations", 1) as u32;
+    let seconds = arg("--seconds", 13) as f32;
+    let every = arg("--every-frames", 30).max(1);
+    let damping: Option<f32> = arg_str("--damping").and_then(|v| v.parse().ok());
+    let soft_friction_off = flag("--soft-friction-off");
+    let solver = SolverSettings {
+        dt: DT,
+        substeps,
+        iterations,
+        ..SolverSettings::default()
+    };
+    let mut coupling = CouplingSettings::default();
+    let mut ground = ColliderBuilder::cuboid(20.0, 0.5, 20.0);
+    if soft_friction_off {
+        coupling.default_collider = SoftColliderBuilder::new()
+            .friction(0.0)
+            .static_friction(0.0)
+            .build()?;
+        ground = ground.friction(1.0);
+    }
+    if let (Some(v), Some(s)) = (
+        arg_str("--skin-speed-mm-s"),
+        coupling.soft_contacts.as_mut(),
+    ) {
+        s.skin_speed = v.parse::<f32>()? * 1e-3;
+    }
+    let thickness = coupling.default_collider.thickness();
+    let mut w = CoupledWorld::new(solver, coupling)?;
+    w.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
+        ground,
+    );
+    let (gap, lift) = if flag("--touching") {
+        (2.0 * thickness, thickness)
+    } else {
+        (0.02, 0.01)
+    };
+    let shapes: Vec<(Vector3<f32>, [u32; 3], f32)> = if flag("--column") {
+        let h = size * n as f32;
+        vec![(
+            Vector3::new(size, h, size),
+            [4, 4 * n as u32, 4],
+            lift + 0.5 * h,
+        )]
+    } else {
+        (0..n)
+            .map(|i| {
+                let y = lift + 0.5 * size + i as f32 * (size + gap);
+                (Vector3::repeat(size), [4, 4, 4], y)
+            })
+            .collect()
+    };
+    let mut bodies = Vec::new();
+    for (extent, cells, y) in shapes {
+        let e = SoftBodyBuilder::new(box_grid(extent, cells, CellSplit::Six)?)
+            .density(1000.0)
+            .edges(0.0)
+            .volume(0.0)
+            .translation(Vector3::new(0.0, y, 0.0))
+            .build()?
+            .spawn(&mut w.soft);
+        w.soft.insert_one(e, Activation::never_sleeps())?;
+        if let Some(rate) = damping {
+            w.soft.insert_one(e, DeformationDamping::new(rate)?)?;
+        }
+        bodies.push(e);
+    }
+    let speed = |w: &CoupledWorld, e: hecs::Entity| -> Res<f32> {
+        Ok(w.soft.get::<&Particles>(e)?.max_speed())
+    };
+    let top = *bodies.last().ok_or("no body")?;
+    let frames = (seconds / DT).round() as usize;
+    let from = frames.saturating_sub((10.0 / DT) as usize).max(1);
+    let (mut last_second, mut drift) = (0.0f32, 0.0f32);
+    let mut reference: Option<Vec<Vector3<f32>>> = None;
+    let mut offsets0: Vec<Vector3<f32>> = Vec::new();
+    let mut slip = vec![0.0f32; bodies.len().saturating_sub(1)];
+    for f in 1..=frames {
+        w.step()?;
+        let speeds: Vec<f32> = bodies.iter().map(|&e| speed(&w, e)).collect::<Res<_>>()?;
+        let max = speeds.iter().copied().fold(0.0f32, f32::max);
+        if f + 60 > frames {
+            last_second = last_second.max(max);
+        }
+        let offsets = interface_offsets(&w, &bodies)?;
+        if f == from {
+            offsets0 = offsets.clone();
+        }
+        for ((s, o), o0) in slip.iter_mut().zip(&offsets).zip(&offsets0) {
+            *s = s.max((o - o0).norm());
+        }
+        let p = w.soft.get::<&Particles>(top)?;
+        if f == from {
+            reference = Some(p.positions().to_vec());
+        }
+        if let Some(x0) = &reference {
+            let d = p.positions().iter().zip(x0).map(|(a, b)| (a - b).norm());
+            drift = d.fold(drift, f32::max);
+        }
+        if f % every == 0 {
+            let c = p.center_of_mass();
+            let per: Vec<String> = speeds.iter().map(|v| format!("{v:.4}")).collect();
+            println!(
+                "t {:5.2} s  max|v| {max:.5} m/s  per body [{}]  top centre ({:.4}, {:.4}, {:.4}) m",
+                f as f32 * DT,
+                per.join(" "),
+                c.x,
+                c.y,
+                c.z
+            );
+        }
+    }
+    println!(
+        "largest speed over the last second {last_second:.2e} m/s; top body moved {:.2} mm over the last {:.0} s",
+        drift * 1e3,
+        (frames - from) as f32 * DT
+    );
+    let slip: Vec<String> = slip.iter().map(|s| format!("{:.2}", s * 1e3)).collect();
+    println!(
+        "interfaces, bottom first: horizontal offset changed by [{}] mm",
+        slip.join(" ")
+    );
+    Ok(())
+}
+
+/// Per pair of consecutive bodies: the horizontal offset of the upper body's lowest particles'
+/// centre from the lower body's highest particles' centre, m.
+fn interface_offsets(w: &CoupledWorld, bodies: &[hecs::Entity]) -> Res<Vec<Vector3<f32>>> {
+    let face = |e: hecs::Entity, top: bool| -> Res<Vector3<f32>> {
+        let p = w.soft.get::<&Particles>(e)?;
+        let y = |x: &Vector3<f32>| if top { x.y } else { -x.y };
+        let far = p
+            .positions()
+            .iter()
+            .map(y)
+            .fold(f32::NEG_INFINITY, f32::max);
+        let face: Vec<&Vector3<f32>> = p.positions().iter().filter(|x| y(x) > far - 0.02).collect();
+        let c = face.iter().copied().sum::<Vector3<f32>>() / face.len().max(1) as f32;
+        Ok(Vector3::new(c.x, 0.0, c.z))
+    };
+    bodies
+        .windows(2)
+        .map(|pair| Ok(face(pair[1], false)? - face(pair[0], true)?))
+        .collect()
+}
