@@ -39,6 +39,8 @@ pub struct SoftBody {
     pub vertex_face: Option<VertexFaceConstraints>,
     /// Volume family, if chosen.
     pub volume: Option<VolumeConstraints>,
+    /// Neo-Hookean material, if chosen ([`SoftBodyBuilder::material`]).
+    pub material: Option<crate::NeoHookeanMaterial>,
 }
 
 impl SoftBody {
@@ -55,6 +57,9 @@ impl SoftBody {
         }
         if let Some(v) = self.volume {
             b.add(v);
+        }
+        if let Some(m) = self.material {
+            b.add(m);
         }
         world.spawn(b.build())
     }
@@ -76,6 +81,7 @@ pub struct SoftBodyBuilder {
     edge: Option<f32>,
     vertex_face: Option<f32>,
     volume: Option<f32>,
+    material: Option<crate::Material>,
     pinned: Vec<u32>,
     placement: Placement,
     epsilon: f32,
@@ -100,6 +106,7 @@ impl SoftBodyBuilder {
             edge: None,
             vertex_face: None,
             volume: None,
+            material: None,
             pinned: Vec::new(),
             placement: Placement::default(),
             epsilon: Self::DEFAULT_EPSILON,
@@ -134,6 +141,14 @@ impl SoftBodyBuilder {
     /// Adds the volume family with compliance `alpha` (m⁵/N).
     pub fn volume(mut self, alpha: f32) -> Self {
         self.volume = Some(alpha);
+        self
+    }
+
+    /// Gives the body a continuum material ([`crate::NeoHookeanMaterial`]): stable
+    /// Neo-Hookean with Young's modulus and Poisson's ratio in physical units, stiffness
+    /// independent of the mesh resolution. Alone or with any of the families.
+    pub fn material(mut self, material: crate::Material) -> Self {
+        self.material = Some(material);
         self
     }
 
@@ -224,6 +239,7 @@ impl SoftBodyBuilder {
             edge,
             vertex_face,
             volume,
+            material,
             pinned,
             placement,
             epsilon,
@@ -275,6 +291,14 @@ impl SoftBodyBuilder {
             lambdas: vec![0.0; mesh.tets.len()],
             compliance: alpha,
         });
+        let tetrahedra = Tetrahedra {
+            indices: mesh.tets,
+            rest_volumes,
+            source,
+            classes: tet_classes,
+        };
+        let material =
+            material.map(|m| crate::NeoHookeanMaterial::new(m, &tetrahedra, &mesh.vertices));
         Ok(SoftBody {
             particles: Particles {
                 prev_positions: positions.clone(),
@@ -290,16 +314,12 @@ impl SoftBodyBuilder {
                 written: false,
                 hook: Default::default(),
             },
-            tetrahedra: Tetrahedra {
-                indices: mesh.tets,
-                rest_volumes,
-                source,
-                classes: tet_classes,
-            },
+            tetrahedra,
             surface,
             edges,
             vertex_face,
             volume,
+            material,
         })
     }
 

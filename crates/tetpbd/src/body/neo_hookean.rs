@@ -1,0 +1,104 @@
+//! [`NeoHookeanMaterial`]: the stable Neo-Hookean material of a body's tetrahedra, an optional
+//! hecs component like the constraint families (a body without it pays nothing).
+
+use nalgebra::Matrix3;
+
+use crate::body::material::{Material, MaterialError};
+use crate::body::mesh::Tetrahedra;
+use crate::constraints::rest_shape_inverse;
+
+/// The stable Neo-Hookean material of every tetrahedron of a body (two constraints each,
+/// solved together; theory in [`crate::constraints::neo_hookean_deviatoric`] and
+/// [`crate::constraints::neo_hookean_delta_lambdas`]), with the rest shape of each
+/// tetrahedron. Compliances follow from the [`Material`] and each rest volume:
+/// `α_D = 1/(μ V₀)`, `α_H = 1/(λ' V₀)` (1/J), `λ' = λ + μ`.
+///
+/// Combines with the seed's families: a body may have this component alone or with
+/// [`crate::EdgeConstraints`], [`crate::VertexFaceConstraints`] and
+/// [`crate::VolumeConstraints`]; the solver projects the material first in each iteration.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct NeoHookeanMaterial {
+    pub(crate) material: Material,
+    /// `Dm⁻¹` of each tetrahedron (solver order, as [`Tetrahedra`]), 1/m.
+    pub(crate) rest_inverse: Vec<Matrix3<f32>>,
+    /// `[λ_D, λ_H]` of each tetrahedron, J⁻¹·s²… in the units of `C/α̃` (J·s², reset every substep).
+    pub(crate) lambdas: Vec<[f32; 2]>,
+    /// Elastic energy released by the material's projections in the current substep, J (the
+    /// energy limit's budget; reset every substep).
+    pub(crate) released: f64,
+}
+
+impl NeoHookeanMaterial {
+    /// The material of `tets` at the rest positions `rest` (m, indexed like the tetrahedra).
+    /// Tetrahedra were checked non-degenerate by the builder; a singular rest shape gets a zero
+    /// `Dm⁻¹` (no force).
+    pub(crate) fn new(
+        material: Material,
+        tets: &Tetrahedra,
+        rest: &[nalgebra::Vector3<f32>],
+    ) -> Self {
+        let rest_inverse = tets
+            .indices
+            .iter()
+            .map(|t| {
+                let [a, b, c, d] = t.map(|i| rest[i as usize].cast::<f64>());
+                rest_shape_inverse(&a, &b, &c, &d).map_or(Matrix3::zeros(), |m| m.cast::<f32>())
+            })
+            .collect();
+        NeoHookeanMaterial {
+            material,
+            rest_inverse,
+            lambdas: vec![[0.0; 2]; tets.indices.len()],
+            released: 0.0,
+        }
+    }
+
+    /// The material's parameters.
+    pub fn material(&self) -> Material {
+        self.material
+    }
+
+    /// Changes the material (E, ν, damping) of the body; the rest shape stays.
+    pub fn set_material(&mut self, material: Material) {
+        self.material = material;
+    }
+
+    /// Changes the damping time, s (finite, ≥ 0).
+    pub fn set_damping(&mut self, beta: f32) -> Result<(), MaterialError> {
+        self.material = self.material.with_damping(beta)?;
+        Ok(())
+    }
+
+    /// Number of tetrahedra (two constraints each).
+    pub fn len(&self) -> usize {
+        self.lambdas.len()
+    }
+
+    /// `true` when there is no tetrahedron.
+    pub fn is_empty(&self) -> bool {
+        self.lambdas.is_empty()
+    }
+
+    /// The inverse rest edge matrix `Dm⁻¹` of each tetrahedron, 1/m.
+    pub fn rest_inverse(&self) -> &[Matrix3<f32>] {
+        &self.rest_inverse
+    }
+
+    /// The material's elastic energy `Σ V₀ Ψ(F)` at `positions` (J; zero at rest), with the
+    /// body's tetrahedra.
+    pub fn elastic_energy(&self, tets: &Tetrahedra, positions: &[nalgebra::Vector3<f32>]) -> f64 {
+        let (mu, lambda) = self.material.lame();
+        let (mu, lp) = (f64::from(mu), f64::from(lambda) + f64::from(mu));
+        tets.indices
+            .iter()
+            .zip(&self.rest_inverse)
+            .zip(&tets.rest_volumes)
+            .map(|((t, dm), v0)| {
+                let p = t.map(|i| positions[i as usize].cast::<f64>());
+                let f = crate::constraints::deformation_gradient(&p, &dm.cast::<f64>());
+                f64::from(v0.abs()) * crate::constraints::neo_hookean_energy_density(&f, mu, lp)
+            })
+            .sum()
+    }
+}

@@ -1,0 +1,163 @@
+//! The scalar kernel of the Neo-Hookean material: one coupled projection of a tetrahedron's
+//! two constraints on the working copy, and a sweep of one body in colour-class order.
+//!
+//! Per tetrahedron (theory in `constraints/neo_hookean.rs`): `F = Ds Dm⁻¹`, the two
+//! constraints and their gradients, the 2×2 coupled XPBD update with damping
+//! ([`constraints::neo_hookean_delta_lambdas`]), the move bounded to `√3/‖Dm⁻¹‖_F` (about one
+//! rest edge) so that a tetrahedron far from rest (inverted, crushed) recovers over a few
+//! projections instead of overshooting, and the elastic energy the projection released for
+//! the energy limit.
+
+use nalgebra::{Matrix3, Vector3};
+use wide::f32x4;
+
+use crate::constraints::{self, Evaluated};
+use crate::kernels::count::ProjectionCount;
+use crate::kernels::slots::Slot;
+
+/// The per-body constants of a sweep.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MaterialStep {
+    /// `[1/(μ h²), 1/(λ' h²)]`: `α̃` per unit rest volume, 1/(J·s²)·m³… divide by `V₀`.
+    pub alpha_tilde_volume: [f32; 2],
+    /// `γ = 1 + μ/λ'`.
+    pub rest_offset: f32,
+    /// `β/h`, the XPBD damping factor.
+    pub damping: f32,
+    /// `h²`, s².
+    pub h2: f32,
+}
+
+impl MaterialStep {
+    /// The constants for `material` in a substep of length `h` (s).
+    pub fn new(material: &crate::Material, h: f32) -> Self {
+        let (mu, lambda) = material.lame();
+        let lp = lambda + mu;
+        let h2 = h * h;
+        MaterialStep {
+            alpha_tilde_volume: [1.0 / (mu * h2), 1.0 / (lp * h2)],
+            rest_offset: constraints::neo_hookean_rest_offset(mu, lp),
+            damping: material.damping() / h,
+            h2,
+        }
+    }
+}
+
+/// What one projection did: applied (with the energy it released, J) or degenerate.
+pub(crate) enum TetOutcome {
+    Applied(f32),
+    Degenerate,
+    Skipped,
+}
+
+#[inline(always)]
+fn xw(s: &Slot) -> (Vector3<f32>, f32) {
+    let [x, y, z, w] = s.xw.to_array();
+    (Vector3::new(x, y, z), w)
+}
+
+/// One coupled projection of the material of tetrahedron `tet`.
+#[inline]
+pub(crate) fn project_tet(
+    slots: &mut [Slot],
+    prev: &[Vector3<f32>],
+    tet: [u32; 4],
+    dm_inv: &Matrix3<f32>,
+    rest_volume: f32,
+    lambdas: &mut [f32; 2],
+    k: &MaterialStep,
+) -> TetOutcome {
+    let idx = tet.map(|i| i as usize);
+    let xw = idx.map(|i| xw(&slots[i]));
+    let w = xw.map(|(_, w)| w);
+    if w.iter().all(|&w| w == 0.0) {
+        return TetOutcome::Skipped;
+    }
+    let p = xw.map(|(x, _)| x);
+    let Some(d) = constraints::neo_hookean_deviatoric(&p, dm_inv) else {
+        return TetOutcome::Degenerate;
+    };
+    let y = constraints::neo_hookean_hydrostatic(&p, dm_inv, k.rest_offset);
+    let dot = |a: &Evaluated<f32, 4>, b: &Evaluated<f32, 4>| {
+        (0..4).fold(0.0f32, |s, i| s + w[i] * a.grad[i].dot(&b.grad[i]))
+    };
+    let g = [[dot(&d, &d), dot(&d, &y)], [dot(&d, &y), dot(&y, &y)]];
+    let v0 = rest_volume.abs();
+    let at = k.alpha_tilde_volume.map(|a| a / v0);
+    let rate = if k.damping > 0.0 {
+        let moved: [Vector3<f32>; 4] = std::array::from_fn(|i| p[i] - prev[idx[i]]);
+        let r = |e: &Evaluated<f32, 4>| (0..4).fold(0.0f32, |s, i| s + e.grad[i].dot(&moved[i]));
+        [r(&d), r(&y)]
+    } else {
+        [0.0; 2]
+    };
+    let Some(mut dl) =
+        constraints::neo_hookean_delta_lambdas([d.c, y.c], *lambdas, at, g, k.damping, rate)
+    else {
+        return TetOutcome::Degenerate;
+    };
+    let mut dx = [Vector3::zeros(); 4];
+    let mut longest = 0.0f32;
+    for i in 0..4 {
+        dx[i] = (d.grad[i] * dl[0] + y.grad[i] * dl[1]) * w[i];
+        longest = longest.max(dx[i].norm_squared());
+    }
+    // The bound: about one rest edge (√3/‖Dm⁻¹‖_F is the edge of a right-angled corner).
+    let bound = 3.0 / dm_inv.norm_squared();
+    if longest > bound {
+        let s = (bound / longest).sqrt();
+        dl = dl.map(|x| x * s);
+        dx = dx.map(|v| v * s);
+    }
+    for i in 0..4 {
+        slots[idx[i]].add(f32x4::new([dx[i].x, dx[i].y, dx[i].z, 0.0]));
+    }
+    lambdas[0] += dl[0];
+    lambdas[1] += dl[1];
+    // Released energy to first order in the constraints: C' = C + G Δλ,
+    // ΔU = Σ (C² − C'²) / (2 α), α = α̃ h².
+    let c_after = [
+        d.c + g[0][0] * dl[0] + g[0][1] * dl[1],
+        y.c + g[1][0] * dl[0] + g[1][1] * dl[1],
+    ];
+    let released = (d.c * d.c - c_after[0] * c_after[0]) / (2.0 * at[0] * k.h2)
+        + (y.c * y.c - c_after[1] * c_after[1]) / (2.0 * at[1] * k.h2);
+    TetOutcome::Applied(released)
+}
+
+/// One Gauss–Seidel sweep of a body's material on its working copy (`slots`), tetrahedra in
+/// solver order; `prev` are the substep's start positions (for the damping). Returns the
+/// counts and the released energy (J, the sum of the tetrahedra's positive releases).
+// The slices of one body's tetrahedra and material, and the constants: what a sweep takes.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn sweep(
+    slots: &mut [Slot],
+    prev: &[Vector3<f32>],
+    tets: &[[u32; 4]],
+    rest_volumes: &[f32],
+    rest_inverse: &[Matrix3<f32>],
+    lambdas: &mut [[f32; 2]],
+    k: &MaterialStep,
+) -> (ProjectionCount, f64) {
+    let mut count = ProjectionCount::default();
+    let mut released = 0.0f64;
+    for t in 0..tets.len() {
+        match project_tet(
+            slots,
+            prev,
+            tets[t],
+            &rest_inverse[t],
+            rest_volumes[t],
+            &mut lambdas[t],
+            k,
+        ) {
+            TetOutcome::Applied(e) => {
+                count.applied += 1;
+                released += f64::from(e.max(0.0));
+            }
+            TetOutcome::Degenerate => count.degenerate += 1,
+            TetOutcome::Skipped => {}
+        }
+    }
+    (count, released)
+}
