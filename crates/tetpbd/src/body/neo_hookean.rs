@@ -9,7 +9,7 @@ use crate::constraints::rest_shape_inverse;
 
 /// The stable Neo-Hookean material of every tetrahedron of a body (two constraints each,
 /// solved together; theory in [`crate::constraints::neo_hookean_deviatoric`] and
-/// [`crate::constraints::neo_hookean_delta_lambdas`]), with the rest shape of each
+/// [`crate::constraints::neo_hookean_update`]), with the rest shape of each
 /// tetrahedron. Compliances follow from the [`Material`] and each rest volume:
 /// `α_D = 1/(μ V₀)`, `α_H = 1/(λ' V₀)` (1/J), `λ' = λ + μ`.
 ///
@@ -83,6 +83,30 @@ impl NeoHookeanMaterial {
     /// The inverse rest edge matrix `Dm⁻¹` of each tetrahedron, 1/m.
     pub fn rest_inverse(&self) -> &[Matrix3<f32>] {
         &self.rest_inverse
+    }
+
+    /// The longest substep (s) at which this material is stable on this body:
+    /// `0.2 L / c`, with `c = √(μ/ρ)` the shear wave speed (`ρ` the body's mean density, from
+    /// `particles`' masses and the rest volumes) and `L = (6√2 V)^⅓` the edge of a regular
+    /// tetrahedron of the smallest rest volume `V`.
+    ///
+    /// Why there is a bound: the two constraints are isotropic invariants of `F`, whose
+    /// gradients at rest are both along the volume change, so the material's shear stiffness
+    /// lives entirely in their curvature times their (non-zero) rest multipliers, and XPBD
+    /// integrates that part explicitly. Shear waves then need the explicit (CFL) condition
+    /// `h ≲ 0.3 L / c`; past it a body at rest starts to vibrate by itself. Choose
+    /// `substeps ≥ dt / max_stable_substep` (`SolverSettings::substeps`).
+    pub fn max_stable_substep(&self, tets: &Tetrahedra, particles: &crate::Particles) -> f32 {
+        let volume: f64 = tets.rest_volumes.iter().map(|v| f64::from(v.abs())).sum();
+        let mass: f64 = particles.masses().iter().map(|&m| f64::from(m)).sum();
+        let smallest = tets
+            .rest_volumes
+            .iter()
+            .fold(f32::INFINITY, |m, v| m.min(v.abs()));
+        let (mu, _) = self.material.lame();
+        let c = (f64::from(mu) * volume / mass).sqrt();
+        let l = (6.0 * std::f64::consts::SQRT_2 * f64::from(smallest)).cbrt();
+        (0.2 * l / c) as f32
     }
 
     /// The material's elastic energy `Σ V₀ Ψ(F)` at `positions` (J; zero at rest), with the

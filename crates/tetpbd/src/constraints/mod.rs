@@ -31,7 +31,7 @@
 //! * [`volume()`] — signed volume (`volume.rs`);
 //! * [`neo_hookean_deviatoric`] and [`neo_hookean_hydrostatic`] — the stable Neo-Hookean
 //!   material's two constraints per tetrahedron, solved together by
-//!   [`neo_hookean_delta_lambdas`] (`neo_hookean.rs`);
+//!   [`neo_hookean_update`] (`neo_hookean.rs`);
 //! * [`grab()`] — a material point held to a target with a bounded force (`grab.rs`);
 //! * [`xpbd_delta_lambda`], [`bounded_step`] and [`apply()`] — the XPBD update (`xpbd.rs`).
 
@@ -48,9 +48,9 @@ mod xpbd;
 pub use edge::edge;
 pub use grab::{grab, grab_delta_lambda};
 pub use neo_hookean::{
-    cofactor, deformation_gradient, neo_hookean_delta_lambdas, neo_hookean_deviatoric,
-    neo_hookean_energy_density, neo_hookean_hydrostatic, neo_hookean_rest_offset,
-    neo_hookean_stress, rest_shape_inverse,
+    cofactor, deformation_gradient, neo_hookean_deviatoric, neo_hookean_energy_density,
+    neo_hookean_hydrostatic, neo_hookean_rest_offset, neo_hookean_stress, neo_hookean_update,
+    rest_shape_inverse, NeoHookeanUpdate,
 };
 pub use vertex_face::{
     signed_height, vertex_face, vertex_face_step_bound, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER,

@@ -23,7 +23,7 @@ use super::Evaluated;
 //
 // At rest (F = I) both constraints are violated (C_D = √3, C_H = −μ/λ'), but their forces
 // cancel: ∂Ψ/∂F = μF + λ'(J − γ) cof F = μI − μI = 0. That is why the two are solved as one
-// 2×2 system per tetrahedron (`neo_hookean_delta_lambdas`): the rest state is then a fixed
+// 2×2 system per tetrahedron (`neo_hookean_update`): the rest state is then a fixed
 // point of a single Gauss–Seidel projection, which it is not for two separate projections.
 //
 // Small strain: the second variation at F = I is 2μ ε:ε + (λ' − μ)(tr ε)², linear elasticity
@@ -136,8 +136,21 @@ pub fn neo_hookean_rest_offset<T: RealField + Copy>(mu: T, lambda_prime: T) -> T
     T::one() + mu / lambda_prime
 }
 
-/// The coupled XPBD multiplier update of the two Neo-Hookean constraints of a tetrahedron,
-/// with damping in the XPBD form (Macklin et al. 2016, eq. 26).
+/// One coupled XPBD update of the two Neo-Hookean constraints of a tetrahedron: the
+/// multiplier steps, the particle moves and the constraint values after them (to first order).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NeoHookeanUpdate<T: RealField + Copy> {
+    /// `[Δλ_D, Δλ_H]`.
+    pub delta_lambda: [T; 2],
+    /// The move of each particle, `wᵢ (∇ᵢC_D Δλ_D + ∇ᵢC_H Δλ_H)`, m.
+    pub moves: [Vector3<T>; 4],
+    /// `[C_D, C_H]` after the moves, to first order: `C + G Δλ`.
+    pub c_after: [T; 2],
+}
+
+/// The coupled XPBD update of the two Neo-Hookean constraints `d` (deviatoric) and `y`
+/// (hydrostatic) of a tetrahedron, with damping in the XPBD form (Macklin et al. 2016,
+/// eq. 26).
 ///
 /// Solves the 2×2 system
 ///
@@ -145,34 +158,61 @@ pub fn neo_hookean_rest_offset<T: RealField + Copy>(mu: T, lambda_prime: T) -> T
 /// ((1 + β/h) G + diag(α̃)) Δλ = −C − α̃ λ − (β/h) (∇C · (x − x̄)),
 /// ```
 ///
-/// `c = [C_D, C_H]`, `lambda` their multipliers, `alpha_tilde = [α_D/h², α_H/h²]`,
-/// `g[a][b] = Σᵢ wᵢ ∇ᵢC_a · ∇ᵢC_b`, `gamma = β/h` with `β` the damping time (s; a damping
-/// force `β k Ċ` for a constraint of stiffness `k = 1/α`, the same time for both terms) and
-/// `rate = [∇C_D·(x − x̄), ∇C_H·(x − x̄)]` the constraints' change since the substep start `x̄`.
-/// Returns `[Δλ_D, Δλ_H]`, or `None` when the system is singular (compliances zero and
-/// gradients parallel or vanishing) or the result not finite.
+/// `w` the particles' inverse masses (1/kg), `lambda = [λ_D, λ_H]`,
+/// `alpha_tilde = [α_D/h², α_H/h²]` (1/(J·s²)), `G_ab = Σᵢ wᵢ ∇ᵢC_a · ∇ᵢC_b`,
+/// `damping = β/h` with `β` the damping time (s; a damping force `β k Ċ` for a constraint of
+/// stiffness `k = 1/α`, the same time for both terms) and `rate = [∇C_D·(x − x̄),
+/// ∇C_H·(x − x̄)]`, the constraints' change since the substep start `x̄`.
+///
+/// Near rest the two gradients are nearly parallel (`∇C_H = √3 ∇C_D` at `F = I`), so `G` is
+/// nearly singular and `det((1 + β/h)G + diag(α̃))` would be the difference of two nearly
+/// equal products. The solve therefore splits `∇C_H = r ∇C_D + ∇⊥C_H` with
+/// `r = G_DH / G_DD`, in which basis every term of the determinant is positive
+/// (`G_HH − r G_DH = Σ wᵢ |∇ᵢ⊥C_H|²` is computed as a sum of squares), and moves the particles
+/// by `wᵢ (∇ᵢC_D u + ∇ᵢ⊥C_H Δλ_H)` with `u = Δλ_D + r Δλ_H`: at rest, where the two
+/// constraints' pulls cancel, nothing large is cancelled in f32.
+///
+/// `None` when the system is singular (all particles pinned, or the gradients vanishing with
+/// zero compliance) or its result not finite.
 #[inline]
-pub fn neo_hookean_delta_lambdas<T: RealField + Copy>(
-    c: [T; 2],
+pub fn neo_hookean_update<T: RealField + Copy>(
+    d: &Evaluated<T, 4>,
+    y: &Evaluated<T, 4>,
+    w: [T; 4],
     lambda: [T; 2],
     alpha_tilde: [T; 2],
-    g: [[T; 2]; 2],
-    gamma: T,
+    damping: T,
     rate: [T; 2],
-) -> Option<[T; 2]> {
-    let k = T::one() + gamma;
-    let a00 = k * g[0][0] + alpha_tilde[0];
-    let a11 = k * g[1][1] + alpha_tilde[1];
-    let a01 = k * g[0][1];
-    let b0 = -c[0] - alpha_tilde[0] * lambda[0] - gamma * rate[0];
-    let b1 = -c[1] - alpha_tilde[1] * lambda[1] - gamma * rate[1];
-    let det = a00 * a11 - a01 * a01;
-    let tiny = T::default_epsilon() * a00.abs().max(a11.abs()).powi(2);
-    if !(det > tiny) {
+) -> Option<NeoHookeanUpdate<T>> {
+    let zero = T::zero();
+    let g_dd = (0..4).fold(zero, |s, i| s + w[i] * d.grad[i].norm_squared());
+    let g_dh = (0..4).fold(zero, |s, i| s + w[i] * d.grad[i].dot(&y.grad[i]));
+    let r = if g_dd > zero { g_dh / g_dd } else { zero };
+    let perp: [Vector3<T>; 4] = std::array::from_fn(|i| y.grad[i] - d.grad[i] * r);
+    let g_perp = (0..4).fold(zero, |s, i| s + w[i] * perp[i].norm_squared());
+    let k = T::one() + damping;
+    let [ad, ah] = alpha_tilde;
+    let b0 = -d.c - ad * lambda[0] - damping * rate[0];
+    let b1 = -y.c - ah * lambda[1] - damping * rate[1];
+    // In the variables (u, Δλ_H), Δλ_D = u − r Δλ_H:
+    //   (k G_DD + α̃_D) u − α̃_D r Δλ_H = b0
+    //   k r G_DD u + (k G⊥ + α̃_H) Δλ_H = b1
+    let p = k * g_dd + ad;
+    let q = k * g_perp + ah;
+    let det = p * q + ad * r * r * k * g_dd;
+    if !(det > zero) {
         return None;
     }
-    let dl = [(b0 * a11 - b1 * a01) / det, (a00 * b1 - a01 * b0) / det];
-    (dl[0].is_finite() && dl[1].is_finite()).then_some(dl)
+    let u = (b0 * q + ad * r * b1) / det;
+    let dl_h = (p * b1 - k * r * g_dd * b0) / det;
+    let dl_d = u - r * dl_h;
+    let moves: [Vector3<T>; 4] = std::array::from_fn(|i| (d.grad[i] * u + perp[i] * dl_h) * w[i]);
+    let finite = u.is_finite() && dl_h.is_finite() && dl_d.is_finite();
+    finite.then_some(NeoHookeanUpdate {
+        delta_lambda: [dl_d, dl_h],
+        moves,
+        c_after: [d.c + g_dd * u, y.c + r * g_dd * u + g_perp * dl_h],
+    })
 }
 
 /// The stable Neo-Hookean energy density `Ψ(F) = μ/2 (tr(FᵀF) − 3) + λ'/2 (det F − γ)² −

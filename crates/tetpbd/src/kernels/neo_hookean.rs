@@ -3,7 +3,7 @@
 //!
 //! Per tetrahedron (theory in `constraints/neo_hookean.rs`): `F = Ds Dm⁻¹`, the two
 //! constraints and their gradients, the 2×2 coupled XPBD update with damping
-//! ([`constraints::neo_hookean_delta_lambdas`]), the move bounded to `√3/‖Dm⁻¹‖_F` (about one
+//! ([`constraints::neo_hookean_update`]), the move bounded to `√3/‖Dm⁻¹‖_F` (about one
 //! rest edge) so that a tetrahedron far from rest (inverted, crushed) recovers over a few
 //! projections instead of overshooting, and the elastic energy the projection released for
 //! the energy limit.
@@ -78,10 +78,6 @@ pub(crate) fn project_tet(
         return TetOutcome::Degenerate;
     };
     let y = constraints::neo_hookean_hydrostatic(&p, dm_inv, k.rest_offset);
-    let dot = |a: &Evaluated<f32, 4>, b: &Evaluated<f32, 4>| {
-        (0..4).fold(0.0f32, |s, i| s + w[i] * a.grad[i].dot(&b.grad[i]))
-    };
-    let g = [[dot(&d, &d), dot(&d, &y)], [dot(&d, &y), dot(&y, &y)]];
     let v0 = rest_volume.abs();
     let at = k.alpha_tilde_volume.map(|a| a / v0);
     let rate = if k.damping > 0.0 {
@@ -91,17 +87,11 @@ pub(crate) fn project_tet(
     } else {
         [0.0; 2]
     };
-    let Some(mut dl) =
-        constraints::neo_hookean_delta_lambdas([d.c, y.c], *lambdas, at, g, k.damping, rate)
-    else {
+    let Some(up) = constraints::neo_hookean_update(&d, &y, w, *lambdas, at, k.damping, rate) else {
         return TetOutcome::Degenerate;
     };
-    let mut dx = [Vector3::zeros(); 4];
-    let mut longest = 0.0f32;
-    for i in 0..4 {
-        dx[i] = (d.grad[i] * dl[0] + y.grad[i] * dl[1]) * w[i];
-        longest = longest.max(dx[i].norm_squared());
-    }
+    let (mut dl, mut dx) = (up.delta_lambda, up.moves);
+    let longest = dx.iter().fold(0.0f32, |m, v| m.max(v.norm_squared()));
     // The bound: about one rest edge (√3/‖Dm⁻¹‖_F is the edge of a right-angled corner).
     let bound = 3.0 / dm_inv.norm_squared();
     if longest > bound {
@@ -114,20 +104,35 @@ pub(crate) fn project_tet(
     }
     lambdas[0] += dl[0];
     lambdas[1] += dl[1];
-    // Released energy to first order in the constraints: C' = C + G Δλ,
-    // ΔU = Σ (C² − C'²) / (2 α), α = α̃ h².
-    let c_after = [
-        d.c + g[0][0] * dl[0] + g[0][1] * dl[1],
-        y.c + g[1][0] * dl[0] + g[1][1] * dl[1],
-    ];
-    let released = (d.c * d.c - c_after[0] * c_after[0]) / (2.0 * at[0] * k.h2)
-        + (y.c * y.c - c_after[1] * c_after[1]) / (2.0 * at[1] * k.h2);
-    TetOutcome::Applied(released)
+    // The elastic energy released since the substep start x̄: U(x̄) − U(x + Δx), exactly,
+    // as the change from x̄ to x (the prediction and earlier projections) plus the change of
+    // this projection (`energy_change`).
+    let f = constraints::deformation_gradient(&p, dm_inv);
+    let ds =
+        |v: &[Vector3<f32>; 4]| Matrix3::from_columns(&[v[1] - v[0], v[2] - v[0], v[3] - v[0]]);
+    let back: [Vector3<f32>; 4] = std::array::from_fn(|i| prev[idx[i]] - p[i]);
+    let df_back = ds(&back) * dm_inv;
+    let to_start = energy_change(&f, &df_back, y.c, at, k.h2);
+    let projected = energy_change(&f, &(ds(&dx) * dm_inv), y.c, at, k.h2);
+    TetOutcome::Applied(to_start - projected)
+}
+
+/// `U(F + dF) − U(F)` (J) of one tetrahedron's constraints, `U = C_D²/(2α_D) + C_H²/(2α_H)`,
+/// `c_h = C_H(F)`, `at = α̃` and `h2 = h²` (`α = α̃ h²`). Without a difference of large numbers:
+/// `‖F + dF‖² − ‖F‖² = (2F + dF) : dF` and `det(F + dF) − det F = cof F : dF + F : cof dF +
+/// det dF`.
+#[inline(always)]
+fn energy_change(f: &Matrix3<f32>, df: &Matrix3<f32>, c_h: f32, at: [f32; 2], h2: f32) -> f32 {
+    let d_norm = (f * 2.0 + df).dot(df);
+    let d_det =
+        constraints::cofactor(f).dot(df) + f.dot(&constraints::cofactor(df)) + df.determinant();
+    d_norm / (2.0 * at[0] * h2) + d_det * (2.0 * c_h + d_det) / (2.0 * at[1] * h2)
 }
 
 /// One Gauss–Seidel sweep of a body's material on its working copy (`slots`), tetrahedra in
 /// solver order; `prev` are the substep's start positions (for the damping). Returns the
-/// counts and the released energy (J, the sum of the tetrahedra's positive releases).
+/// counts and the elastic energy released since the substep start (J, summed over the
+/// tetrahedra, each taken when it was projected; negative where energy was stored).
 // The slices of one body's tetrahedra and material, and the constants: what a sweep takes.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn sweep(
@@ -153,7 +158,7 @@ pub(crate) fn sweep(
         ) {
             TetOutcome::Applied(e) => {
                 count.applied += 1;
-                released += f64::from(e.max(0.0));
+                released += f64::from(e);
             }
             TetOutcome::Degenerate => count.degenerate += 1,
             TetOutcome::Skipped => {}

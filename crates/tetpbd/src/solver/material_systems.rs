@@ -14,7 +14,7 @@ use crate::kernels::working_copy::{self, CopyMode};
 
 /// One Gauss–Seidel sweep over every awake body's [`NeoHookeanMaterial`], tetrahedra in
 /// solver (colour) order, on the scalar kernel: the two constraints of each tetrahedron
-/// projected together ([`crate::constraints::neo_hookean_delta_lambdas`]), with the
+/// projected together ([`crate::constraints::neo_hookean_update`]), with the
 /// material's damping. A tetrahedron collapsed to a point (no deviatoric direction) is
 /// skipped and counted as degenerate.
 pub fn project_neo_hookean(world: &mut World, h: f32) -> ProjectionCount {
@@ -39,7 +39,7 @@ pub(crate) fn project_neo_hookean_in(world: &mut World, h: f32, mode: CopyMode) 
             &mut m.lambdas,
             &k,
         );
-        m.released += released;
+        m.released = released;
         if mode == CopyMode::PerSweep {
             working_copy::store(p);
         }
@@ -59,34 +59,11 @@ pub fn reset_neo_hookean(world: &mut World) {
     }
 }
 
-/// The material's share of the energy limit's budget for one body (J): the elastic energy its
-/// projections released in the substep, plus `(1 + W̄/α̃_H)|A|` for the energy the prediction
-/// moved in or out of it (`A` the work term, J; `W̄ = w_max Σ|∇C_H|²` at the rest shape of a
-/// regular tetrahedron of the body's mean rest volume `V`, `Σ|∇ det F|² = L⁴/(12 V²)`),
-/// as the seed's families' budget in `stabilisation::correction_energy`.
-pub(crate) fn energy_budget(
-    m: &NeoHookeanMaterial,
-    tets: &Tetrahedra,
-    h: f32,
-    w_max: f32,
-    work: f64,
-) -> f64 {
-    let (mu, lambda) = m.material.lame();
-    let lp = f64::from(lambda) + f64::from(mu);
-    let n = tets.rest_volumes.len().max(1) as f64;
-    let v = tets
-        .rest_volumes
-        .iter()
-        .map(|v| f64::from(v.abs()))
-        .sum::<f64>()
-        / n;
-    let l4 = (6.0 * std::f64::consts::SQRT_2 * v).cbrt().powi(4);
-    let wbar = f64::from(w_max) * l4 / (12.0 * v * v);
-    let alpha_tilde = 1.0 / (lp * v * f64::from(h) * f64::from(h));
-    let moved = (1.0 + wbar / alpha_tilde) * work.abs();
-    if moved.is_finite() {
-        moved + m.released
-    } else {
-        m.released
-    }
+/// The material's share of the energy limit's budget for one body (J): the elastic energy it
+/// released since the substep start, `Σ V₀ (Ψ(F̄) − Ψ(F))` over its tetrahedra (each taken
+/// exactly when the last sweep projected it; zero if the material stored energy). That is
+/// the energy its corrections may turn into motion; a step that would add more (an
+/// instability, a tangle) is limited.
+pub(crate) fn energy_budget(m: &NeoHookeanMaterial) -> f64 {
+    m.released.max(0.0)
 }

@@ -232,12 +232,7 @@ pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: b
             } else if hook >= gain {
                 hook
             } else {
-                let material = match (m, t) {
-                    (Some(m), Some(t)) => {
-                        crate::solver::material_systems::energy_budget(m, t, h, w_max, work)
-                    }
-                    _ => 0.0,
-                };
+                let material = m.map_or(0.0, crate::solver::material_systems::energy_budget);
                 hook + material + elastic_release([h, w_max], [work, gain - hook], e, t, vf, vol)
             }
         };
