@@ -86,7 +86,7 @@ impl NeoHookeanMaterial {
     }
 
     /// The longest substep (s) at which this material is stable on this body:
-    /// `0.2 L / c`, with `c = √(μ/ρ)` the shear wave speed (`ρ` the body's mean density, from
+    /// `0.1 L / c`, with `c = √(μ/ρ)` the shear wave speed (`ρ` the body's mean density, from
     /// `particles`' masses and the rest volumes) and `L = (6√2 V)^⅓` the edge of a regular
     /// tetrahedron of the smallest rest volume `V`.
     ///
@@ -106,7 +106,7 @@ impl NeoHookeanMaterial {
         let (mu, _) = self.material.lame();
         let c = (f64::from(mu) * volume / mass).sqrt();
         let l = (6.0 * std::f64::consts::SQRT_2 * f64::from(smallest)).cbrt();
-        (0.2 * l / c) as f32
+        (0.1 * l / c) as f32
     }
 
     /// The material's elastic energy `Σ V₀ Ψ(F)` at `positions` (J; zero at rest), with the
