@@ -4,7 +4,10 @@ use hecs::World;
 use rapier3d::dynamics::{ImpulseJointSet, MultibodyJointSet};
 use rapier3d::geometry::NarrowPhase;
 use rapier3d::pipeline::QueryPipeline;
-use tetpbd::{FrameContext, Particles, SubstepContext, SubstepHook, Surface};
+use tetpbd::{
+    applied_acceleration, ExternalAcceleration, FrameContext, Grab, Particles, SubstepContext,
+    SubstepHook, Surface, UserForces,
+};
 
 use crate::attachments::{anchor_of, project_attachments, Attachments};
 use crate::contacts::corner::{project_corners, CornerPass};
@@ -191,11 +194,20 @@ impl SubstepHook for CouplingHook<'_, '_> {
         }
         end_substep_supports(supports, h);
         for s in soft.iter() {
-            let Ok((p, surface, sc)) =
-                world.query_one_mut::<(&mut Particles, &Surface, Option<&SoftCollider>)>(s.entity)
-            else {
+            let Ok((p, surface, sc, loads)) = world.query_one_mut::<(
+                &mut Particles,
+                &Surface,
+                Option<&SoftCollider>,
+                (
+                    Option<&UserForces>,
+                    Option<&Grab>,
+                    Option<&ExternalAcceleration>,
+                ),
+            )>(s.entity) else {
                 continue;
             };
+            let (forces, grab, external) = loads;
+            let pull = (substep.gravity() + applied_acceleration(p, forces, grab, external)) * h;
             let rolling = sc.unwrap_or(&self.default_collider).rolling_resistance();
             let range = s.contacts.clone();
             if s.stacked {
@@ -219,6 +231,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 &mut corners[s.corners.clone()],
                 p,
                 &s.v_cm_pre,
+                &pull,
                 bodies,
                 colliders,
                 threshold,

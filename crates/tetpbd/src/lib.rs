@@ -58,7 +58,7 @@ mod stabilisation;
 pub use body::activation::{Activation, Asleep};
 pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
 pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};
-pub use body::forces::UserForces;
+pub use body::forces::{applied_acceleration, UserForces};
 pub use body::generators;
 pub use body::grab::Grab;
 pub use body::impulses::PointImpulse;

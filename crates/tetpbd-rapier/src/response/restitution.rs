@@ -22,6 +22,24 @@
 //!    the load rests on it (it does once the load is lifted).
 //!
 //! `e` is the largest combined restitution among the pair's contacts.
+//!
+//! The cap stops the body's own recoil, not a pull: the loads applied to the body besides
+//! its contacts — gravity, its user forces, a grab, an external acceleration
+//! ([`tetpbd::applied_acceleration`]) — change `v_n` by `a_n h` in each substep, and the
+//! episode raises its cap by their sum since it began, kept at or above 0:
+//!
+//! ```text
+//! allowance ← max(0, allowance + n·a h),    cap = −e·v⁻ + allowance
+//! allowance ← min(allowance, max(0, v_n − (−e·v⁻)))      (after the cap)
+//! ```
+//!
+//! The second line keeps the allowance from running ahead of the separation the body
+//! really has, so loads a contact balances (the weight of a soft body under another) do
+//! not let recoil through.
+//!
+//! A body resting under its weight gains nothing (`n·g < 0`); a grab or force stronger than
+//! the weight lifts it as it would lift a free body. The rigid body's own loads are not
+//! counted (rapier moves it between frames).
 
 use hecs::Entity;
 use nalgebra::Vector3;
@@ -39,27 +57,40 @@ pub(crate) struct Episode {
     key: (u64, u64),
     /// `v⁻`, m/s (< 0 when approaching).
     approach: f32,
+    /// Whether the approach was an impact (faster than the threshold).
+    impact: bool,
+    /// The separation speed the applied loads have given since the episode began, m/s
+    /// (module docs).
+    allowance: f32,
     compressing: bool,
     seen: bool,
 }
 
 impl Episode {
     /// The change of the relative normal velocity `v_n` (m/s, > 0 separating) that steps 2
-    /// and 3 of the module docs ask for in this substep, `e` the pair's restitution; `None`
-    /// when nothing is to change.
-    pub fn change(&mut self, v_n: f32, e: f32) -> Option<f32> {
-        let target = -e * self.approach;
-        if self.compressing {
+    /// and 3 of the module docs ask for in this substep, `e` the pair's restitution and
+    /// `pull` (m/s) the change of `v_n` the applied loads gave in the substep; `None` when
+    /// nothing is to change. A contact that is not an impact is capped at the allowance.
+    pub fn change(&mut self, v_n: f32, e: f32, pull: f32) -> Option<f32> {
+        if pull.is_finite() {
+            self.allowance = (self.allowance + pull).max(0.0);
+        }
+        let bounce = if self.impact { -e * self.approach } else { 0.0 };
+        let target = bounce + self.allowance;
+        let dv = if self.compressing {
             if v_n < 0.0 {
                 return None;
             }
             self.compressing = false;
             Some(target - v_n)
-        } else if v_n > target {
-            Some(target - v_n)
         } else {
-            None
-        }
+            (v_n > target).then_some(target - v_n)
+        };
+        // The allowance never runs ahead of the separation the body has: loads that the
+        // contact balances (a lower body's weight on its support) add nothing.
+        let after = v_n + dv.unwrap_or(0.0) - bounce;
+        self.allowance = self.allowance.min(after.max(0.0));
+        dv
     }
 }
 
@@ -81,14 +112,28 @@ impl Episodes {
         approach: impl FnOnce() -> f32,
         threshold: f32,
     ) -> Option<&mut Episode> {
+        let ep = self.episode(key, approach, threshold);
+        ep.impact.then_some(ep)
+    }
+
+    /// The episode of pair `key`, impact or not (as [`Episodes::impact`]).
+    pub fn episode(
+        &mut self,
+        key: (u64, u64),
+        approach: impl FnOnce() -> f32,
+        threshold: f32,
+    ) -> &mut Episode {
         let k = match self.list.binary_search_by(|ep| ep.key.cmp(&key)) {
             Ok(k) => k,
             Err(k) => {
                 let approach = approach();
+                let impact = approach < -threshold;
                 let ep = Episode {
                     key,
                     approach,
-                    compressing: approach < -threshold,
+                    impact,
+                    allowance: 0.0,
+                    compressing: impact,
                     seen: false,
                 };
                 self.list.insert(k, ep);
@@ -97,7 +142,7 @@ impl Episodes {
         };
         let ep = &mut self.list[k];
         ep.seen = true;
-        (ep.approach < -threshold).then_some(ep)
+        ep
     }
 
     /// Ends the substep: drops the episodes of pairs with no active contact in it.
@@ -111,7 +156,9 @@ impl Episodes {
 
 /// Runs the episodes of one soft body after a substep's velocity update. `contacts` are the
 /// body's contacts (contiguous per collider), `v_cm_pre` its centre-of-mass velocity before
-/// the substep. `active` is scratch space (its capacity is reused across calls).
+/// the substep, `pull` the change of its velocity the applied loads and gravity gave in the
+/// substep (m/s, module docs). `active` is scratch space (its capacity is reused across
+/// calls).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn restitution_pass(
     episodes: &mut Episodes,
@@ -121,6 +168,7 @@ pub(crate) fn restitution_pass(
     corners: &mut [CornerContact],
     p: &mut Particles,
     v_cm_pre: &Vector3<f32>,
+    pull: &Vector3<f32>,
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
     threshold: f32,
@@ -150,7 +198,8 @@ pub(crate) fn restitution_pass(
         let Some(ep) = episodes.impact(key, approach, threshold) else {
             continue;
         };
-        let Some(dv) = ep.change(n.dot(&(v_cm - vb)), e) else {
+        let pull = if anchored { 0.0 } else { n.dot(pull) };
+        let Some(dv) = ep.change(n.dot(&(v_cm - vb)), e, pull) else {
             continue;
         };
         let w_soft = if anchored { 0.0 } else { 1.0 / mass };

@@ -2,7 +2,7 @@
 
 use hecs::{Entity, World};
 use nalgebra::Vector3;
-use tetpbd::Particles;
+use tetpbd::{applied_acceleration, ExternalAcceleration, Grab, Particles, UserForces};
 
 use crate::soft_collider::SoftCollider;
 
@@ -33,6 +33,25 @@ impl FrameBody {
     pub fn com_velocity(&self, world: &mut World) -> Vector3<f32> {
         match world.query_one_mut::<&Particles>(self.entity) {
             Ok(p) => p.free_velocity().map_or(Vector3::zeros(), |v| v.0),
+            Err(_) => Vector3::zeros(),
+        }
+    }
+
+    /// The change of the body's centre-of-mass velocity (m/s) that gravity `g` (m/s²) and
+    /// the loads applied to it ([`tetpbd::applied_acceleration`]) give over a substep of `h`
+    /// (s); zero for a body held by a pinned particle or that cannot be read.
+    pub fn pull(&self, world: &mut World, g: &Vector3<f32>, h: f32) -> Vector3<f32> {
+        if self.inv_mass <= 0.0 {
+            return Vector3::zeros();
+        }
+        type Loads<'a> = (
+            &'a Particles,
+            Option<&'a UserForces>,
+            Option<&'a Grab>,
+            Option<&'a ExternalAcceleration>,
+        );
+        match world.query_one_mut::<Loads<'_>>(self.entity) {
+            Ok((p, f, grab, a)) => (g + applied_acceleration(p, f, grab, a)) * h,
             Err(_) => Vector3::zeros(),
         }
     }

@@ -242,8 +242,13 @@ impl SubstepHook for SoftContacts {
             .remove_velocity(world, &self.gather.bodies, substep.h());
         self.frame.velocity_pass(world, &self.gather);
         let a_max = self.settings.max_acceleration;
-        self.restitution
-            .apply(world, &self.gather, &self.frame, a_max, substep.h());
+        self.restitution.apply(
+            world,
+            &self.gather,
+            &self.frame,
+            (a_max, &substep.gravity()),
+            substep.h(),
+        );
     }
 
     fn end_frame(&mut self, world: &mut World, _frame: FrameContext) {

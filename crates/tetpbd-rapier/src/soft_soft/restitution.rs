@@ -20,7 +20,10 @@
 //! ([`crate::SoftContactSettings::max_acceleration`] standing in for gravity, which a bare
 //! solver's hook does not know) is an impact, bounced back at `e` times its approach speed
 //! once compression ends and capped there while the contact lasts. Any other contact, and
-//! every contact when `e = 0`, does not separate as a whole: `v_n` is capped at 0. The change
+//! every contact when `e = 0`, does not separate as a whole: `v_n` is capped at 0. Both caps
+//! are raised by what gravity and the loads applied to the two bodies (user forces, grabs,
+//! external accelerations) have added to `v_n` since the contact began, as for a collider
+//! (`response::restitution`): a pull lifts a body off another, its recoil does not. The change
 //! is an opposite pair of impulses on the two bodies shared by `W` (1/body mass, 0 for a
 //! body with a pinned particle): momentum is conserved, every particle of a body gets the
 //! same change (no deformation is added), and only the normal part of the relative motion is
@@ -46,6 +49,9 @@ pub(crate) struct BodyRestitution {
     /// Per frame body: centre-of-mass velocity at the substep start (only when some pair
     /// has a restitution above 0).
     v_pre: Vec<Vector3<f32>>,
+    /// Per frame body: the velocity change gravity and the applied loads gave it in the
+    /// substep, m/s (only when some pair is in contact).
+    pulls: Vec<Vector3<f32>>,
     episodes: Episodes,
 }
 
@@ -61,14 +67,14 @@ impl BodyRestitution {
             .extend(g.bodies.iter().map(|b| b.com_velocity(world)));
     }
 
-    /// Applies the body-level restitution after a substep of `h` (s); `a_max` (m/s²) sets
-    /// the impact threshold (module docs).
+    /// Applies the body-level restitution after a substep of `h` (s) under `gravity`
+    /// (m/s²); `a_max` (m/s²) sets the impact threshold (module docs).
     pub fn apply(
         &mut self,
         world: &mut World,
         g: &Gather,
         frame: &ContactFrame,
-        a_max: f32,
+        (a_max, gravity): (f32, &Vector3<f32>),
         h: f32,
     ) {
         self.sums.clear();
@@ -90,6 +96,9 @@ impl BodyRestitution {
             any = true;
         }
         if any {
+            self.pulls.clear();
+            self.pulls
+                .extend(g.bodies.iter().map(|b| b.pull(world, gravity, h)));
             let threshold = 2.0 * a_max * h;
             for k in 0..g.pairs.len() {
                 self.pair(world, g, k, threshold);
@@ -112,21 +121,17 @@ impl BodyRestitution {
         }
         let v_n = relative_normal_velocity(world, ba, bb, &n);
         let e = g.pair_props[k].restitution;
-        let impact = if e > 0.0 {
-            let key = (ba.entity.to_bits().get(), bb.entity.to_bits().get());
-            let v_pre = (self.v_pre.get(a), self.v_pre.get(b));
-            let approach = || match v_pre {
-                (Some(va), Some(vb)) => (va - vb).dot(&n),
-                _ => 0.0,
-            };
-            self.episodes.impact(key, approach, threshold)
-        } else {
-            None
+        let key = (ba.entity.to_bits().get(), bb.entity.to_bits().get());
+        let v_pre = (self.v_pre.get(a), self.v_pre.get(b));
+        let approach = || match v_pre {
+            (Some(va), Some(vb)) if e > 0.0 => (va - vb).dot(&n),
+            _ => 0.0,
         };
-        let dv = match impact {
-            Some(ep) => ep.change(v_n, e),
-            None => (v_n > 0.0).then_some(-v_n),
-        };
+        let pull = (self.pulls[a] - self.pulls[b]).dot(&n);
+        let dv = self
+            .episodes
+            .episode(key, approach, threshold)
+            .change(v_n, e, pull);
         if let Some(dv) = dv.filter(|dv| !dv.is_nan()) {
             exchange(world, (ba, bb), &n, dv);
         }

@@ -24,10 +24,11 @@
 
 use nalgebra::Vector3;
 
+use crate::body::grab::Grab;
 use crate::body::impulses::finite;
 use crate::body::material_point::MaterialPoint;
 use crate::body::mesh::Tetrahedra;
-use crate::body::particles::Particles;
+use crate::body::particles::{ExternalAcceleration, Particles};
 use crate::error::StateError;
 
 /// User forces on one soft body, one per particle, N (an optional hecs component; see the
@@ -222,5 +223,42 @@ pub fn integrate_user_forces(world: &mut hecs::World, h: f32) {
         for ((v, w), f) in velocities.iter_mut().zip(inv_masses.iter()).zip(&f.forces) {
             *v += f * (h * *w);
         }
+    }
+}
+
+/// The acceleration (m/s²) that the loads applied to a body besides gravity give the centre
+/// of mass of its free particles: its [`UserForces`] on free particles, its [`Grab`]'s force
+/// over the last substep ([`Grab::force`]) and its [`ExternalAcceleration`],
+///
+/// ```text
+/// a = (Σ_free Fᵢ + F_grab) / Σ_free mᵢ + a_ext
+/// ```
+///
+/// Zero for a body without free particles or when a load is not finite. Contact responses
+/// use it to tell a pull the user applies from the body's own elastic recoil.
+pub fn applied_acceleration(
+    particles: &Particles,
+    forces: Option<&UserForces>,
+    grab: Option<&Grab>,
+    external: Option<&ExternalAcceleration>,
+) -> Vector3<f32> {
+    let mut mass = 0.0f32;
+    let mut force = grab.map_or(Vector3::zeros(), Grab::force);
+    for (i, &m) in particles.masses.iter().enumerate() {
+        if particles.inv_masses[i] > 0.0 {
+            mass += m;
+            if let Some(f) = forces.and_then(|f| f.forces.get(i)) {
+                force += f;
+            }
+        }
+    }
+    if mass <= 0.0 {
+        return Vector3::zeros();
+    }
+    let total = force / mass + external.map_or(Vector3::zeros(), ExternalAcceleration::get);
+    if total.iter().all(|c| c.is_finite()) {
+        total
+    } else {
+        Vector3::zeros()
     }
 }
