@@ -283,10 +283,10 @@ fn coupled_update_solves_its_system() {
             r0.abs() < 1e-8 * scale && r1.abs() < 1e-8 * scale,
             "residual {r0} {r1} of {b:?}"
         );
-        for i in 0..4 {
-            let dx = (d.grad[i] * dl[0] + y.grad[i] * dl[1]) * w[i];
+        for (i, (wi, moved)) in w.iter().zip(&up.moves).enumerate() {
+            let dx = (d.grad[i] * dl[0] + y.grad[i] * dl[1]) * *wi;
             assert!(
-                (dx - up.moves[i]).norm() <= 1e-8 * dx.norm().max(1e-12),
+                (dx - moved).norm() <= 1e-8 * dx.norm().max(1e-12),
                 "move {i}"
             );
         }
@@ -294,8 +294,8 @@ fn coupled_update_solves_its_system() {
             d.c + g[0][0] * dl[0] + g[0][1] * dl[1],
             y.c + g[0][1] * dl[0] + g[1][1] * dl[1],
         ];
-        for a in 0..2 {
-            assert!((c_after[a] - up.c_after[a]).abs() < 1e-8 * (1.0 + c_after[a].abs()));
+        for (c, got) in c_after.iter().zip(&up.c_after) {
+            assert!((c - got).abs() < 1e-8 * (1.0 + c.abs()));
         }
     }
 }

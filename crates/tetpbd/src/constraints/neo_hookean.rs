@@ -97,7 +97,8 @@ pub fn neo_hookean_deviatoric<T: RealField + Copy>(
 ) -> Option<Evaluated<T, 4>> {
     let f = deformation_gradient(p, dm_inv);
     let c = f.norm();
-    if !(c > T::default_epsilon() * T::default_epsilon()) {
+    let tiny = T::default_epsilon() * T::default_epsilon();
+    if c.partial_cmp(&tiny) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     Some(Evaluated {
@@ -200,7 +201,7 @@ pub fn neo_hookean_update<T: RealField + Copy>(
     let p = k * g_dd + ad;
     let q = k * g_perp + ah;
     let det = p * q + ad * r * r * k * g_dd;
-    if !(det > zero) {
+    if det.partial_cmp(&zero) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let u = (b0 * q + ad * r * b1) / det;
