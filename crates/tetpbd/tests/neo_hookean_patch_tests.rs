@@ -311,3 +311,24 @@ fn bad_materials_are_typed_errors_naming_the_value() {
     let msg = Material::new(1e5, 0.5).unwrap_err().to_string();
     assert!(msg.contains("0.5"), "{msg}");
 }
+
+/// A material and a body's material component round-trip through serde; a serialized
+/// material out of range is rejected with the same typed error.
+#[cfg(feature = "serde")]
+#[test]
+fn material_round_trips_through_serde_and_stays_validated() {
+    let m = Material::JELLY;
+    let json = serde_json::to_string(&m).unwrap();
+    assert_eq!(serde_json::from_str::<Material>(&json).unwrap(), m);
+    let bad = json.replace("0.45", "0.5");
+    let err = serde_json::from_str::<Material>(&bad)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("Poisson"), "{err}");
+    let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [2, 2, 2], CellSplit::Six).unwrap();
+    let body = SoftBodyBuilder::new(mesh).material(m).build().unwrap();
+    let c = body.material.unwrap();
+    let back: NeoHookeanMaterial =
+        serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
+    assert_eq!(back, c);
+}
