@@ -22,7 +22,7 @@ pub struct NeoHookeanMaterial {
     pub(crate) material: Material,
     /// `Dm⁻¹` of each tetrahedron (solver order, as [`Tetrahedra`]), 1/m.
     pub(crate) rest_inverse: Vec<Matrix3<f32>>,
-    /// `[λ_D, λ_H]` of each tetrahedron, J⁻¹·s²… in the units of `C/α̃` (J·s², reset every substep).
+    /// `[λ_D, λ_H]` of each tetrahedron, J·s² (dimensionless `C` over `α̃`; reset every substep).
     pub(crate) lambdas: Vec<[f32; 2]>,
     /// Elastic energy released by the material's projections in the current substep, J (the
     /// energy limit's budget; reset every substep).

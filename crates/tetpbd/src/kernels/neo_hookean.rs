@@ -5,8 +5,8 @@
 //! constraints and their gradients, the 2×2 coupled XPBD update with damping
 //! ([`constraints::neo_hookean_update`]), the move bounded to `√3/‖Dm⁻¹‖_F` (about one
 //! rest edge) so that a tetrahedron far from rest (inverted, crushed) recovers over a few
-//! projections instead of overshooting, and the elastic energy the projection released for
-//! the energy limit.
+//! projections instead of overshooting, and the elastic energy released since the substep
+//! start, for the energy limit.
 
 use nalgebra::{Matrix3, Vector3};
 use wide::f32x4;
@@ -18,7 +18,7 @@ use crate::kernels::slots::Slot;
 /// The per-body constants of a sweep.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct MaterialStep {
-    /// `[1/(μ h²), 1/(λ' h²)]`: `α̃` per unit rest volume, 1/(J·s²)·m³… divide by `V₀`.
+    /// `[1/(μ h²), 1/(λ' h²)]`, m³/(J·s²): `α̃ V₀` (divide by a tetrahedron's rest volume).
     pub alpha_tilde_volume: [f32; 2],
     /// `γ = 1 + μ/λ'`.
     pub rest_offset: f32,
