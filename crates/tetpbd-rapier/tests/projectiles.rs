@@ -218,3 +218,83 @@ fn soft_bodies_at_50_to_300_m_s_never_pass_rigid_ones() {
         }
     }
 }
+
+/// A rigid cube of `mass` (kg, half size 0.08 m) thrown straight down at `speed` from
+/// 0.4 m above a small soft cube of `size` (m, 3³ cells, 1000 kg/m³) resting on the ground,
+/// `off` (m) off its axis, for 0.5 s. rapier stops the projectile at the ground in its own
+/// step (it does not see the soft body); the coupling must not then drive it, and the soft
+/// body under it, into the ground. Returns the projectile's lowest bottom (m), its fastest
+/// speed after the first frame (m/s), the soft body's lowest particle at the end (m) and its
+/// fastest particle after the first frame (m/s). A struck edge may squeeze the soft body
+/// out sideways: the ground is wide.
+fn onto_small_jelly(
+    substeps: u32,
+    speed: f32,
+    size: f32,
+    off: f32,
+    mass: f32,
+) -> (f32, f32, f32, f32) {
+    let mut s = robust_common::scene_substeps(substeps);
+    s.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
+        ColliderBuilder::cuboid(100.0, 0.5, 100.0),
+    );
+    let jelly = soft_box(
+        &mut s,
+        Vector3::repeat(size),
+        [3; 3],
+        Vector3::new(0.0, 0.5 * size + 0.002, 0.0),
+        Vector3::zeros(),
+        1000.0,
+    );
+    let (cube, _) = s.physics.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(off, size + 0.48, 0.0))
+            .linvel(Vector::new(0.0, -speed, 0.0)),
+        ColliderBuilder::cuboid(0.08, 0.08, 0.08).mass(mass),
+    );
+    let (mut lowest, mut fastest, mut jelly_fastest) = (f32::INFINITY, 0.0f32, 0.0f32);
+    for f in 0..30 {
+        s.step().expect("step");
+        let b = &s.physics.bodies[cube];
+        lowest = lowest.min(b.translation().y - 0.08);
+        if f > 0 {
+            fastest = fastest.max(b.linvel().length());
+            jelly_fastest = jelly_fastest.max(particles(&s, jelly).max_speed());
+        }
+    }
+    let jelly_low = particles(&s, jelly).aabb().0.y;
+    (lowest, fastest, jelly_low, jelly_fastest)
+}
+
+#[test]
+fn a_fast_cube_onto_a_small_jelly_on_the_ground_never_ends_in_the_ground() {
+    let mut k = 0usize;
+    for substeps in [5u32, 10, 40] {
+        for speed in [20.0f32, 60.0, 120.0] {
+            for size in [0.2f32, 0.3, 0.5] {
+                for off in [0.0f32, 0.08, 0.15] {
+                    // Masses turning through their list (seeded, reproducible).
+                    let mass = [0.6f32, 3.0, 20.0][k % 3];
+                    k += 1;
+                    let (lowest, fastest, jelly_low, jelly_fastest) =
+                        onto_small_jelly(substeps, speed, size, off, mass);
+                    let what = format!(
+                        "{mass} kg cube at {speed} m/s, {substeps} substeps, jelly {size} m, \
+                         {off} m off axis"
+                    );
+                    assert!(lowest > -0.03, "{what}: cube {lowest} m into the ground");
+                    assert!(
+                        jelly_low > -0.03,
+                        "{what}: jelly {jelly_low} m into the ground"
+                    );
+                    assert!(fastest < speed, "{what}: cube out at {fastest} m/s");
+                    assert!(
+                        jelly_fastest < speed,
+                        "{what}: jelly thrown at {jelly_fastest} m/s"
+                    );
+                }
+            }
+        }
+    }
+}

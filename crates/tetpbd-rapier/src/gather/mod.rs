@@ -166,8 +166,13 @@ impl Frame {
                     .contact_pairs_with(c)
                     .any(|pair| pair.has_any_active_contact())
             });
-        self.bodies
-            .push(BodyProxy::new(handle, rb, start, self.dt, supported));
+        self.bodies.push(BodyProxy::new(
+            handle,
+            rb,
+            start,
+            (self.dt, self.gravity),
+            supported,
+        ));
         self.body_index.insert(key, self.bodies.len() - 1);
         Some(self.bodies.len() - 1)
     }

@@ -17,6 +17,16 @@
 //! position differs from rapier's `c₀ + v₁dt` by `½a·dt(dt − h)`; only bodies a soft body
 //! actually touched are written back.
 //!
+//! rapier's end pose also holds what its contacts did by moving the body rather than by
+//! changing its velocity: a fast body that hit the ground in rapier's step can end at the
+//! ground with its velocity barely changed, and the path above would then run up to a
+//! frame's travel into the ground, pushing whatever soft body lies there with it. So when
+//! the path's end misses rapier's centre of mass `c₁` by more than the body's smooth
+//! accelerations (gravity, user force) could explain over the frame, `|D| > a_s dt²` with
+//! `D = c₁ − c(dt)`, the miss is taken as a velocity change at the frame's start:
+//! `v₀ ← v₀ + D/dt` and `v₁ ← v₁ + D/dt`, so the path ends at `c₁` and its velocities stay
+//! those of its positions. Motion under smooth forces is left as it is.
+//!
 //! A dynamic body in contact with other rigid colliders is *supported*: infinitely heavy
 //! inside the substeps, its summed soft reaction handed to rapier as a force for its next
 //! step. One that also carries an attachment is *anchored* (`contacts::support` module docs): it
@@ -105,6 +115,12 @@ pub(crate) struct BodyProxy {
     /// Linear and angular velocity at the start of the current substep (before any soft
     /// correction), and the centre of mass they refer to.
     pre: (Vector3<f32>, Vector3<f32>, Vector3<f32>),
+    /// Magnitude of the body's smooth acceleration over the frame (gravity times its
+    /// scale, its user force over its mass), m/s².
+    smooth_accel: f32,
+    /// Whether the base path has been made to end at rapier's centre of mass (module docs;
+    /// done in the frame's first substep, whose length the path depends on).
+    ends_at_rapier: bool,
 }
 
 impl BodyKind {
@@ -139,11 +155,12 @@ fn inverse_mass(body: &RigidBody) -> (Vector3<f32>, Matrix3<f32>) {
 
 impl BodyProxy {
     /// A proxy of `body`, whose pose before rapier's step was `start` (m, rad).
+    /// `gravity` is the magnitude of the scene's gravity, m/s².
     pub fn new(
         handle: RigidBodyHandle,
         body: &RigidBody,
         (start, v_start): (Isometry3<f32>, Vector3<f32>),
-        dt: f32,
+        (dt, gravity): (f32, f32),
         supported: bool,
     ) -> Self {
         let kind = BodyKind::of(body, supported);
@@ -170,6 +187,13 @@ impl BodyProxy {
             ),
         };
         let (inv_mass, inv_inertia) = inverse_mass(body);
+        let mass = body.mass();
+        let force = if mass > 0.0 {
+            body.user_force().length() / mass
+        } else {
+            0.0
+        };
+        let smooth_accel = gravity * body.gravity_scale().abs() + force;
         BodyProxy {
             handle,
             kind,
@@ -207,6 +231,8 @@ impl BodyProxy {
             friction: 0.0,
             held: false,
             pre: (Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
+            smooth_accel,
+            ends_at_rapier: false,
         }
     }
 
@@ -227,6 +253,10 @@ impl BodyProxy {
     /// Moves to the end of the next substep; `frac` is its end time as a fraction of the frame.
     pub fn begin_substep(&mut self, frac: f32, h: f32) {
         self.h = h;
+        if !self.ends_at_rapier {
+            self.ends_at_rapier = true;
+            self.end_at_rapier();
+        }
         self.prev = self.pose;
         self.soft_load = (Vector3::zeros(), self.soft_load.0);
         self.held = false;
@@ -275,13 +305,32 @@ impl BodyProxy {
             return;
         }
         self.frac = frac;
-        let t = frac * self.dt;
-        let com = self.com_start
-            + self.v_start * t
-            + (self.v_end - self.v_start) * (0.5 * t * (t + self.h) / self.dt)
-            + self.dx;
+        let com = self.base_com(frac * self.dt) + self.dx;
         let rot = self.dq * self.rot_start.nlerp(&self.rot_end, frac);
         self.pose = Isometry3::from_parts(Translation3::from(com - rot * self.com_local), rot);
+    }
+
+    /// The centre of mass on the base path at time `t` of the frame, s (module docs).
+    fn base_com(&self, t: f32) -> Vector3<f32> {
+        self.com_start
+            + self.v_start * t
+            + (self.v_end - self.v_start) * (0.5 * t * (t + self.h) / self.dt)
+    }
+
+    /// Takes a miss of rapier's end centre of mass that the smooth accelerations do not
+    /// explain as a velocity change at the frame's start (module docs).
+    fn end_at_rapier(&mut self) {
+        if !matches!(self.kind, BodyKind::Dynamic | BodyKind::Supported) {
+            return;
+        }
+        let miss = self.com_end - self.base_com(self.dt);
+        let explained = self.smooth_accel * self.dt * self.dt;
+        let len = miss.norm();
+        if len.is_finite() && len > explained {
+            let dv = miss / self.dt;
+            self.v_start += dv;
+            self.v_end += dv;
+        }
     }
 
     /// Poses before and after rapier's step (no soft offsets).

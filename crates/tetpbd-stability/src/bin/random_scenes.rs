@@ -1,0 +1,351 @@
+//! `cargo run --release -p tetpbd-stability --bin random_scenes [-- --scenes N]`
+//!
+//! Seeded random coupled scenes at default settings, a search for failures outside the
+//! suite's cases: soft bodies of random size, aspect, density, mesh split, families (the
+//! seed's combinations, hard and compliant), speed, pose and spin dropped on a wide fixed
+//! ground, on dynamic boxes of random mass, on each other, and rigid cubes of random mass
+//! and speed thrown at them. Each scene runs 4 s and is flagged when a step errs or the
+//! energy goes non-finite, the total mechanical energy (kinetic + gravitational, soft and
+//! rigid) rises more than 1 % of its scale, a soft particle ends more than 3 cm below the
+//! ground, anything moves faster than 1.2 × what the start's speed and height allow (+5 m/s),
+//! or anything still moves faster than 5 cm/s in the last second. A report, not a test: it
+//! prints one line per scene and the count of each flag. `--scene K` runs one scene,
+//! `--trace` prints it frame by frame, `--substeps` and `--family` override the draw.
+
+use nalgebra::{UnitQuaternion, Vector3};
+use rapier3d::math::Vector;
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
+use tetpbd::generators::{self, CellSplit};
+use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
+use tetpbd_rapier::{CoupledWorld, CouplingSettings};
+
+/// Options of the command line.
+#[derive(clap::Parser, Debug)]
+#[command(about = "Seeded random coupled scenes at default settings, flagged when they misbehave")]
+struct Options {
+    /// Number of scenes (seeds 0..N).
+    #[arg(long, default_value_t = 40)]
+    scenes: u64,
+    /// Run only this scene.
+    #[arg(long)]
+    scene: Option<u64>,
+    /// Override the drawn substep count.
+    #[arg(long)]
+    substeps: Option<u32>,
+    /// Override the drawn family combination: 0 hard edges + volume, 1 compliant edges +
+    /// volume, 2 hard edges + vertex–face, 3 compliant vertex–face + hard volume.
+    #[arg(long)]
+    family: Option<u64>,
+    /// Print the chosen scene frame by frame.
+    #[arg(long)]
+    trace: bool,
+}
+
+/// A small deterministic generator (SplitMix64).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in `[a, b)`.
+    fn range(&mut self, a: f32, b: f32) -> f32 {
+        a + (b - a) * ((self.next() >> 40) as f32 / (1u64 << 24) as f32)
+    }
+    /// Log-uniform in `[a, b)`.
+    fn log(&mut self, a: f32, b: f32) -> f32 {
+        (self.range(a.ln(), b.ln())).exp()
+    }
+    fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
+        xs[(self.next() % xs.len() as u64) as usize]
+    }
+}
+
+/// What a scene measured.
+#[derive(Debug, Default)]
+struct Outcome {
+    /// Largest rise of the total mechanical energy (kinetic + gravitational) over its
+    /// start, J.
+    gain: f32,
+    /// The start's total mechanical energy scale (kinetic + m g size), J.
+    scale: f32,
+    /// Lowest soft particle at the end, m (the ground's top is at 0).
+    lowest_end: f32,
+    /// Fastest soft particle or rigid body over the last second, m/s.
+    end_speed: f32,
+    /// Fastest anything moved after the first frames, m/s.
+    fastest: f32,
+    /// Fastest anything could move from the scene's start: its largest speed and a fall
+    /// from its highest point, m/s.
+    start_speed: f32,
+    /// First error a step returned.
+    error: Option<String>,
+}
+
+/// Kinetic + gravitational energy of everything (J) and the fastest speed (m/s).
+fn energy(s: &CoupledWorld) -> (f32, f32) {
+    let (mut e, mut fastest) = (0.0f64, 0.0f32);
+    for p in s.soft.query::<&Particles>().iter() {
+        e += f64::from(p.kinetic_energy());
+        for (x, m) in p.positions().iter().zip(p.masses()) {
+            e += f64::from(m * 9.81 * x.y);
+        }
+        fastest = fastest.max(p.max_speed());
+    }
+    for (_, b) in s.physics.bodies.iter() {
+        if b.is_dynamic() {
+            let v = b.linvel().length();
+            e += f64::from(0.5 * b.mass() * v * v + b.mass() * 9.81 * b.translation().y);
+            let w = b.angvel();
+            let i = b.mass_properties().effective_angular_inertia();
+            let iw = i * w;
+            e += f64::from(0.5 * w.dot(iw));
+            fastest = fastest.max(v);
+        }
+    }
+    (e as f32, fastest)
+}
+
+/// A soft body of random size, density, mesh and families.
+fn random_body(
+    rng: &mut Rng,
+    at: Vector3<f32>,
+    v: Vector3<f32>,
+    family: Option<u64>,
+) -> (SoftBodyBuilder, f32, String) {
+    let size = rng.log(0.1, 1.2);
+    let cells = rng.pick(&[2u32, 3, 4]);
+    let split = rng.pick(&[CellSplit::Five, CellSplit::Six]);
+    let aspect = Vector3::new(
+        rng.range(0.5, 1.5),
+        rng.range(0.5, 1.5),
+        rng.range(0.5, 1.5),
+    );
+    let dims = aspect * size;
+    let mesh = generators::box_grid(dims, [cells; 3], split).expect("mesh");
+    let density = rng.log(20.0, 3000.0);
+    let mut b = SoftBodyBuilder::new(mesh)
+        .density(density)
+        .translation(at + Vector3::y() * (0.5 * dims.max()))
+        .rotation(UnitQuaternion::from_euler_angles(
+            rng.range(-3.1, 3.1),
+            rng.range(-3.1, 3.1),
+            rng.range(-3.1, 3.1),
+        ))
+        .velocity(v)
+        .angular_velocity(Vector3::new(
+            rng.range(-5.0, 5.0),
+            rng.range(-5.0, 5.0),
+            0.0,
+        ));
+    let fam = rng.next() % 4;
+    let fam = family.unwrap_or(fam);
+    let desc = format!("[{cells}³ {split:?} fam {fam} ρ {density:.0}]");
+    b = match fam {
+        0 => b.edges(0.0).volume(0.0),
+        1 => b.edges(rng.log(1e-7, 1e-4)).volume(rng.log(1e-10, 1e-7)),
+        2 => b.edges(0.0).vertex_face(0.0),
+        _ => b.vertex_face(rng.log(1e-7, 1e-5)).volume(0.0),
+    };
+    (b, dims.max(), desc)
+}
+
+/// One random scene `k`: builds it, runs 4 s and measures.
+fn run_scene(k: u64, o: &Options) -> (String, Outcome) {
+    let mut rng = Rng(0x5EED_0000 + k);
+    let substeps = rng.pick(&[2u32, 5, 10, 20, 40]);
+    let substeps = std::env::var("SUBSTEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(substeps);
+    let solver = SolverSettings {
+        substeps,
+        ..SolverSettings::default()
+    };
+    let mut s = CoupledWorld::new(solver, CouplingSettings::default()).expect("settings");
+    s.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
+        ColliderBuilder::cuboid(500.0, 0.5, 500.0),
+    );
+    let kind = rng.next() % 4;
+    let mut what = format!("scene {k}: {substeps} substeps, ");
+    let mut top = 0.0f32;
+    let mut start_speed = 0.0f32;
+    let mut boxes: Vec<RigidBodyHandle> = Vec::new();
+    if kind == 1 {
+        // A dynamic box on the ground under the soft body.
+        let half = rng.log(0.1, 0.6);
+        let mass = rng.log(0.1, 1000.0);
+        let (h, _) = s.physics.insert(
+            RigidBodyBuilder::dynamic().translation(Vector::new(0.0, half, 0.0)),
+            ColliderBuilder::cuboid(half, half, half).mass(mass),
+        );
+        boxes.push(h);
+        top = 2.0 * half;
+        what += &format!("box {mass:.2} kg half {half:.2} m, ");
+    }
+    let bodies = if kind == 2 { 2 + rng.next() % 3 } else { 1 };
+    let mut scale_size = 0.0f32;
+    for i in 0..bodies {
+        let speed = if kind == 2 {
+            rng.range(0.0, 5.0)
+        } else {
+            rng.log(0.1, 80.0)
+        };
+        start_speed = start_speed.max(speed);
+        let dir = Vector3::new(rng.range(-0.5, 0.5), -1.0, rng.range(-0.5, 0.5)).normalize();
+        let at = Vector3::new(
+            rng.range(-0.1, 0.1),
+            top + 0.05 + rng.range(0.0, 0.5),
+            rng.range(-0.1, 0.1),
+        );
+        let (b, size, desc) = random_body(&mut rng, at, dir * speed, o.family);
+        b.build().expect("body").spawn(&mut s.soft);
+        what += &format!("body {i} {size:.2} m {desc} at {speed:.1} m/s, ");
+        top = at.y + 1.8 * size;
+        scale_size = scale_size.max(size);
+    }
+    if kind == 3 {
+        // A rigid projectile (a cube) of random mass and speed.
+        let r = rng.log(0.03, 0.3);
+        let mass = rng.log(0.1, 300.0);
+        let speed = rng.log(1.0, 150.0);
+        start_speed = start_speed.max(speed);
+        let (h, _) = s.physics.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(rng.range(-0.1, 0.1), top + r + 0.3, 0.0))
+                .linvel(Vector::new(0.0, -speed, 0.0)),
+            ColliderBuilder::cuboid(r, r, r).mass(mass),
+        );
+        boxes.push(h);
+        what += &format!("cube {mass:.1} kg half {r:.2} m at {speed:.0} m/s, ");
+        top += 2.0 * r + 0.3;
+    }
+    let (e0, _) = energy(&s);
+    let mass: f32 = s
+        .soft
+        .query::<&Particles>()
+        .iter()
+        .map(|p| p.total_mass())
+        .sum::<f32>()
+        + boxes
+            .iter()
+            .map(|&h| s.physics.bodies[h].mass())
+            .sum::<f32>();
+    let ke0: f32 = {
+        let (e, _) = energy(&s);
+        e
+    };
+    let trace = o.trace;
+    let mut o = Outcome {
+        scale: ke0.abs() + mass * 9.81 * (scale_size + top),
+        start_speed: (start_speed * start_speed + 2.0 * 9.81 * (top + scale_size)).sqrt(),
+        lowest_end: f32::INFINITY,
+        ..Outcome::default()
+    };
+    let frames = 240;
+    for f in 0..frames {
+        if let Err(err) = s.step() {
+            o.error = Some(format!("frame {f}: {err}"));
+            return (what, o);
+        }
+        let (e, fastest) = energy(&s);
+        if !e.is_finite() {
+            o.error = Some(format!("frame {f}: energy {e}"));
+            return (what, o);
+        }
+        o.gain = o.gain.max(e - e0);
+        if trace {
+            let speeds: Vec<String> = s
+                .soft
+                .query::<&Particles>()
+                .iter()
+                .map(|p| {
+                    let c = p.center_of_mass();
+                    let v = p.linear_momentum() / p.total_mass();
+                    format!(
+                        "{:.2} v {:.2} @ {:.2} {:.2} {:.2}",
+                        p.max_speed(),
+                        v.norm(),
+                        c.x,
+                        c.y,
+                        c.z
+                    )
+                })
+                .collect();
+            let rigid: Vec<String> = boxes
+                .iter()
+                .map(|&h| {
+                    let b = &s.physics.bodies[h];
+                    format!("{:.2}@{:.2}", b.linvel().length(), b.translation().y)
+                })
+                .collect();
+            println!("frame {f}: E {:.1} soft {speeds:?} rigid {rigid:?}", e - e0);
+        }
+        if f > 2 {
+            o.fastest = o.fastest.max(fastest);
+        }
+        if f >= frames - 60 {
+            o.end_speed = o.end_speed.max(fastest);
+        }
+    }
+    for p in s.soft.query::<&Particles>().iter() {
+        o.lowest_end = o.lowest_end.min(p.aabb().0.y);
+    }
+    (what, o)
+}
+
+fn main() {
+    let opts = <Options as clap::Parser>::parse();
+    let names = [
+        "error",
+        "energy gain",
+        "below ground",
+        "moving at 4 s",
+        "launched",
+    ];
+    let mut counts = [0usize; 5];
+    let mut flagged = 0usize;
+    let mut run = 0usize;
+    for k in (0..opts.scenes).filter(|k| opts.scene.is_none_or(|o| o == *k)) {
+        let (what, o) = run_scene(k, &opts);
+        let flags = [
+            o.error.is_some(),
+            o.gain > 1e-2 * o.scale + 1e-3,
+            o.lowest_end < -0.03,
+            o.end_speed > 0.05,
+            o.fastest > 1.2 * o.start_speed + 5.0,
+        ];
+        let found: Vec<&str> = names
+            .iter()
+            .zip(flags)
+            .filter(|(_, f)| *f)
+            .map(|(n, _)| *n)
+            .collect();
+        for (c, f) in counts.iter_mut().zip(flags) {
+            *c += usize::from(f);
+        }
+        run += 1;
+        flagged += usize::from(!found.is_empty());
+        println!(
+            "{} {what}gain {:.2e} of {:.2e} J, lowest {:.3} m, end speed {:.3} m/s, fastest {:.1} of {:.1} m/s{}{}",
+            if found.is_empty() { "ok  " } else { "FLAG" },
+            o.gain,
+            o.scale,
+            o.lowest_end,
+            o.end_speed,
+            o.fastest,
+            o.start_speed,
+            if found.is_empty() { String::new() } else { format!(" {found:?}") },
+            o.error.map_or(String::new(), |e| format!(" ({e})")),
+        );
+    }
+    println!("{flagged} of {run} scenes flagged");
+    for (n, c) in names.iter().zip(counts) {
+        println!("  {n}: {c}");
+    }
+}
