@@ -4,8 +4,9 @@
 //! What a user touches: [`SoftBodyBuilder`] turns a [`TetMesh`] (from a file or a
 //! [`generators`] function) into components — [`Particles`] (flat arrays per quantity),
 //! [`Tetrahedra`], [`Surface`] and one optional component per constraint family
-//! ([`EdgeConstraints`], [`VertexFaceConstraints`], [`VolumeConstraints`]): a body pays only
-//! for the families it has. A [`Solver`] steps every body of a `hecs::World` with
+//! ([`EdgeConstraints`], [`VertexFaceConstraints`], [`VolumeConstraints`]) and optionally a
+//! physical [`Material`] (Young's modulus, Poisson's ratio) as the [`NeoHookeanMaterial`]
+//! component: a body pays only for the families it has. A [`Solver`] steps every body of a `hecs::World` with
 //! [`SolverSettings`], runs a [`SubstepHook`] (contacts, attachments of a coupling crate)
 //! inside its substep loop and returns [`StepStats`]. Interaction: impulses on
 //! [`Particles`] (`apply_impulse`, `apply_impulse_at_point`, `apply_radial_impulse`), forces
@@ -21,7 +22,7 @@
 //! | folder | holds |
 //! |---|---|
 //! | `body/` | the builder, the mesh generators and the components |
-//! | `constraints/` | one file per constraint (`edge.rs`, `vertex_face.rs`, `vertex_face_bounded.rs`, `volume.rs`) and the XPBD update (`xpbd.rs`) |
+//! | `constraints/` | one file per constraint (`edge.rs`, `vertex_face.rs`, `vertex_face_bounded.rs`, `volume.rs`, `neo_hookean.rs`) and the XPBD update (`xpbd.rs`) |
 //! | `solver/` | settings, the hook, the statistics, the systems, and `step.rs`, where a frame and each substep start |
 //! | `stabilisation/` | the rigid fit of a body, the angular-momentum conservation, the safety net's momentum restoration, the deformation damping, the ground-up sweep for heavy loads |
 //! | `kernels/` | the scalar and SIMD projections and the working copy of the particles they run on |
@@ -64,8 +65,10 @@ pub use body::forces::{applied_acceleration, UserForces};
 pub use body::generators;
 pub use body::grab::Grab;
 pub use body::impulses::PointImpulse;
+pub use body::material::{Material, MaterialError};
 pub use body::material_point::MaterialPoint;
 pub use body::mesh::{Surface, Tetrahedra};
+pub use body::neo_hookean::NeoHookeanMaterial;
 pub use body::particles::{ExternalAcceleration, Particles};
 pub use body::placement::Placement;
 pub use body::plasticity::{Plasticity, PlasticitySettings, VOLUME_PRESERVING_TOLERANCE};

@@ -390,7 +390,7 @@ fn reset_gives_back_the_built_rest_state() {
                 Option<&mut EdgeConstraints>,
             )>(e)
             .unwrap();
-        assert!(plastic.reset(p, t, vf, edges));
+        assert!(plastic.reset(p, t, vf, edges, None));
         assert_eq!(
             world.get::<&EdgeConstraints>(e).unwrap().rest_lengths(),
             &built_edges[..]

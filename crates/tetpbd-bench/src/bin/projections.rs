@@ -4,7 +4,9 @@
 //! cargo run --release -p tetpbd-bench --bin projections [-- --cells N --repeats R --shuffle --spatial-order on|off|both --simd-only]
 //! ```
 //!
-//! Each family is measured alone (a body with only that family's component), as full
+//! Each family is measured alone (a body with only that family's component), and the
+//! Neo-Hookean material (`neo-hookean`, `Material::SOFT_TISSUE`; one projection is a
+//! tetrahedron's two coupled constraints; scalar kernel only, run also with `--simd-only`), as full
 //! Gauss–Seidel sweeps of the family's system over a slightly perturbed grid so every
 //! projection does real work. Prints the median and the spread over the repeats.
 //!
@@ -17,7 +19,7 @@ use std::time::Instant;
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, shuffled, CellSplit};
 use tetpbd::systems::{self, Kernel};
-use tetpbd::{Particles, SoftBodyBuilder};
+use tetpbd::{Material, Particles, SoftBodyBuilder};
 use tetpbd_bench::{arg, flag, orders, perturb};
 
 fn median(v: &mut [f64]) -> f64 {
@@ -46,6 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .into_iter()
         .flat_map(|f| [(f, Kernel::Scalar), (f, Kernel::Simd)])
         .filter(|(_, k)| *k == Kernel::Simd || !flag("--simd-only"))
+        .chain([("neo-hookean", Kernel::Scalar)])
         .flat_map(|(f, k)| orders().into_iter().map(move |o| (f, k, o)))
     {
         let mut world = hecs::World::new();
@@ -55,6 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let b = match family {
             "edge" => b.edges(1e-6),
             "volume" => b.volume(1e-9),
+            "neo-hookean" => b.material(Material::SOFT_TISSUE),
             _ => b.vertex_face(1e-6),
         };
         let e = b.build()?.spawn(&mut world);
@@ -78,6 +82,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let c = match family {
                     "edge" => systems::project_edges_with(&mut world, h, kernel),
                     "volume" => systems::project_volume_with(&mut world, h, kernel),
+                    "neo-hookean" => systems::project_neo_hookean(&mut world, h),
                     _ => systems::project_vertex_face_with(&mut world, h, kernel),
                 };
                 n += c.applied + c.degenerate;

@@ -41,6 +41,8 @@ pub struct SoftBody {
     pub volume: Option<VolumeConstraints>,
     /// Plastic flow, if chosen.
     pub plasticity: Option<crate::Plasticity>,
+    /// Neo-Hookean material, if chosen ([`SoftBodyBuilder::material`]).
+    pub material: Option<crate::NeoHookeanMaterial>,
 }
 
 impl SoftBody {
@@ -60,6 +62,9 @@ impl SoftBody {
         }
         if let Some(p) = self.plasticity {
             b.add(p);
+        }
+        if let Some(m) = self.material {
+            b.add(m);
         }
         world.spawn(b.build())
     }
@@ -82,6 +87,7 @@ pub struct SoftBodyBuilder {
     vertex_face: Option<f32>,
     volume: Option<f32>,
     plasticity: Option<crate::PlasticitySettings>,
+    material: Option<crate::Material>,
     pinned: Vec<u32>,
     placement: Placement,
     epsilon: f32,
@@ -107,6 +113,7 @@ impl SoftBodyBuilder {
             vertex_face: None,
             volume: None,
             plasticity: None,
+            material: None,
             pinned: Vec::new(),
             placement: Placement::default(),
             epsilon: Self::DEFAULT_EPSILON,
@@ -149,6 +156,14 @@ impl SoftBodyBuilder {
     /// Checked by [`Self::build`] ([`BuildError::Plasticity`]).
     pub fn plasticity(mut self, settings: crate::PlasticitySettings) -> Self {
         self.plasticity = Some(settings);
+        self
+    }
+
+    /// Gives the body a continuum material ([`crate::NeoHookeanMaterial`]): stable
+    /// Neo-Hookean with Young's modulus and Poisson's ratio in physical units, stiffness
+    /// independent of the mesh resolution. Alone or with any of the families.
+    pub fn material(mut self, material: crate::Material) -> Self {
+        self.material = Some(material);
         self
     }
 
@@ -240,6 +255,7 @@ impl SoftBodyBuilder {
             vertex_face,
             volume,
             plasticity,
+            material,
             pinned,
             placement,
             epsilon,
@@ -291,6 +307,14 @@ impl SoftBodyBuilder {
             lambdas: vec![0.0; mesh.tets.len()],
             compliance: alpha,
         });
+        let tetrahedra = Tetrahedra {
+            indices: mesh.tets,
+            rest_volumes,
+            source,
+            classes: tet_classes,
+        };
+        let material =
+            material.map(|m| crate::NeoHookeanMaterial::new(m, &tetrahedra, &mesh.vertices));
         let mut body = SoftBody {
             particles: Particles {
                 prev_positions: positions.clone(),
@@ -306,17 +330,13 @@ impl SoftBodyBuilder {
                 written: false,
                 hook: Default::default(),
             },
-            tetrahedra: Tetrahedra {
-                indices: mesh.tets,
-                rest_volumes,
-                source,
-                classes: tet_classes,
-            },
+            tetrahedra,
             surface,
             edges,
             vertex_face,
             volume,
             plasticity: None,
+            material,
         };
         if let Some(settings) = plasticity {
             let (p, t, e) = (&body.particles, &body.tetrahedra, body.edges.as_ref());

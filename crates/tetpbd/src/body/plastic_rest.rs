@@ -10,6 +10,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints};
 use crate::body::mesh::Tetrahedra;
+use crate::body::neo_hookean::NeoHookeanMaterial;
 use crate::body::plasticity::{built_edge_matrix, Plasticity};
 use crate::constraints::{bounded_height, signed_volume, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
 
@@ -21,11 +22,13 @@ pub(crate) struct RestState<'a> {
     pub vertex_face: Option<&'a mut VertexFaceConstraints>,
     /// Edge rest lengths, if the body has the family.
     pub edges: Option<&'a mut EdgeConstraints>,
+    /// The material's inverse rest shapes `Dₜ⁻¹`, if the body has one.
+    pub material: Option<&'a mut NeoHookeanMaterial>,
 }
 
 impl RestState<'_> {
-    /// Sets the rest values of tetrahedron `t`'s own constraints (its rest volume and its
-    /// four vertex–face rest heights) to its rest shape `stretch · D⁰ₜ` (see
+    /// Sets the rest values of tetrahedron `t`'s own constraints (its rest volume, its
+    /// four vertex–face rest heights and the material's `Dₜ⁻¹`) to its rest shape `stretch · D⁰ₜ` (see
     /// [`crate::Plasticity`]); an identity stretch gives back the built values bit for bit.
     pub fn refresh_tetrahedron(
         &mut self,
@@ -43,10 +46,13 @@ impl RestState<'_> {
         } else {
             (stretch.determinant() * f64::from(v0)) as f32
         };
+        let dm = stretch * built_edge_matrix(tet, rest_positions);
+        if let Some(m) = self.material.as_deref_mut() {
+            m.set_rest_shape(t, tet, &dm, identity, rest_positions);
+        }
         let Some(vf) = self.vertex_face.as_deref_mut() else {
             return;
         };
-        let dm = stretch * built_edge_matrix(tet, rest_positions);
         let q = [
             Vector3::zeros(),
             dm.column(0).into_owned(),

@@ -254,6 +254,7 @@ impl Plasticity {
         tetrahedra: &mut Tetrahedra,
         vertex_face: Option<&mut crate::VertexFaceConstraints>,
         edges: Option<&mut EdgeConstraints>,
+        material: Option<&mut crate::NeoHookeanMaterial>,
     ) -> bool {
         let vf_fits = vertex_face
             .as_ref()
@@ -269,6 +270,7 @@ impl Plasticity {
             tetrahedra,
             vertex_face,
             edges,
+            material,
         };
         rest.refresh_all(self, rest_positions);
         true

@@ -19,7 +19,8 @@
 //! Lagrange multiplier, reset to zero at the start of every substep. With `α = 0` this is
 //! the hard PBD projection of Müller et al. 2006, which removes `C` to first order in one
 //! step. The potential energy behind a compliant constraint is `U = C² / (2α)`, so `α` has the
-//! units of `C² / J`: m/N for the two length constraints and the grab, m⁵/N for the volume constraint.
+//! units of `C² / J`: m/N for the two length constraints and the grab, m⁵/N for the volume constraint, 1/J for
+//! the Neo-Hookean material's dimensionless constraints.
 //!
 //! # Where each constraint lives
 //!
@@ -28,6 +29,9 @@
 //!   [`vertex_face_bounded()`], the degeneracy-aware form the solver runs
 //!   (`vertex_face_bounded.rs`);
 //! * [`volume()`] — signed volume (`volume.rs`);
+//! * [`neo_hookean_deviatoric`] and [`neo_hookean_hydrostatic`] — the stable Neo-Hookean
+//!   material's two constraints per tetrahedron, solved together by
+//!   [`neo_hookean_update`] (`neo_hookean.rs`);
 //! * [`grab()`] — a material point held to a target with a bounded force (`grab.rs`);
 //! * [`xpbd_delta_lambda`], [`bounded_step`] and [`apply()`] — the XPBD update (`xpbd.rs`).
 
@@ -35,6 +39,7 @@ use nalgebra::{RealField, Vector3};
 
 mod edge;
 mod grab;
+mod neo_hookean;
 mod vertex_face;
 mod vertex_face_bounded;
 mod volume;
@@ -42,6 +47,11 @@ mod xpbd;
 
 pub use edge::edge;
 pub use grab::{grab, grab_delta_lambda};
+pub use neo_hookean::{
+    cofactor, deformation_gradient, neo_hookean_deviatoric, neo_hookean_energy_density,
+    neo_hookean_hydrostatic, neo_hookean_rest_offset, neo_hookean_stress, neo_hookean_update,
+    rest_shape_inverse, NeoHookeanUpdate,
+};
 pub use vertex_face::{
     signed_height, vertex_face, vertex_face_step_bound, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER,
 };

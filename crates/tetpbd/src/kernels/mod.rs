@@ -14,6 +14,7 @@ pub(crate) mod compensated;
 pub(crate) mod count;
 pub(crate) mod lane_types;
 pub(crate) mod lanes;
+pub(crate) mod neo_hookean;
 pub(crate) mod particle_runs;
 pub(crate) mod scalar;
 pub(crate) mod slots;

@@ -59,20 +59,21 @@ pub(crate) enum CopyMode {
 }
 
 /// The bodies some family system sweeps: those with edges, or with tetrahedra and a
-/// vertex–face or volume family.
+/// vertex–face or volume family or a material.
 type Swept<'a> = (
     &'a mut Particles,
     Option<&'a EdgeConstraints>,
     Option<&'a Tetrahedra>,
     Option<&'a VertexFaceConstraints>,
     Option<&'a VolumeConstraints>,
+    Option<&'a crate::NeoHookeanMaterial>,
 );
 
 /// Runs `f` on every body a family system sweeps.
 pub(crate) fn for_each_swept(world: &mut World, mut f: impl FnMut(&mut Particles)) {
     let swept = world.query_mut::<Swept<'_>>();
-    for (p, e, t, vf, vol) in swept.without::<&crate::Asleep>() {
-        if e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some())) {
+    for (p, e, t, vf, vol, m) in swept.without::<&crate::Asleep>() {
+        if e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some() || m.is_some())) {
             f(p);
         }
     }

@@ -5,6 +5,7 @@
 //! (`Solver::substep`).
 
 pub(crate) mod hook;
+pub(crate) mod material_systems;
 pub(crate) mod non_finite;
 pub(crate) mod plastic_flow;
 pub(crate) mod settings;

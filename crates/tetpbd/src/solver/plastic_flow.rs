@@ -11,6 +11,7 @@ use nalgebra::Matrix3;
 use crate::body::activation::Asleep;
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints};
 use crate::body::mesh::Tetrahedra;
+use crate::body::neo_hookean::NeoHookeanMaterial;
 use crate::body::particles::Particles;
 use crate::body::plastic_rest::RestState;
 use crate::body::plasticity::{built_edge_matrix, Plasticity, PlasticitySettings};
@@ -29,8 +30,9 @@ pub fn flow_plastically(world: &mut World, dt: f32) -> usize {
         &mut Plasticity,
         Option<&mut VertexFaceConstraints>,
         Option<&mut EdgeConstraints>,
+        Option<&mut NeoHookeanMaterial>,
     )>();
-    for (p, tetrahedra, plastic, vertex_face, edges) in q.without::<&Asleep>() {
+    for (p, tetrahedra, plastic, vertex_face, edges, material) in q.without::<&Asleep>() {
         if !plastic.fits(tetrahedra, edges.as_deref()) {
             continue;
         }
@@ -38,6 +40,7 @@ pub fn flow_plastically(world: &mut World, dt: f32) -> usize {
             tetrahedra,
             vertex_face,
             edges,
+            material,
         };
         let settings = plastic.settings;
         let quick = quick_bound(settings.yield_strain);

@@ -88,6 +88,9 @@ pub struct StepStats {
     pub vertex_face: FamilyStats,
     /// Volume family.
     pub volume: FamilyStats,
+    /// The Neo-Hookean material ([`crate::NeoHookeanMaterial`]; `count` is its tetrahedra,
+    /// two constraints each; no error measure).
+    pub material: FamilyStats,
     /// Tetrahedra inverted at the end of the step (when measuring error).
     pub inverted: Option<usize>,
     /// Particles whose state became non-finite during the step and were reset to their
@@ -147,6 +150,9 @@ impl StepStats {
 
     /// Degenerate skips over all families.
     pub fn degenerate(&self) -> u64 {
-        self.edge.degenerate + self.vertex_face.degenerate + self.volume.degenerate
+        self.edge.degenerate
+            + self.vertex_face.degenerate
+            + self.volume.degenerate
+            + self.material.degenerate
     }
 }

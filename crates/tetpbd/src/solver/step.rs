@@ -316,6 +316,12 @@ impl Solver {
         let t = Instant::now();
         working_copy::load_bodies(world);
         stats.copy_time += t.elapsed();
+        let t = Instant::now();
+        let c =
+            crate::solver::material_systems::project_neo_hookean_in(world, h, CopyMode::Resident);
+        stats.material.time += t.elapsed();
+        stats.material.projections += c.applied;
+        stats.material.degenerate += c.degenerate;
         for family in s.order {
             let t = Instant::now();
             let c = systems::project_family(world, family, h, s.kernel, CopyMode::Resident);
@@ -383,6 +389,12 @@ fn count_constraints(world: &mut World, stats: &mut StepStats) {
     }
     for v in world.query_mut::<&VolumeConstraints>().without::<&Asleep>() {
         stats.volume.count += v.len();
+    }
+    for m in world
+        .query_mut::<&crate::NeoHookeanMaterial>()
+        .without::<&Asleep>()
+    {
+        stats.material.count += m.len();
     }
 }
 

@@ -26,6 +26,7 @@ pub use crate::kernels::particle_runs::VelocityUpdate;
 use crate::kernels::particle_runs::{PredictRun, VelocityRun};
 use crate::kernels::slots::WorkAccess;
 use crate::kernels::working_copy::{self, CopyMode};
+pub use crate::solver::material_systems::{project_neo_hookean, reset_neo_hookean};
 pub use crate::solver::plastic_flow::flow_plastically;
 use crate::solver::stats::{ErrorAccumulator, ErrorStats};
 pub use crate::stabilisation::deformation_damping::damp_deformation;
@@ -87,9 +88,11 @@ pub fn predict(
     restored
 }
 
-/// Sets every multiplier λ to zero (start of a substep), the [`crate::Grab`]s' too.
+/// Sets every multiplier λ to zero (start of a substep), the [`crate::Grab`]s' and the
+/// [`crate::NeoHookeanMaterial`]s' too.
 pub fn reset_lambdas(world: &mut World) {
     reset_grabs(world);
+    reset_neo_hookean(world);
     for e in world
         .query_mut::<&mut EdgeConstraints>()
         .without::<&Asleep>()

@@ -206,17 +206,18 @@ pub(crate) fn elastic_release(
 /// is set. Returns the number of bodies the limit acted on.
 pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: bool) -> u64 {
     let mut limited = 0;
-    for (p, e, t, vf, vol) in world
+    for (p, e, t, vf, vol, m) in world
         .query_mut::<(
             &mut crate::Particles,
             Option<&EdgeConstraints>,
             Option<&Tetrahedra>,
             Option<&VertexFaceConstraints>,
             Option<&VolumeConstraints>,
+            Option<&crate::NeoHookeanMaterial>,
         )>()
         .without::<&crate::Asleep>()
     {
-        if !(e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some()))) {
+        if !(e.is_some() || (t.is_some() && (vf.is_some() || vol.is_some() || m.is_some()))) {
             continue;
         }
         if !limit && !spin {
@@ -231,7 +232,8 @@ pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: b
             } else if hook >= gain {
                 hook
             } else {
-                hook + elastic_release([h, w_max], [work, gain - hook], e, t, vf, vol)
+                let material = m.map_or(0.0, crate::solver::material_systems::energy_budget);
+                hook + material + elastic_release([h, w_max], [work, gain - hook], e, t, vf, vol)
             }
         };
         if crate::stabilisation::angular_momentum::store_measured(p, h, spin, budget) {

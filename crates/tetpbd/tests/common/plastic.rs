@@ -5,8 +5,8 @@ use hecs::{Entity, World};
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{
-    EdgeConstraints, Particles, PlasticitySettings, SoftBodyBuilder, Solver, SolverSettings,
-    Tetrahedra, VertexFaceConstraints, VOLUME_PRESERVING_TOLERANCE,
+    EdgeConstraints, Material, NeoHookeanMaterial, Particles, PlasticitySettings, SoftBodyBuilder,
+    Solver, SolverSettings, Tetrahedra, VertexFaceConstraints, VOLUME_PRESERVING_TOLERANCE,
 };
 
 /// Edge compliance of the bars, m/N: soft enough that a frame sees the held shape's strain.
@@ -18,6 +18,13 @@ pub const VOLUME_COMPLIANCE: f32 = 1e-7;
 pub enum Families {
     EdgesVolume,
     EdgesVertexFace,
+    /// No family: the Neo-Hookean material [`bar_material`] alone.
+    Material,
+}
+
+/// The material of [`Families::Material`] bars: E = 5 MPa, ν = 0.3, damping 1 ms.
+pub fn bar_material() -> Material {
+    Material::new(5e6, 0.3).unwrap().with_damping(1e-3).unwrap()
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -39,12 +46,27 @@ pub fn spawn_bar(world: &mut World, bar: Bar, settings: Option<PlasticitySetting
     let b = match bar.families {
         Families::EdgesVolume => b.edges(EDGE_COMPLIANCE).volume(VOLUME_COMPLIANCE),
         Families::EdgesVertexFace => b.edges(EDGE_COMPLIANCE).vertex_face(EDGE_COMPLIANCE),
+        Families::Material => b.material(bar_material()),
     };
     let b = match settings {
         Some(s) => b.plasticity(s),
         None => b,
     };
     b.build().unwrap().spawn(world)
+}
+
+/// The substeps per 1/60 s frame a bar's material needs
+/// ([`NeoHookeanMaterial::max_stable_substep`]), at least 5.
+pub fn stable_substeps(bar: Bar) -> u32 {
+    let mut world = World::new();
+    let e = spawn_bar(&mut world, bar, None);
+    let material = world.get::<&NeoHookeanMaterial>(e).unwrap();
+    let (t, p) = (
+        world.get::<&Tetrahedra>(e).unwrap(),
+        world.get::<&Particles>(e).unwrap(),
+    );
+    let h = material.max_stable_substep(&t, &p);
+    ((1.0 / 60.0 / h).ceil() as u32).max(5)
 }
 
 pub fn solver(substeps: u32, damping: f32) -> Solver {

@@ -1,0 +1,168 @@
+//! The scalar kernel of the Neo-Hookean material: one coupled projection of a tetrahedron's
+//! two constraints on the working copy, and a sweep of one body in colour-class order.
+//!
+//! Per tetrahedron (theory in `constraints/neo_hookean.rs`): `F = Ds Dm⁻¹`, the two
+//! constraints and their gradients, the 2×2 coupled XPBD update with damping
+//! ([`constraints::neo_hookean_update`]), the move bounded to `√3/‖Dm⁻¹‖_F` (about one
+//! rest edge) so that a tetrahedron far from rest (inverted, crushed) recovers over a few
+//! projections instead of overshooting, and the elastic energy released since the substep
+//! start, for the energy limit.
+
+use nalgebra::{Matrix3, Vector3};
+use wide::f32x4;
+
+use crate::constraints::{self, Evaluated};
+use crate::kernels::count::ProjectionCount;
+use crate::kernels::slots::Slot;
+
+/// The per-body constants of a sweep.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MaterialStep {
+    /// `[1/(μ h²), 1/(λ' h²)]`, m³/(J·s²): `α̃ V₀` (divide by a tetrahedron's rest volume).
+    pub alpha_tilde_volume: [f32; 2],
+    /// `γ = 1 + μ/λ'`.
+    pub rest_offset: f32,
+    /// `β/h`, the XPBD damping factor.
+    pub damping: f32,
+    /// `h²`, s².
+    pub h2: f32,
+}
+
+impl MaterialStep {
+    /// The constants for `material` in a substep of length `h` (s).
+    pub fn new(material: &crate::Material, h: f32) -> Self {
+        let (mu, lambda) = material.lame();
+        let lp = lambda + mu;
+        let h2 = h * h;
+        MaterialStep {
+            alpha_tilde_volume: [1.0 / (mu * h2), 1.0 / (lp * h2)],
+            rest_offset: constraints::neo_hookean_rest_offset(mu, lp),
+            damping: material.damping() / h,
+            h2,
+        }
+    }
+}
+
+/// What one projection did: applied (with the energy it released, J) or degenerate.
+pub(crate) enum TetOutcome {
+    Applied(f32),
+    Degenerate,
+    Skipped,
+}
+
+#[inline(always)]
+fn xw(s: &Slot) -> (Vector3<f32>, f32) {
+    let [x, y, z, w] = s.xw.to_array();
+    (Vector3::new(x, y, z), w)
+}
+
+/// One coupled projection of the material of tetrahedron `tet`.
+#[inline]
+pub(crate) fn project_tet(
+    slots: &mut [Slot],
+    prev: &[Vector3<f32>],
+    tet: [u32; 4],
+    dm_inv: &Matrix3<f32>,
+    rest_volume: f32,
+    lambdas: &mut [f32; 2],
+    k: &MaterialStep,
+) -> TetOutcome {
+    let idx = tet.map(|i| i as usize);
+    let xw = idx.map(|i| xw(&slots[i]));
+    let w = xw.map(|(_, w)| w);
+    if w.iter().all(|&w| w == 0.0) {
+        return TetOutcome::Skipped;
+    }
+    let p = xw.map(|(x, _)| x);
+    let Some(d) = constraints::neo_hookean_deviatoric(&p, dm_inv) else {
+        return TetOutcome::Degenerate;
+    };
+    let y = constraints::neo_hookean_hydrostatic(&p, dm_inv, k.rest_offset);
+    let v0 = rest_volume.abs();
+    let at = k.alpha_tilde_volume.map(|a| a / v0);
+    let rate = if k.damping > 0.0 {
+        let moved: [Vector3<f32>; 4] = std::array::from_fn(|i| p[i] - prev[idx[i]]);
+        let r = |e: &Evaluated<f32, 4>| (0..4).fold(0.0f32, |s, i| s + e.grad[i].dot(&moved[i]));
+        [r(&d), r(&y)]
+    } else {
+        [0.0; 2]
+    };
+    let Some(up) = constraints::neo_hookean_update(&d, &y, w, *lambdas, at, k.damping, rate) else {
+        return TetOutcome::Degenerate;
+    };
+    let (mut dl, mut dx) = (up.delta_lambda, up.moves);
+    let longest = dx.iter().fold(0.0f32, |m, v| m.max(v.norm_squared()));
+    // The bound: about one rest edge (√3/‖Dm⁻¹‖_F is the edge of a right-angled corner).
+    let bound = 3.0 / dm_inv.norm_squared();
+    if longest > bound {
+        let s = (bound / longest).sqrt();
+        dl = dl.map(|x| x * s);
+        dx = dx.map(|v| v * s);
+    }
+    for i in 0..4 {
+        slots[idx[i]].add(f32x4::new([dx[i].x, dx[i].y, dx[i].z, 0.0]));
+    }
+    lambdas[0] += dl[0];
+    lambdas[1] += dl[1];
+    // The elastic energy released since the substep start x̄: U(x̄) − U(x + Δx), exactly,
+    // as the change from x̄ to x (the prediction and earlier projections) plus the change of
+    // this projection (`energy_change`).
+    let f = constraints::deformation_gradient(&p, dm_inv);
+    let ds =
+        |v: &[Vector3<f32>; 4]| Matrix3::from_columns(&[v[1] - v[0], v[2] - v[0], v[3] - v[0]]);
+    let back: [Vector3<f32>; 4] = std::array::from_fn(|i| prev[idx[i]] - p[i]);
+    let df_back = ds(&back) * dm_inv;
+    let to_start = energy_change(&f, &df_back, y.c, at, k.h2);
+    let projected = energy_change(&f, &(ds(&dx) * dm_inv), y.c, at, k.h2);
+    TetOutcome::Applied(to_start - projected)
+}
+
+/// `U(F + dF) − U(F)` (J) of one tetrahedron's constraints, `U = C_D²/(2α_D) + C_H²/(2α_H)`,
+/// `c_h = C_H(F)`, `at = α̃` and `h2 = h²` (`α = α̃ h²`). Without a difference of large numbers:
+/// `‖F + dF‖² − ‖F‖² = (2F + dF) : dF` and `det(F + dF) − det F = cof F : dF + F : cof dF +
+/// det dF`.
+#[inline(always)]
+fn energy_change(f: &Matrix3<f32>, df: &Matrix3<f32>, c_h: f32, at: [f32; 2], h2: f32) -> f32 {
+    let d_norm = (f * 2.0 + df).dot(df);
+    let d_det =
+        constraints::cofactor(f).dot(df) + f.dot(&constraints::cofactor(df)) + df.determinant();
+    d_norm / (2.0 * at[0] * h2) + d_det * (2.0 * c_h + d_det) / (2.0 * at[1] * h2)
+}
+
+/// One Gauss–Seidel sweep of a body's material on its working copy (`slots`), tetrahedra in
+/// solver order; `prev` are the substep's start positions (for the damping). Returns the
+/// counts and the elastic energy released since the substep start (J, summed over the
+/// tetrahedra, each taken when it was projected; negative where energy was stored).
+// The slices of one body's tetrahedra and material, and the constants: what a sweep takes.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn sweep(
+    slots: &mut [Slot],
+    prev: &[Vector3<f32>],
+    tets: &[[u32; 4]],
+    rest_volumes: &[f32],
+    rest_inverse: &[Matrix3<f32>],
+    lambdas: &mut [[f32; 2]],
+    k: &MaterialStep,
+) -> (ProjectionCount, f64) {
+    let mut count = ProjectionCount::default();
+    let mut released = 0.0f64;
+    for t in 0..tets.len() {
+        match project_tet(
+            slots,
+            prev,
+            tets[t],
+            &rest_inverse[t],
+            rest_volumes[t],
+            &mut lambdas[t],
+            k,
+        ) {
+            TetOutcome::Applied(e) => {
+                count.applied += 1;
+                released += f64::from(e);
+            }
+            TetOutcome::Degenerate => count.degenerate += 1,
+            TetOutcome::Skipped => {}
+        }
+    }
+    (count, released)
+}
