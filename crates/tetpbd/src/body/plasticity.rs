@@ -81,10 +81,8 @@ impl PlasticitySettings {
 /// - vertex–face rest heights ([`crate::VertexFaceConstraints`]): each corner's signed height
 ///   above its opposite face, corners at `0` and the columns of `Dₜ`;
 /// - edge rest lengths ([`crate::EdgeConstraints`]): the length of the edge in each incident
-///   tetrahedron's rest shape, averaged over those tetrahedra.
-///
-/// A family that needs a rest shape of its own (a material model's `Dₜ⁻¹`) reads it the
-/// same way, from [`Plasticity::rest_edge_matrix`].
+///   tetrahedron's rest shape, averaged over those tetrahedra;
+/// - the material's inverse rest shapes ([`crate::NeoHookeanMaterial`]): `Dₜ⁻¹`.
 ///
 /// # Flow rule
 ///
