@@ -98,27 +98,51 @@ fn coupled_only(filter: &str, configs: &[Config]) {
     }
 }
 
+/// The numerical stability matrix: every case of the suite under every configuration, written
+/// as a Markdown report.
+#[derive(clap::Parser)]
+#[command(name = "stability")]
+struct Args {
+    /// Where the report is written.
+    #[arg(long, default_value = "docs/stability.md")]
+    out: String,
+    /// Skip the long cases.
+    #[arg(long)]
+    fast: bool,
+    /// `SolverSettings::limit_correction_energy` off in every uncoupled scene.
+    #[arg(long)]
+    no_energy_limit: bool,
+    /// Run the sweeps over grid splits and substep counts under the safety net too.
+    #[arg(long)]
+    net_everywhere: bool,
+    /// Skip the coupled cases.
+    #[arg(long)]
+    no_coupled: bool,
+    /// Only the cases whose name contains this text (repeatable).
+    #[arg(long = "case", value_name = "TEXT")]
+    cases: Vec<String>,
+    /// Run only the coupled cases whose name contains TEXT ("" for all) and print them,
+    /// without writing the report.
+    #[arg(long, value_name = "TEXT", num_args = 0..=1, default_missing_value = "")]
+    coupled: Option<String>,
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().collect();
-    let out = args
-        .iter()
-        .position(|a| a == "--out")
-        .and_then(|i| args.get(i + 1).cloned())
-        .unwrap_or_else(|| "docs/stability.md".into());
-    let fast = args.iter().any(|a| a == "--fast");
-    let no_limit = args.iter().any(|a| a == "--no-energy-limit");
-    let net_everywhere = args.iter().any(|a| a == "--net-everywhere");
-    let no_coupled = args.iter().any(|a| a == "--no-coupled");
-    let filters: Vec<&str> = args
-        .windows(2)
-        .filter(|w| w[0] == "--case")
-        .map(|w| w[1].as_str())
-        .collect();
-    let wanted = |name: &str| filters.is_empty() || filters.iter().any(|f| name.contains(f));
+    let args = <Args as clap::Parser>::parse();
+    let Args {
+        out,
+        fast,
+        no_energy_limit: no_limit,
+        net_everywhere,
+        no_coupled,
+        cases: filters,
+        coupled,
+    } = args;
+    let wanted =
+        |name: &str| filters.is_empty() || filters.iter().any(|f| name.contains(f.as_str()));
     let configs = Config::all();
-    if let Some(i) = args.iter().position(|a| a == "--coupled") {
-        let filter = args.get(i + 1).map_or("", |s| s.as_str());
-        coupled_only(filter, &configs);
+    if let Some(filter) = coupled {
+        coupled_only(&filter, &configs);
         return Ok(());
     }
     let started = Instant::now();
