@@ -275,6 +275,30 @@ impl Plasticity {
     }
 }
 
+impl Plasticity {
+    /// The plastic state of a piece of this body (after a split): tetrahedron `k` of the
+    /// piece is tetrahedron `from[k]` of this body and keeps its plastic stretch; the edge
+    /// incidence is that of the piece's `tets` and `edges`.
+    pub(crate) fn for_piece(
+        &self,
+        from: &[u32],
+        tets: &[[u32; 4]],
+        edges: Option<&EdgeConstraints>,
+    ) -> Plasticity {
+        let (edge_offsets, edge_corners) = match edges {
+            Some(e) => edge_incidence(tets, &e.edges),
+            None => (Vec::new(), Vec::new()),
+        };
+        Plasticity {
+            settings: self.settings,
+            stretch: from.iter().map(|&t| self.stretch[t as usize]).collect(),
+            inv_rest: from.iter().map(|&t| self.inv_rest[t as usize]).collect(),
+            edge_offsets,
+            edge_corners,
+        }
+    }
+}
+
 /// `[r₁ − r₀, r₂ − r₀, r₃ − r₀]` of tetrahedron `tet` at `positions`, in `f64`, m.
 pub(crate) fn built_edge_matrix(tet: [u32; 4], positions: &[Vector3<f32>]) -> Matrix3<f64> {
     let p = tet.map(|i| positions[i as usize].cast::<f64>());

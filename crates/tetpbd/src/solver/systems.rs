@@ -29,6 +29,7 @@ use crate::kernels::working_copy::{self, CopyMode};
 pub use crate::solver::material_systems::{project_neo_hookean, reset_neo_hookean};
 pub use crate::solver::plastic_flow::flow_plastically;
 use crate::solver::stats::{ErrorAccumulator, ErrorStats};
+pub use crate::solver::tearing_pass::tear_by_strain;
 pub use crate::stabilisation::deformation_damping::damp_deformation;
 
 /// Saves `x` as the substep start, applies gravity plus each body's
