@@ -13,7 +13,7 @@ use crate::body::builder::{body_parts, edge_constraints, SoftBody, TetMesh};
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::body::forces::UserForces;
 use crate::body::mesh::{Surface, Tetrahedra};
-use crate::body::neo_hookean::NeoHookeanMaterial;
+use crate::body::neo_hookean::{NeoHookeanMaterial, ReleasedScratch};
 use crate::body::particles::Particles;
 use crate::body::plastic_rest::RestState;
 use crate::body::plasticity::Plasticity;
@@ -95,6 +95,7 @@ pub(crate) fn assemble(b: &SplitBody, particles: &[u32], tets: &[u32]) -> PieceP
         rest_inverse: from.iter().map(|t| m.rest_inverse[pick(t)]).collect(),
         lambdas: vec![[0.0; 2]; count],
         released: 0.0,
+        tet_released: ReleasedScratch(vec![0.0; count]),
     });
     let plasticity = b
         .plasticity

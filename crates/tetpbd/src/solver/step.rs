@@ -338,8 +338,12 @@ impl Solver {
         working_copy::load_bodies(world);
         stats.copy_time += t.elapsed();
         let t = Instant::now();
-        let c =
-            crate::solver::material_systems::project_neo_hookean_in(world, h, CopyMode::Resident);
+        let c = crate::solver::material_systems::project_neo_hookean_in(
+            world,
+            h,
+            s.kernel,
+            CopyMode::Resident,
+        );
         stats.material.time += t.elapsed();
         stats.material.projections += c.applied;
         stats.material.degenerate += c.degenerate;
