@@ -17,7 +17,7 @@
 //!   [`shapes`] generates the sample assets under `examples/assets/`.
 //! * The `tet_export` binary reads a `.msh` or `.node`/`.ele` mesh, hangs it from its highest
 //!   vertices under gravity and writes each frame as OBJ and VTU:
-//!   `cargo run -p tetpbd-io --bin tet_export -- mesh.node out/ 60`.
+//!   `cargo run -p tetpbd-io --features cli --bin tet_export -- mesh.node out/ --frames 60`.
 //!
 //! ```
 //! use tetpbd::SoftBodyBuilder;

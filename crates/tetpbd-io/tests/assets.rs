@@ -15,7 +15,7 @@ fn committed_assets_match_the_generator() {
         let committed = std::fs::read_to_string(assets_dir().join(name)).unwrap();
         assert!(
             committed == text,
-            "{name} differs from the generator: run `cargo run -p tetpbd-io --bin make_assets`"
+            "{name} differs from the generator: run `cargo run -p tetpbd-io --features cli --bin make_assets`"
         );
     }
 }

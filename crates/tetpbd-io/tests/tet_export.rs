@@ -20,7 +20,7 @@ fn exports_frames_and_reports_errors() {
         let run = Command::new(env!("CARGO_BIN_EXE_tet_export"))
             .arg(dir.join(input))
             .arg(&out)
-            .arg("3")
+            .args(["--frames", "3"])
             .output()
             .unwrap();
         let stdout = String::from_utf8_lossy(&run.stdout);
@@ -51,5 +51,15 @@ fn exports_frames_and_reports_errors() {
         stderr.contains(".node line 2: input ends after 1 of 4 point rows"),
         "{stderr}"
     );
+    // A bad option is named, not parsed as something else.
+    let run = Command::new(env!("CARGO_BIN_EXE_tet_export"))
+        .arg(dir.join("col.node"))
+        .arg(dir.join("unused"))
+        .arg("--compliance=-1")
+        .output()
+        .unwrap();
+    assert!(!run.status.success());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("--compliance"), "{stderr}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -2,7 +2,8 @@
 //! and writes every frame's surface (OBJ) and tetrahedra (VTU) to a folder.
 //!
 //! ```text
-//! tet_export <mesh.msh | mesh.node> <out_dir> [frames = 60] [edge compliance = 1e-6]
+//! cargo run -p tetpbd-io --features cli --bin tet_export -- <mesh.msh | mesh.node> <out_dir>
+//!     [--frames 60] [--compliance 1e-6]
 //! ```
 //!
 //! A `.node` file is read with the `.ele` file of the same stem; vertices no tetrahedron
@@ -20,14 +21,40 @@ use tetpbd_io::{
     write_tetrahedra_vtu,
 };
 
-const USAGE: &str =
-    "usage: tet_export <mesh.msh | mesh.node> <out_dir> [frames = 60] [edge compliance = 1e-6]";
+/// Options of the command line.
+#[derive(clap::Parser, Debug)]
+#[command(
+    about = "Hangs a tetrahedral mesh from its highest vertices under gravity and writes every \
+             frame's surface (OBJ) and tetrahedra (VTU)"
+)]
+struct Options {
+    /// The mesh: a Gmsh `.msh` file, or a TetGen `.node` file read with the `.ele` file of
+    /// the same stem.
+    mesh: PathBuf,
+    /// The folder the frames are written to (created if missing).
+    out_dir: PathBuf,
+    /// Frames to simulate, 1/60 s each (frame 0, the rest state, is written too).
+    #[arg(long, default_value_t = 60)]
+    frames: u32,
+    /// Compliance of the edge constraints, m/N (0 = hard).
+    #[arg(long, default_value_t = 1e-6, value_parser = non_negative)]
+    compliance: f32,
+}
+
+/// Parses a finite, non-negative number.
+fn non_negative(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        Ok(v) => Err(format!("{v} is not a finite, non-negative compliance")),
+        Err(e) => Err(e.to_string()),
+    }
+}
 
 fn read_mesh(path: &Path) -> Result<TetMesh, Box<dyn Error>> {
     match path.extension().and_then(|e| e.to_str()) {
         Some("msh") => Ok(read_msh_file(path)?),
         Some("node") => Ok(read_tetgen_files(path, path.with_extension("ele"))?),
-        _ => Err(format!("{}: expected a .msh or .node file\n{USAGE}", path.display()).into()),
+        _ => Err(format!("{}: expected a .msh or .node file", path.display()).into()),
     }
 }
 
@@ -45,14 +72,14 @@ fn top_vertices(mesh: &TetMesh) -> Vec<u32> {
         .collect()
 }
 
-fn run() -> Result<(), Box<dyn Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.len() < 2 || args.len() > 4 {
-        return Err(USAGE.into());
-    }
-    let frames: u32 = args.get(2).map_or(Ok(60), |s| s.parse())?;
-    let compliance: f32 = args.get(3).map_or(Ok(1e-6), |s| s.parse())?;
-    let read = read_mesh(Path::new(&args[0]))?;
+fn run(options: Options) -> Result<(), Box<dyn Error>> {
+    let Options {
+        mesh: input,
+        out_dir: out,
+        frames,
+        compliance,
+    } = options;
+    let read = read_mesh(&input)?;
     let (mesh, _) = drop_unreferenced_vertices(&read);
     if mesh.vertices.len() < read.vertices.len() {
         println!(
@@ -60,7 +87,6 @@ fn run() -> Result<(), Box<dyn Error>> {
             read.vertices.len() - mesh.vertices.len()
         );
     }
-    let out = PathBuf::from(&args[1]);
     std::fs::create_dir_all(&out)?;
     let pinned = top_vertices(&mesh);
     let mut world = World::new();
@@ -100,7 +126,8 @@ fn run() -> Result<(), Box<dyn Error>> {
 }
 
 fn main() {
-    if let Err(e) = run() {
+    let options = <Options as clap::Parser>::parse();
+    if let Err(e) = run(options) {
         eprintln!("tet_export: {e}");
         std::process::exit(1);
     }
