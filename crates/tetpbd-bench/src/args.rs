@@ -1,36 +1,44 @@
-//! Command-line helpers shared by the benchmark binaries.
+//! Command-line pieces shared by the benchmark binaries (each bin declares its own options
+//! with clap; these are the ones several of them take).
 
-/// The value after `name` on the command line parsed as a number, or `default`.
-pub fn arg(name: &str, default: usize) -> usize {
-    arg_str(name)
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
+/// The particle orders to measure (`--spatial-order`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SpatialOrder {
+    /// The builder's spatial particle order only.
+    On,
+    /// The mesh's own numbering only.
+    Off,
+    /// Both, one after the other.
+    Both,
 }
 
-/// The value after `name` on the command line, if any.
-pub fn arg_str(name: &str) -> Option<String> {
-    let mut args = std::env::args().skip_while(|a| a != name);
-    args.next()?;
-    args.next()
+/// The particle orders to measure for `choice`: both, one, or (`None`) the builder's default
+/// ([`tetpbd::SoftBodyBuilder::DEFAULT_SPATIAL_ORDER`]).
+pub fn orders(choice: Option<SpatialOrder>) -> Vec<bool> {
+    match choice {
+        Some(SpatialOrder::On) => vec![true],
+        Some(SpatialOrder::Off) => vec![false],
+        Some(SpatialOrder::Both) => vec![false, true],
+        None => vec![tetpbd::SoftBodyBuilder::DEFAULT_SPATIAL_ORDER],
+    }
 }
 
-/// `true` when `name` is on the command line.
-pub fn flag(name: &str) -> bool {
-    std::env::args().any(|a| a == name)
+/// The family sets the solver benchmarks measure (`--set`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FamilySet {
+    /// Edges + volume.
+    #[value(name = "edges+volume")]
+    EdgesVolume,
+    /// Vertex–face alone.
+    VertexFace,
 }
 
-/// The particle orders to measure, from `--spatial-order on|off|both` (default: the
-/// builder's default, [`tetpbd::SoftBodyBuilder::DEFAULT_SPATIAL_ORDER`]).
-pub fn orders() -> Vec<bool> {
-    let args: Vec<String> = std::env::args().collect();
-    let value = args
-        .iter()
-        .position(|a| a == "--spatial-order")
-        .and_then(|i| args.get(i + 1));
-    match value.map(String::as_str) {
-        Some("on") => vec![true],
-        Some("off") => vec![false],
-        Some("both") => vec![false, true],
-        _ => vec![tetpbd::SoftBodyBuilder::DEFAULT_SPATIAL_ORDER],
+impl FamilySet {
+    /// The name printed in reports (the value the command line takes).
+    pub fn name(self) -> &'static str {
+        match self {
+            FamilySet::EdgesVolume => "edges+volume",
+            FamilySet::VertexFace => "vertex-face",
+        }
     }
 }

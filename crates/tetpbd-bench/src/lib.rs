@@ -1,4 +1,4 @@
-//! Code shared by the tetpbd-bench binaries: command-line helpers (`projections`, `scaling`)
+//! Code shared by the tetpbd-bench binaries: command-line pieces (`projections`, `scaling`)
 //! and, for `error_vs_time` and `vs_rapier`, how rapier's built-in soft bodies are set up next
 //! to tetpbd's, the contact scenes (a soft cube dropped on rigid ground, a pile of nine cubes)
 //! in both engines, the observables measured the same way from either engine's particle
@@ -14,7 +14,7 @@ mod perturb;
 mod rapier_setup;
 mod xpbd64;
 
-pub use args::{arg, arg_str, flag, orders};
+pub use args::{orders, FamilySet, SpatialOrder};
 pub use clock::thread_cpu_ms;
 pub use contact_metrics::{
     interpenetration, observe_contact, run_contact, ContactObservables, ContactResult,

@@ -206,6 +206,12 @@ impl Coupling {
         &mut self.settings
     }
 
+    /// What the last step's tearing did ([`tetpbd::Solver::tear_events`]); the coupling's
+    /// components already follow the pieces ([`crate::follow_pieces`]).
+    pub fn tear_events(&self) -> &[tetpbd::TearEvent] {
+        self.solver.tear_events()
+    }
+
     /// The soft–rigid contacts of the last step; a sleeping soft body's are those it fell
     /// asleep on.
     pub fn contacts(&self) -> &[ContactReport] {
@@ -296,7 +302,13 @@ impl Coupling {
                 soft,
                 extra,
             };
-            self.solver.step_frame(world, dt, gravity, &mut hooks)?
+            let out = self.solver.step_frame(world, dt, gravity, &mut hooks);
+            // The coupling's components follow the pieces of the step's tears (also when
+            // the step reports a restored particle: the frame ran to its end).
+            for event in self.solver.tear_events() {
+                crate::pieces::follow_pieces(world, event);
+            }
+            out?
         };
         let mut stats = std::mem::take(&mut self.frame.stats);
         self.write_back(world, ctx.bodies, &mut stats);

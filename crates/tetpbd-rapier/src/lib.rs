@@ -82,6 +82,7 @@ mod heavy_loads;
 mod impact;
 mod joints;
 mod mesh_side;
+mod pieces;
 mod placement;
 pub mod prelude;
 mod queries;
@@ -100,6 +101,7 @@ pub use attachments::{AttachTarget, Attachment, Attachments};
 pub use context::RapierContext;
 pub use coupling::Coupling;
 pub use error::CouplingError;
+pub use pieces::follow_pieces;
 pub use placement::RapierPlacement;
 pub use queries::{
     QueryError, ScenePointProjection, SceneRayHit, SoftLocation, SoftPointProjection, SoftQueries,

@@ -11,9 +11,15 @@ pub enum ConstraintSet {
     VertexFace,
     /// Vertex–face + edge distance.
     VertexFaceEdges,
+    /// The Neo-Hookean material alone ([`tetpbd::Material`]): `soft` picks
+    /// [`tetpbd::Material::SOFT_TISSUE`], otherwise [`tetpbd::Material::RUBBER`] (E = 1.2 MPa,
+    /// ν = 0.49: the stiffest preset, nearly incompressible). Its substeps are chosen from
+    /// [`tetpbd::NeoHookeanMaterial::max_stable_substep`] ([`crate::run::substeps_for`]).
+    Material,
 }
 
-/// A constraint set with either hard (α = 0) or soft compliance.
+/// A constraint set with either hard (α = 0) or soft compliance (for the material: rubber or
+/// soft tissue).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Config {
     /// The families.
@@ -28,8 +34,20 @@ impl Config {
     /// Soft volume compliance, m⁵/N (α = V/K: K ≈ 7 MPa for the 1 m, 3³-cell cube's tetrahedra).
     pub const SOFT_VOLUME: f32 = 1e-9;
 
-    /// The six configurations of the matrix.
+    /// The eight configurations of the matrix: [`Config::families`] and the material's two.
     pub fn all() -> Vec<Config> {
+        let mut v = Self::families();
+        for soft in [false, true] {
+            v.push(Config {
+                set: ConstraintSet::Material,
+                soft,
+            });
+        }
+        v
+    }
+
+    /// The six configurations of the seed's families (the coupled cases run these).
+    pub fn families() -> Vec<Config> {
         let mut v = Vec::new();
         for set in [
             ConstraintSet::EdgesVolume,
@@ -45,16 +63,22 @@ impl Config {
 
     /// A short column label.
     pub fn label(&self) -> String {
+        if self.set == ConstraintSet::Material {
+            let preset = if self.soft { "soft tissue" } else { "rubber" };
+            return format!("material, {preset}");
+        }
         let set = match self.set {
             ConstraintSet::EdgesVolume => "edges+volume",
             ConstraintSet::VertexFace => "vertex-face",
             ConstraintSet::VertexFaceEdges => "vertex-face+edges",
+            ConstraintSet::Material => "material",
         };
         format!("{set}, {}", if self.soft { "soft" } else { "α=0" })
     }
 
     /// Adds this configuration's families to a builder; `scale` multiplies the compliances
-    /// (a case's "stiffest finite compliance" passes a tiny value with `soft`).
+    /// (a case's "stiffest finite compliance" passes a tiny value with `soft`). The material
+    /// has no compliance to scale: it keeps its preset's E and ν (its stiff case is rubber).
     pub fn apply(&self, b: SoftBodyBuilder, scale: f32) -> SoftBodyBuilder {
         let (l, v) = if self.soft {
             (Self::SOFT_LENGTH * scale, Self::SOFT_VOLUME * scale)
@@ -65,6 +89,8 @@ impl Config {
             ConstraintSet::EdgesVolume => b.edges(l).volume(v),
             ConstraintSet::VertexFace => b.vertex_face(l),
             ConstraintSet::VertexFaceEdges => b.vertex_face(l).edges(l),
+            ConstraintSet::Material if self.soft => b.material(tetpbd::Material::SOFT_TISSUE),
+            ConstraintSet::Material => b.material(tetpbd::Material::RUBBER),
         }
     }
 }

@@ -4,7 +4,8 @@
 //! The elastic energy of a family with compliance `α > 0` is `Σ C²/(2α)` (J; `C` in m for
 //! the edges and vertex–faces, α in m/N; `C` in m³ for the volumes, α in m⁵/N). Hard
 //! families (`α = 0`) hold no defined energy and count as 0: a hard body's energy is its
-//! kinetic and potential energy. The potential is `−Σ mᵢ g·xᵢ` (J). Without external work
+//! kinetic and potential energy. The Neo-Hookean material's is
+//! [`tetpbd::NeoHookeanMaterial::elastic_energy`]. The potential is `−Σ mᵢ g·xᵢ` (J). Without external work
 //! (pins do none: they do not move; a ground contact with restitution 0 only removes
 //! energy) this sum may only fall. The matrix compares kinetic + gravitational energy
 //! ([`motion`]) at every frame with the whole sum at the start: a rise above it is energy
@@ -15,7 +16,10 @@
 use hecs::{Entity, World};
 use nalgebra::Vector3;
 use tetpbd::constraint::{bounded_height, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
-use tetpbd::{EdgeConstraints, Particles, Tetrahedra, VertexFaceConstraints, VolumeConstraints};
+use tetpbd::{
+    EdgeConstraints, NeoHookeanMaterial, Particles, Tetrahedra, VertexFaceConstraints,
+    VolumeConstraints,
+};
 
 /// Elastic energy of the compliant families of body `e`, J.
 pub fn elastic(world: &World, e: Entity) -> f64 {
@@ -36,6 +40,9 @@ pub fn elastic(world: &World, e: Entity) -> f64 {
     let Ok(t) = world.get::<&Tetrahedra>(e) else {
         return u;
     };
+    if let Ok(m) = world.get::<&NeoHookeanMaterial>(e) {
+        u += m.elastic_energy(&t, x);
+    }
     if let Ok(f) = world.get::<&VolumeConstraints>(e) {
         let alpha = f.compliance();
         if alpha > 0.0 {

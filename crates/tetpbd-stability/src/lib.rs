@@ -24,4 +24,6 @@ pub use coupled::{coupled_cases, CoupledCase, CoupledOutcome};
 pub use coupled_rapier::rapier_comparison;
 pub use ground::Ground;
 pub use report::{markdown, verdict, Verdict};
-pub use run::{run_scene, run_scene_observed, FrameView, Outcome, Scene, Start};
+pub use run::{
+    run_scene, run_scene_observed, stable_substeps, substeps_for, FrameView, Outcome, Scene, Start,
+};

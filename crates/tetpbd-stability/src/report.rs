@@ -79,6 +79,9 @@ fn cell(config: &Config, o: &Outcome) -> String {
     if o.velocity_clamps > 0 {
         let _ = write!(s, ", clamps {}", o.velocity_clamps);
     }
+    if config.set == ConstraintSet::Material {
+        let _ = write!(s, ", {} substeps", o.substeps);
+    }
     s
 }
 

@@ -2,7 +2,8 @@
 
 use nalgebra::Vector3;
 use tetpbd::{
-    Particles, SoftBodyBuilder, Solver, SolverSettings, StateError, StepStats, TetMesh, Tetrahedra,
+    Particles, SoftBody, SoftBodyBuilder, Solver, SolverSettings, StateError, StepStats, TetMesh,
+    Tetrahedra,
 };
 
 use crate::config::Config;
@@ -110,6 +111,8 @@ pub struct Outcome {
     /// For a body thrown at the ground: its speed of approach and the largest upward speed
     /// of its centre of mass afterwards, m/s.
     pub rebound: Option<(f32, f32)>,
+    /// Substeps per frame the run used ([`substeps_for`]).
+    pub substeps: u32,
 }
 
 impl Outcome {
@@ -207,6 +210,40 @@ impl Start {
     }
 }
 
+/// The substeps per frame a body runs with: the scene's, or for a body with the Neo-Hookean
+/// material at least `dt / max_stable_substep` (as the README tells integrators to choose
+/// them: the material is explicit in shear).
+pub fn stable_substeps(body: &SoftBody, settings: &SolverSettings) -> u32 {
+    let Some(m) = &body.material else {
+        return settings.substeps;
+    };
+    let h = m.max_stable_substep(&body.tetrahedra, &body.particles);
+    let needed = (settings.dt / h).ceil();
+    if needed.is_finite() && needed >= 1.0 {
+        settings.substeps.max(needed.min(u32::MAX as f32) as u32)
+    } else {
+        settings.substeps
+    }
+}
+
+/// The substeps per frame `scene` runs with under `config` ([`stable_substeps`]; the
+/// scene's own if the body cannot be built).
+pub fn substeps_for(scene: &Scene, config: &Config) -> u32 {
+    builder(scene, config)
+        .build()
+        .map_or(scene.settings.substeps, |b| {
+            stable_substeps(&b, &scene.settings)
+        })
+}
+
+fn builder(scene: &Scene, config: &Config) -> SoftBodyBuilder {
+    let builder = SoftBodyBuilder::new(scene.mesh.clone())
+        .density(1000.0)
+        .pinned(scene.pinned.iter().copied())
+        .volume_epsilon(scene.epsilon);
+    config.apply(builder, scene.compliance_scale)
+}
+
 /// Runs `scene` under `config`.
 pub fn run_scene(scene: &Scene, config: &Config) -> Outcome {
     run_scene_observed(scene, config, |_| {})
@@ -224,18 +261,17 @@ pub fn run_scene_observed(
         require_recovery: scene.require_recovery || scene.ground,
         ..Outcome::default()
     };
-    let builder = SoftBodyBuilder::new(scene.mesh.clone())
-        .density(1000.0)
-        .pinned(scene.pinned.iter().copied())
-        .volume_epsilon(scene.epsilon);
-    let body = match config.apply(builder, scene.compliance_scale).build() {
+    let body = match builder(scene, config).build() {
         Ok(b) => b,
         Err(e) => {
             out.build_error = Some(e.to_string());
             return out;
         }
     };
-    let mut solver = match Solver::new(scene.settings.clone()) {
+    let mut settings = scene.settings.clone();
+    settings.substeps = stable_substeps(&body, &settings);
+    out.substeps = settings.substeps;
+    let mut solver = match Solver::new(settings) {
         Ok(s) => s,
         Err(e) => {
             out.settings_error = Some(e.to_string());

@@ -77,6 +77,8 @@ pub enum BuildError {
     },
     /// A plasticity setting is out of range.
     Plasticity(PlasticityError),
+    /// A tearing setting is out of range.
+    Tearing(TearingError),
     /// A generator parameter is out of range.
     BadGeneratorParameter {
         /// Parameter name.
@@ -140,6 +142,7 @@ impl fmt::Display for BuildError {
                 write!(f, "scale must be finite and positive, got {value}")
             }
             BuildError::Plasticity(e) => write!(f, "{e}"),
+            BuildError::Tearing(e) => write!(f, "{e}"),
             BuildError::BadGeneratorParameter { name, value } => {
                 write!(f, "generator parameter `{name}` is out of range: {value}")
             }
@@ -398,3 +401,66 @@ impl From<PlasticityError> for BuildError {
         BuildError::Plasticity(e)
     }
 }
+
+/// Why tearing settings were rejected ([`crate::TearingSettings::validate`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TearingError {
+    /// The tearing strain must be finite and > 0.
+    BadStrain {
+        /// The value given (dimensionless).
+        value: f32,
+    },
+    /// The smoothing time must be finite and ≥ 0, s.
+    BadSmoothingTime {
+        /// The value given, s.
+        value: f32,
+    },
+}
+
+impl fmt::Display for TearingError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            TearingError::BadStrain { value } => {
+                write!(f, "tearing strain must be finite and > 0, got {value}")
+            }
+            TearingError::BadSmoothingTime { value } => write!(
+                f,
+                "tearing smoothing time must be finite and >= 0 s, got {value}"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for TearingError {}
+
+impl From<TearingError> for BuildError {
+    fn from(e: TearingError) -> Self {
+        BuildError::Tearing(e)
+    }
+}
+
+/// Why a cut was rejected ([`crate::cut`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum CutError {
+    /// The entity is not a soft body (no particles or tetrahedra), or is gone.
+    NoSuchBody {
+        /// The entity given.
+        entity: hecs::Entity,
+    },
+    /// The blade is not finite, or degenerate (a zero normal, a flat triangle).
+    BadBlade {
+        /// What is wrong with it.
+        what: &'static str,
+    },
+}
+
+impl fmt::Display for CutError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CutError::NoSuchBody { entity } => write!(f, "{entity:?} is not a soft body"),
+            CutError::BadBlade { what } => write!(f, "bad blade: {what}"),
+        }
+    }
+}
+
+impl std::error::Error for CutError {}

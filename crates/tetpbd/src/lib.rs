@@ -13,7 +13,9 @@
 //! in the [`UserForces`] component (integrated like gravity, kept until reset), and the
 //! [`Grab`] component holding a [`MaterialPoint`] to a moving target (mouse picking). The
 //! optional [`Plasticity`] component lets a body's rest shape flow past a yield (bodies that
-//! stay bent), every family's rest values following. [`constraints`] holds the constraint
+//! stay bent), every family's rest values following; the optional [`Tearing`] component
+//! lets it tear past a strain, and [`cut`] cuts it with a [`Blade`], both splitting it into
+//! pieces ([`TearEvent`]). [`constraints`] holds the constraint
 //! math as pure functions and [`systems`] the solver's steps as plain functions over
 //! `&mut hecs::World`, for an integrator who builds a different schedule.
 //!
@@ -60,6 +62,7 @@ mod stabilisation;
 
 pub use body::activation::{Activation, Asleep};
 pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
+pub use body::cutting::{cut, Blade};
 pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};
 pub use body::forces::{applied_acceleration, UserForces};
 pub use body::generators;
@@ -70,9 +73,13 @@ pub use body::material_point::MaterialPoint;
 pub use body::mesh::{Surface, Tetrahedra};
 pub use body::neo_hookean::NeoHookeanMaterial;
 pub use body::particles::{ExternalAcceleration, Particles};
+pub use body::pieces::{Piece, TearEvent};
 pub use body::placement::Placement;
 pub use body::plasticity::{Plasticity, PlasticitySettings, VOLUME_PRESERVING_TOLERANCE};
-pub use error::{BuildError, PlasticityError, SettingsError, StateError, StepError};
+pub use body::tearing::{Pieces, Tearing, TearingSettings};
+pub use error::{
+    BuildError, CutError, PlasticityError, SettingsError, StateError, StepError, TearingError,
+};
 pub use ordering::ColourClasses;
 pub use solver::hook::{FrameContext, SubstepContext, SubstepHook};
 pub use solver::non_finite::Restored;

@@ -129,3 +129,40 @@ fn plastic_flow_allocates_nothing() {
         assert!(flowed > 0, "the twist never flowed");
     }
 }
+
+/// The tearing pass of a frame that tears nothing allocates nothing: a bar held stretched
+/// below its tearing strain has its faces' strains smoothed every frame.
+#[test]
+fn a_frame_without_tearing_allocates_nothing() {
+    let mut world = hecs::World::new();
+    let mesh = box_grid(Vector3::new(2.0, 0.4, 0.4), [8, 2, 2], CellSplit::Six).unwrap();
+    let e = SoftBodyBuilder::new(mesh)
+        .edges(1e-5)
+        .volume(1e-7)
+        .tearing(tetpbd::TearingSettings::default())
+        .build()
+        .unwrap()
+        .spawn(&mut world);
+    {
+        let mut p = world.get::<&mut tetpbd::Particles>(e).unwrap();
+        for i in 0..p.len() {
+            let x = p.rest_positions()[i];
+            p.set_position(i, Vector3::new(1.2 * x.x, x.y, x.z))
+                .unwrap();
+            p.set_pinned(i, true).unwrap();
+        }
+    }
+    let mut solver = Solver::new(SolverSettings::default()).unwrap();
+    solver.step(&mut world).unwrap();
+    let before = allocations();
+    for _ in 0..10 {
+        let stats = solver.step(&mut world).unwrap();
+        assert_eq!(stats.faces_torn, 0);
+    }
+    assert_eq!(allocations() - before, 0);
+    let strain = world
+        .get::<&tetpbd::Tearing>(e)
+        .unwrap()
+        .max_smoothed_strain();
+    assert!(strain > 0.1, "the strain was not read: {strain}");
+}

@@ -6,7 +6,7 @@
 //!
 //! Each family is measured alone (a body with only that family's component), and the
 //! Neo-Hookean material (`neo-hookean`, `Material::SOFT_TISSUE`; one projection is a
-//! tetrahedron's two coupled constraints; scalar kernel only, run also with `--simd-only`), as full
+//! tetrahedron's two coupled constraints), as full
 //! Gauss–Seidel sweeps of the family's system over a slightly perturbed grid so every
 //! projection does real work. Prints the median and the spread over the repeats.
 //!
@@ -16,11 +16,34 @@
 
 use std::time::Instant;
 
+use clap::Parser;
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, shuffled, CellSplit};
 use tetpbd::systems::{self, Kernel};
 use tetpbd::{Material, Particles, SoftBodyBuilder};
-use tetpbd_bench::{arg, flag, orders, perturb};
+use tetpbd_bench::{orders, perturb, SpatialOrder};
+
+/// ns per constraint projection, per family and kernel, single-threaded, on a grid of
+/// `cells`³ × 6 tetrahedra.
+#[derive(Parser)]
+#[command(name = "projections")]
+struct Args {
+    /// Cells per side of the grid (19: about 41k tetrahedra).
+    #[arg(long, default_value_t = 19)]
+    cells: u32,
+    /// Samples of 10 sweeps each (median, min and max printed).
+    #[arg(long, default_value_t = 15)]
+    repeats: usize,
+    /// Number the grid's vertices and tetrahedra in a random order.
+    #[arg(long)]
+    shuffle: bool,
+    /// Particle orders to measure (default: the builder's).
+    #[arg(long, value_enum)]
+    spatial_order: Option<SpatialOrder>,
+    /// Skip the seed families' scalar kernels.
+    #[arg(long)]
+    simd_only: bool,
+}
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -28,12 +51,12 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let cells = arg("--cells", 19) as u32;
-    let repeats = arg("--repeats", 15);
+    let args = Args::parse();
+    let (cells, repeats) = (args.cells, args.repeats);
     let sweeps = 10;
     let h = 1.0 / 600.0;
     let mut mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Six)?;
-    let shuffle = flag("--shuffle");
+    let shuffle = args.shuffle;
     if shuffle {
         mesh = shuffled(&mesh, 1).0;
     }
@@ -44,12 +67,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         mesh.vertices.len()
     );
     println!("family        kernel  spatial order  projections/sweep   median ns/projection   min      max");
-    for (family, kernel, spatial) in ["edge", "volume", "vertex-face"]
+    for (family, kernel, spatial) in ["edge", "volume", "vertex-face", "neo-hookean"]
         .into_iter()
         .flat_map(|f| [(f, Kernel::Scalar), (f, Kernel::Simd)])
-        .filter(|(_, k)| *k == Kernel::Simd || !flag("--simd-only"))
-        .chain([("neo-hookean", Kernel::Scalar)])
-        .flat_map(|(f, k)| orders().into_iter().map(move |o| (f, k, o)))
+        .filter(|(_, k)| *k == Kernel::Simd || !args.simd_only)
+        .flat_map(|(f, k)| {
+            orders(args.spatial_order)
+                .into_iter()
+                .map(move |o| (f, k, o))
+        })
     {
         let mut world = hecs::World::new();
         let b = SoftBodyBuilder::new(mesh.clone())
@@ -82,7 +108,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let c = match family {
                     "edge" => systems::project_edges_with(&mut world, h, kernel),
                     "volume" => systems::project_volume_with(&mut world, h, kernel),
-                    "neo-hookean" => systems::project_neo_hookean(&mut world, h),
+                    "neo-hookean" => systems::project_neo_hookean_with(&mut world, h, kernel),
                     _ => systems::project_vertex_face_with(&mut world, h, kernel),
                 };
                 n += c.applied + c.degenerate;

@@ -16,6 +16,7 @@
 //! (`SoftQueries::update`) is timed with the bodies at rest and after every particle moved
 //! by 1 mm (as after a step: every BVH is refitted).
 
+use clap::Parser;
 use hecs::World;
 use nalgebra::Vector3;
 use rapier3d::geometry::Ray;
@@ -23,7 +24,23 @@ use rapier3d::math::Vector;
 use std::hint::black_box;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, Surface};
-use tetpbd_bench::{arg, thread_cpu_ms};
+use tetpbd_bench::thread_cpu_ms;
+
+/// µs per scene query against soft bodies (ray casts, point projection and containment,
+/// snapshot refresh) on one body and on a scene of 100 bodies, single-threaded.
+#[derive(Parser)]
+#[command(name = "queries")]
+struct Args {
+    /// Cells per side of the single body (12: 10 368 tetrahedra).
+    #[arg(long, default_value_t = 12)]
+    cells: u32,
+    /// Queries timed per sample.
+    #[arg(long, default_value_t = 2000)]
+    queries: usize,
+    /// Samples per query kind (median, min and max printed).
+    #[arg(long, default_value_t = 21)]
+    repeats: usize,
+}
 use tetpbd_rapier::{SoftQueries, SoftQueryFilter};
 
 /// A small deterministic generator (xorshift64*), uniform in `[0, 1)`.
@@ -285,9 +302,11 @@ fn time_update(scene: &mut Scene, repeats: usize) {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let cells = arg("--cells", 12) as u32;
-    let n = arg("--queries", 2000);
-    let repeats = arg("--repeats", 21);
+    let Args {
+        cells,
+        queries: n,
+        repeats,
+    } = Args::parse();
     let mut one = Scene::new(
         format!("one body, {cells}³ cells"),
         &[(1.0, cells, Vector3::zeros())],

@@ -25,6 +25,7 @@
 use std::error::Error;
 use std::time::Instant;
 
+use clap::Parser;
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{
@@ -35,12 +36,27 @@ use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{hecs, is_sleeping, unique_edges, Activation, SoftBodyBuilder, SolverSettings};
 use tetpbd::{Particles, Surface, TetMesh};
 use tetpbd_bench::{
-    arg, flag, interpenetration, lumped_masses, rapier_material, to_rapier, ContactKind,
-    ContactScene, DT,
+    interpenetration, lumped_masses, rapier_material, to_rapier, ContactKind, ContactScene, DT,
 };
 use tetpbd_rapier::{CoupledWorld, CouplingSettings};
 
 type Res<T> = Result<T, Box<dyn Error>>;
+
+/// Rest and sleep, tetpbd against rapier 0.36's soft bodies on a stack of five cubes and a
+/// pile of twenty, awake and sleeping.
+#[derive(Parser)]
+#[command(name = "rest_vs_rapier")]
+struct Args {
+    /// Substeps per 1/60 s frame (and rapier's solver iterations).
+    #[arg(long, default_value_t = 10)]
+    substeps: u32,
+    /// The stack only.
+    #[arg(long, conflicts_with = "pile")]
+    stack: bool,
+    /// The pile only.
+    #[arg(long)]
+    pile: bool,
+}
 
 /// Cube edge, m.
 const SIZE: f32 = 0.5;
@@ -414,9 +430,12 @@ fn compare(cube: &TetMesh, l: &Layout, substeps: u32) -> Res<()> {
 }
 
 fn main() -> Res<()> {
-    let substeps = arg("--substeps", 10) as u32;
+    let Args {
+        substeps,
+        stack: only_stack,
+        pile: only_pile,
+    } = Args::parse();
     let cube = box_grid(Vector3::repeat(SIZE), [4, 4, 4], CellSplit::Six)?;
-    let (only_stack, only_pile) = (flag("--stack"), flag("--pile"));
     if !only_pile {
         compare(&cube, &stack(), substeps)?;
     }

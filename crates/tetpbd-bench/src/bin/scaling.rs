@@ -59,10 +59,69 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use clap::Parser;
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, shuffled, CellSplit};
 use tetpbd::{EdgeConstraints, SoftBodyBuilder, Solver, SolverSettings, StepStats, TetMesh};
-use tetpbd_bench::{arg, arg_str, flag, orders};
+use tetpbd_bench::{orders, FamilySet, SpatialOrder};
+
+/// ms per frame for hanging cubes of about 1k, 10k, 100k and 1M tetrahedra, edges + volume
+/// and vertex–face, on 1 and 2 threads (2 with `--features parallel`).
+#[derive(Parser)]
+#[command(name = "scaling")]
+struct Args {
+    /// Smallest cube to measure, cells per side (of 6, 12, 26, 55).
+    #[arg(long, default_value_t = 0)]
+    min_cells: u32,
+    /// Largest cube to measure, cells per side.
+    #[arg(long, default_value_t = 55)]
+    max_cells: u32,
+    /// Measured frames per body (at least 1).
+    #[arg(long, default_value_t = 15, value_parser = clap::value_parser!(u32).range(1..))]
+    frames: u32,
+    /// Slabs of the sweep order (`SoftBodyBuilder::parts`; 0: the builder's choice).
+    #[arg(long, default_value_t = 0)]
+    parts: usize,
+    /// One family set only (default both).
+    #[arg(long, value_enum)]
+    set: Option<FamilySet>,
+    /// All 1-thread frames first, then all 2-thread ones (instead of interleaved).
+    #[arg(long)]
+    sequential: bool,
+    /// Number each grid's vertices and tetrahedra in a random order.
+    #[arg(long)]
+    shuffle: bool,
+    /// Particle orders to measure (default: the builder's).
+    #[arg(long, value_enum)]
+    spatial_order: Option<SpatialOrder>,
+    /// Also print the median ms per frame of each phase.
+    #[arg(long)]
+    breakdown: bool,
+    /// Also print every measured frame.
+    #[arg(long)]
+    per_frame: bool,
+    /// Print the constraint error of the 1-thread body after the measured frames.
+    #[arg(long)]
+    error: bool,
+    /// `SolverSettings::limit_correction_energy` off (to measure its cost).
+    #[arg(long)]
+    no_energy_limit: bool,
+    /// `ParallelSettings::keep_helpers_awake` on.
+    #[arg(long)]
+    keep_helpers_awake: bool,
+    /// `ParallelSettings::move_helpers_off_step_core` on.
+    #[arg(long)]
+    move_helpers_off: bool,
+    /// Give the pool to the solver (`Solver::set_thread_pool`) instead of installing it.
+    #[arg(long)]
+    given_pool: bool,
+}
+
+/// The command line, parsed once.
+fn args() -> &'static Args {
+    static ARGS: std::sync::OnceLock<Args> = std::sync::OnceLock::new();
+    ARGS.get_or_init(Args::parse)
+}
 
 /// Warm-up frames of each body, not measured.
 const WARM_UP: usize = 2;
@@ -86,7 +145,7 @@ struct Body {
 /// A hanging cube (top face pinned) of `mesh` with the family set `set`.
 fn body(
     mesh: &TetMesh,
-    set: &str,
+    set: FamilySet,
     spatial: bool,
     parts: usize,
 ) -> Result<Body, Box<dyn std::error::Error>> {
@@ -98,7 +157,7 @@ fn body(
         .spatial_order(spatial)
         .parts(parts)
         .pinned(top);
-    let b = if set == "edges+volume" {
+    let b = if set == FamilySet::EdgesVolume {
         b.edges(1e-7).volume(1e-10)
     } else {
         b.vertex_face(1e-7)
@@ -120,11 +179,11 @@ fn body(
     let solver = Solver::new(SolverSettings {
         substeps: 10,
         parallel: tetpbd::ParallelSettings {
-            keep_helpers_awake: flag("--keep-helpers-awake"),
-            move_helpers_off_step_core: flag("--move-helpers-off"),
+            keep_helpers_awake: args().keep_helpers_awake,
+            move_helpers_off_step_core: args().move_helpers_off,
             ..Default::default()
         },
-        limit_correction_energy: !flag("--no-energy-limit"),
+        limit_correction_energy: !args().no_energy_limit,
         ..Default::default()
     })?;
     Ok(Body {
@@ -253,7 +312,7 @@ fn measure(
                 .map(Arc::new)
         };
         let (p1, p2) = (pool(1), pool(2));
-        let given = flag("--given-pool");
+        let given = args().given_pool;
         let frame = |b: &mut Body, p: &Option<Arc<rayon::ThreadPool>>, warm: bool| {
             if given {
                 b.solver.set_thread_pool(p.clone());
@@ -292,14 +351,10 @@ fn measure(
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let min_cells = arg("--min-cells", 0) as u32;
-    let max_cells = arg("--max-cells", 55) as u32;
-    let frames = arg("--frames", 15).max(1);
-    let parts = arg("--parts", 0);
-    let sequential = flag("--sequential");
-    let only = arg_str("--set");
-    let shuffle = flag("--shuffle");
-    let breakdown = flag("--breakdown");
+    let a = args();
+    let (min_cells, max_cells, frames) = (a.min_cells, a.max_cells, a.frames as usize);
+    let (parts, sequential, only) = (a.parts, a.sequential, a.set);
+    let (shuffle, breakdown) = (a.shuffle, a.breakdown);
     let parallel = cfg!(feature = "parallel");
     let numbering = if shuffle { "shuffled" } else { "grid" };
     let mode = if !parallel {
@@ -313,9 +368,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if parallel {
         println!(
             "keep helpers awake: {}, move helpers off the step's core: {}, pool {}",
-            flag("--keep-helpers-awake"),
-            flag("--move-helpers-off"),
-            if flag("--given-pool") {
+            a.keep_helpers_awake,
+            a.move_helpers_off,
+            if a.given_pool {
                 "given to the solver, stepped from the main thread"
             } else {
                 "installed (stepped on a pool thread)"
@@ -331,10 +386,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if shuffle {
             mesh = shuffled(&mesh, 1).0;
         }
-        for (set, spatial) in ["edges+volume", "vertex-face"]
+        for (set, spatial) in [FamilySet::EdgesVolume, FamilySet::VertexFace]
             .into_iter()
-            .filter(|s| only.as_ref().is_none_or(|o| o == s))
-            .flat_map(|s| orders().into_iter().map(move |o| (s, o)))
+            .filter(|s| only.is_none_or(|o| o == *s))
+            .flat_map(|s| orders(a.spatial_order).into_iter().map(move |o| (s, o)))
         {
             let mut one = body(&mesh, set, spatial, parts)?;
             let mut two = if parallel {
@@ -374,12 +429,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 None => ("-".to_string(), "-".to_string()),
             };
             println!(
-                "{set:13} {:13} {:9} {:10}   {one_ms:17.2}  {per_tet:14.1}   {two_s:>18}  {speed}  others {others:.2} cores over {wall:.1} s",
+                "{:13} {:13} {:9} {:10}   {one_ms:17.2}  {per_tet:14.1}   {two_s:>18}  {speed}  others {others:.2} cores over {wall:.1} s",
+                set.name(),
                 if spatial { "on" } else { "off" },
                 mesh.tets.len(),
                 mesh.vertices.len()
             );
-            if flag("--per-frame") {
+            if a.per_frame {
                 let two_times = two.as_ref().map_or(&[][..], |t| &t.times[..]);
                 let shares = two.as_ref().map_or(&[][..], |t| &t.waits[2][..]);
                 let moves = two.as_ref().map_or(&[][..], |t| &t.waits[3][..]);
@@ -399,7 +455,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     println!("    frame {i:3}: 1 thread {a:.2} ms, 2 threads {b} ms{share}");
                 }
             }
-            if flag("--error") {
+            if a.error {
                 one.solver.settings.measure_error = true;
                 let s = one.solver.step(&mut one.world)?;
                 let f = |e: Option<tetpbd::ErrorStats>| {

@@ -22,25 +22,65 @@
 //! their horizontal offset over those 10 s (the upper cube's bottom-face centre against the
 //! lower cube's top-face centre: slip and rocking at the contact).
 
+use clap::Parser;
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{hecs, Activation, DeformationDamping, Particles, SoftBodyBuilder, SolverSettings};
-use tetpbd_bench::{arg, arg_str, flag, DT};
+use tetpbd_bench::DT;
+
+/// Does a stack of soft cubes on rigid ground come to rest, awake? Default settings, sleeping
+/// off, and switches that take one ingredient away at a time.
+#[derive(Parser)]
+#[command(name = "stack_rest")]
+struct Args {
+    /// Cubes in the stack (at least 1).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    cubes: u32,
+    /// Side of each cube, mm.
+    #[arg(long, default_value_t = 500)]
+    size_mm: u32,
+    /// Substeps per 1/60 s frame.
+    #[arg(long, default_value_t = 10)]
+    substeps: u32,
+    /// Solver iterations per substep.
+    #[arg(long, default_value_t = 1)]
+    iterations: u32,
+    /// Simulated time, s.
+    #[arg(long, default_value_t = 13)]
+    seconds: u32,
+    /// Print the speeds every this many frames (at least 1).
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
+    every_frames: u32,
+    /// `DeformationDamping` rate on every body, 1/s (none by default).
+    #[arg(long, value_name = "RATE")]
+    damping: Option<f32>,
+    /// Friction 0 between the soft bodies (the ground contact keeps the default 0.5).
+    #[arg(long)]
+    soft_friction_off: bool,
+    /// `SoftContactSettings::skin_speed`, mm/s (the default's otherwise).
+    #[arg(long)]
+    skin_speed_mm_s: Option<f32>,
+    /// The cubes start at the contact thickness instead of 2 cm apart.
+    #[arg(long)]
+    touching: bool,
+    /// One body as tall as the stack (4 × 4·cubes × 4 cells) instead of cubes.
+    #[arg(long)]
+    column: bool,
+}
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftColliderBuilder};
 
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
 fn main() -> Res<()> {
-    let n = arg("--cubes", 5).max(1);
-    let size = arg("--size-mm", 500) as f32 * 1e-3;
-    let substeps = arg("--substeps", 10) as u32;
-    let iterations = arg("--iterations", 1) as u32;
-    let seconds = arg("--seconds", 13) as f32;
-    let every = arg("--every-frames", 30).max(1);
-    let damping: Option<f32> = arg_str("--damping").and_then(|v| v.parse().ok());
-    let soft_friction_off = flag("--soft-friction-off");
+    let args = Args::parse();
+    let n = args.cubes as usize;
+    let size = args.size_mm as f32 * 1e-3;
+    let (substeps, iterations) = (args.substeps, args.iterations);
+    let seconds = args.seconds as f32;
+    let every = args.every_frames as usize;
+    let (damping, soft_friction_off) = (args.damping, args.soft_friction_off);
     let solver = SolverSettings {
         dt: DT,
         substeps,
@@ -56,11 +96,8 @@ fn main() -> Res<()> {
             .build()?;
         ground = ground.friction(1.0);
     }
-    if let (Some(v), Some(s)) = (
-        arg_str("--skin-speed-mm-s"),
-        coupling.soft_contacts.as_mut(),
-    ) {
-        s.skin_speed = v.parse::<f32>()? * 1e-3;
+    if let (Some(v), Some(s)) = (args.skin_speed_mm_s, coupling.soft_contacts.as_mut()) {
+        s.skin_speed = v * 1e-3;
     }
     let thickness = coupling.default_collider.thickness();
     let mut w = CoupledWorld::new(solver, coupling)?;
@@ -68,12 +105,12 @@ fn main() -> Res<()> {
         RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
         ground,
     );
-    let (gap, lift) = if flag("--touching") {
+    let (gap, lift) = if args.touching {
         (2.0 * thickness, thickness)
     } else {
         (0.02, 0.01)
     };
-    let shapes: Vec<(Vector3<f32>, [u32; 3], f32)> = if flag("--column") {
+    let shapes: Vec<(Vector3<f32>, [u32; 3], f32)> = if args.column {
         let h = size * n as f32;
         vec![(
             Vector3::new(size, h, size),

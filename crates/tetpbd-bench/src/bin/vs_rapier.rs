@@ -24,9 +24,8 @@
 //! of a surface particle of one body inside another's tetrahedra; settled max |v| from
 //! positions (displacement over a frame / dt).
 
-use tetpbd_bench::{
-    build_contact, flag, run_contact, ContactEngine, ContactResult, ContactScene, DT,
-};
+use clap::Parser;
+use tetpbd_bench::{build_contact, run_contact, ContactEngine, ContactResult, ContactScene, DT};
 
 use rapier3d::prelude::{SoftBodyCellModel, SoftBodySolver};
 
@@ -66,8 +65,27 @@ fn print_row(name: &str, tets: usize, x: &ContactResult) {
 
 type Found = Option<(ContactEngine, u32, ContactResult)>;
 
-fn compare(scene: &ContactScene) -> Res<()> {
-    let self_weight = flag("--self-weight");
+/// tetpbd against rapier 0.36's soft bodies on a soft cube dropped onto rigid ground and a
+/// pile of nine cubes: ms per frame and the errors at rest, and the speed-ups at equal error.
+#[derive(Parser)]
+#[command(name = "vs_rapier")]
+struct Args {
+    /// Frames per run (at least 240).
+    #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(240..))]
+    frames: u32,
+    /// Only the pile.
+    #[arg(long)]
+    pile: bool,
+    /// tetpbd's rows at every substep count, no rapier.
+    #[arg(long)]
+    tetpbd_only: bool,
+    /// tetpbd with `CouplingSettings::self_weight_stacking` on.
+    #[arg(long)]
+    self_weight: bool,
+}
+
+fn compare(scene: &ContactScene, args: &Args) -> Res<()> {
+    let self_weight = args.self_weight;
     let undamped = ContactEngine::Tetpbd {
         damping: 0.0,
         self_weight,
@@ -80,7 +98,7 @@ fn compare(scene: &ContactScene) -> Res<()> {
     for substeps in TETPBD_SUBSTEPS {
         for e in [undamped, damped] {
             let x = measure(e, scene, substeps)?;
-            if flag("--tetpbd-only") {
+            if args.tetpbd_only {
                 print_row(
                     &format!("{}, {substeps} substeps", e.label()),
                     scene.tets(),
@@ -90,7 +108,7 @@ fn compare(scene: &ContactScene) -> Res<()> {
             ours.push((e, substeps, x));
         }
     }
-    if flag("--tetpbd-only") {
+    if args.tetpbd_only {
         return Ok(());
     }
     for substeps in RAPIER_SUBSTEPS {
@@ -157,26 +175,20 @@ fn load() -> String {
 }
 
 fn main() -> Res<()> {
-    let args: Vec<String> = std::env::args().collect();
-    let frames = args
-        .iter()
-        .position(|a| a == "--frames")
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(300usize)
-        .max(240);
+    let args = Args::parse();
+    let frames = args.frames as usize;
     println!(
         "hard edges + volume in both engines, rapier at {RAPIER_SUBSTEPS:?} substeps, dt {DT:.4} s, {frames} frames, load average {}",
         load()
     );
     println!("engine                                     tets   ms/frame    max|v| m/s   ground pen. m   interpen. m   volume err %");
-    for cells in [4u32, 8, 12].into_iter().filter(|_| !flag("--pile")) {
+    for cells in [4u32, 8, 12].into_iter().filter(|_| !args.pile) {
         let scene = ContactScene::drop(cells, frames)?;
         println!("c) 1 m cube, {cells}³ cells, dropped 5 cm onto rigid ground");
-        compare(&scene)?;
+        compare(&scene, &args)?;
     }
     println!("d) pile of nine 1 m cubes (4³ cells) on rigid ground");
-    compare(&ContactScene::pile(frames)?)?;
+    compare(&ContactScene::pile(frames)?, &args)?;
     println!("load average at the end: {}", load());
     Ok(())
 }

@@ -43,6 +43,8 @@ pub struct SoftBody {
     pub plasticity: Option<crate::Plasticity>,
     /// Neo-Hookean material, if chosen ([`SoftBodyBuilder::material`]).
     pub material: Option<crate::NeoHookeanMaterial>,
+    /// Tearing, if chosen ([`SoftBodyBuilder::tearing`]).
+    pub tearing: Option<crate::Tearing>,
 }
 
 impl SoftBody {
@@ -66,6 +68,9 @@ impl SoftBody {
         if let Some(m) = self.material {
             b.add(m);
         }
+        if let Some(t) = self.tearing {
+            b.add(t);
+        }
         world.spawn(b.build())
     }
 }
@@ -88,6 +93,7 @@ pub struct SoftBodyBuilder {
     volume: Option<f32>,
     plasticity: Option<crate::PlasticitySettings>,
     material: Option<crate::Material>,
+    tearing: Option<crate::TearingSettings>,
     pinned: Vec<u32>,
     placement: Placement,
     epsilon: f32,
@@ -114,6 +120,7 @@ impl SoftBodyBuilder {
             volume: None,
             plasticity: None,
             material: None,
+            tearing: None,
             pinned: Vec::new(),
             placement: Placement::default(),
             epsilon: Self::DEFAULT_EPSILON,
@@ -164,6 +171,14 @@ impl SoftBodyBuilder {
     /// independent of the mesh resolution. Alone or with any of the families.
     pub fn material(mut self, material: crate::Material) -> Self {
         self.material = Some(material);
+        self
+    }
+
+    /// Lets the body tear (a [`crate::Tearing`] component): a face shared by two
+    /// tetrahedra splits once its smoothed strain passes `settings.strain`. Checked by
+    /// [`Self::build`] ([`BuildError::Tearing`]).
+    pub fn tearing(mut self, settings: crate::TearingSettings) -> Self {
+        self.tearing = Some(settings);
         self
     }
 
@@ -256,6 +271,7 @@ impl SoftBodyBuilder {
             volume,
             plasticity,
             material,
+            tearing,
             pinned,
             placement,
             epsilon,
@@ -337,10 +353,15 @@ impl SoftBodyBuilder {
             volume,
             plasticity: None,
             material,
+            tearing: None,
         };
         if let Some(settings) = plasticity {
             let (p, t, e) = (&body.particles, &body.tetrahedra, body.edges.as_ref());
             body.plasticity = Some(crate::Plasticity::new(settings, p, t, e)?);
+        }
+        if let Some(settings) = tearing {
+            let (p, t) = (&body.particles, &body.tetrahedra);
+            body.tearing = Some(crate::Tearing::new(settings, p, t)?);
         }
         Ok(body)
     }
@@ -371,6 +392,9 @@ impl SoftBodyBuilder {
         if let Some(s) = &self.plasticity {
             s.validate()?;
         }
+        if let Some(s) = &self.tearing {
+            s.validate()?;
+        }
         self.placement.check()
     }
 }
@@ -398,7 +422,11 @@ fn particle_order(
 }
 
 /// The part count (`parts`, or chosen by size when 0) and the slab of each particle.
-fn body_parts(vertices: &[Vector3<f32>], tets: &[[u32; 4]], parts: usize) -> (usize, Vec<u32>) {
+pub(crate) fn body_parts(
+    vertices: &[Vector3<f32>],
+    tets: &[[u32; 4]],
+    parts: usize,
+) -> (usize, Vec<u32>) {
     let (axis, extent) = longest_axis(vertices);
     let parts = match parts {
         0 => auto_parts(tets.len(), extent / mean_edge_length(vertices, tets)),
@@ -477,7 +505,12 @@ fn pinned_inverse_masses(masses: &[f32], pinned: &[u32]) -> Result<Vec<f32>, Bui
 
 /// The edge family of a built mesh (particles and tetrahedra in solver order), its edges in
 /// the solver's order for the body's parts.
-fn edge_constraints(mesh: &TetMesh, part_of: &[u32], parts: usize, alpha: f32) -> EdgeConstraints {
+pub(crate) fn edge_constraints(
+    mesh: &TetMesh,
+    part_of: &[u32],
+    parts: usize,
+    alpha: f32,
+) -> EdgeConstraints {
     let sorted = unique_edges(&mesh.tets);
     let (edge_order, classes) = part_order(&sorted, part_of, parts, mesh.vertices.len());
     let list: Vec<[u32; 2]> = edge_order.iter().map(|&k| sorted[k]).collect();

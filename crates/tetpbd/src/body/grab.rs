@@ -116,6 +116,12 @@ impl Grab {
         self.point
     }
 
+    /// The grab of the same material point with its tetrahedron renumbered to `t`.
+    pub(crate) fn renumbered(mut self, t: usize) -> Grab {
+        self.point = self.point.renumbered(t);
+        self
+    }
+
     /// Compliance, m/N.
     pub fn compliance(&self) -> f32 {
         self.compliance

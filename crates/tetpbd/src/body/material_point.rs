@@ -91,6 +91,14 @@ impl MaterialPoint {
         ))
     }
 
+    /// The same point in tetrahedron `t` (the same tetrahedron renumbered, after a split).
+    pub(crate) fn renumbered(self, t: usize) -> MaterialPoint {
+        MaterialPoint {
+            tetrahedron: t,
+            ..self
+        }
+    }
+
     /// Index of the tetrahedron holding the point.
     pub fn tetrahedron(&self) -> usize {
         self.tetrahedron

@@ -5,10 +5,12 @@
 //! one body: [`Particles`](particles::Particles) (one flat array per quantity),
 //! [`Tetrahedra`](mesh::Tetrahedra), [`Surface`](mesh::Surface) and one optional component per
 //! constraint family ([`families`]): a body pays only for the families it has, and for
-//! [`Plasticity`](plasticity::Plasticity) only if it has it.
+//! [`Plasticity`](plasticity::Plasticity) and [`Tearing`](tearing::Tearing) only if it has
+//! them.
 
 pub(crate) mod activation;
 pub(crate) mod builder;
+pub(crate) mod cutting;
 pub(crate) mod families;
 pub(crate) mod forces;
 pub mod generators;
@@ -19,6 +21,10 @@ pub(crate) mod material_point;
 pub(crate) mod mesh;
 pub(crate) mod neo_hookean;
 pub(crate) mod particles;
+pub(crate) mod pieces;
 pub(crate) mod placement;
 pub(crate) mod plastic_rest;
 pub(crate) mod plasticity;
+pub(crate) mod rebuild;
+pub(crate) mod split;
+pub(crate) mod tearing;

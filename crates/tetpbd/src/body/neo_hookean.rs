@@ -27,6 +27,22 @@ pub struct NeoHookeanMaterial {
     /// Elastic energy released by the material's projections in the current substep, J (the
     /// energy limit's budget; reset every substep).
     pub(crate) released: f64,
+    /// The energy each tetrahedron's last projection released, J (scratch of the sweep,
+    /// summed into `released` in tetrahedron order, so the sum does not depend on how the
+    /// sweep was split among threads).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub(crate) tet_released: ReleasedScratch,
+}
+
+/// The per-tetrahedron released energies of the last sweep: scratch, not state (never
+/// serialized, equal whatever it holds, sized by the sweep on first use).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ReleasedScratch(pub(crate) Vec<f32>);
+
+impl PartialEq for ReleasedScratch {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 impl NeoHookeanMaterial {
@@ -51,6 +67,7 @@ impl NeoHookeanMaterial {
             rest_inverse,
             lambdas: vec![[0.0; 2]; tets.indices.len()],
             released: 0.0,
+            tet_released: ReleasedScratch(vec![0.0; tets.indices.len()]),
         }
     }
 

@@ -143,7 +143,9 @@ impl Particles {
     /// vertex. Use it to turn a mesh vertex index into the particle index that
     /// [`Particles::positions`], pinning and attachments take.
     pub fn particle_of(&self, vertex: u32) -> Option<u32> {
-        self.vertex_to_particle.get(vertex as usize).copied()
+        // A piece of a split body lacks the vertices of the other pieces (`u32::MAX`).
+        let p = *self.vertex_to_particle.get(vertex as usize)?;
+        (p != u32::MAX).then_some(p)
     }
 
     /// Rest-pose positions the body was built from, m.

@@ -81,10 +81,8 @@ impl PlasticitySettings {
 /// - vertex–face rest heights ([`crate::VertexFaceConstraints`]): each corner's signed height
 ///   above its opposite face, corners at `0` and the columns of `Dₜ`;
 /// - edge rest lengths ([`crate::EdgeConstraints`]): the length of the edge in each incident
-///   tetrahedron's rest shape, averaged over those tetrahedra.
-///
-/// A family that needs a rest shape of its own (a material model's `Dₜ⁻¹`) reads it the
-/// same way, from [`Plasticity::rest_edge_matrix`].
+///   tetrahedron's rest shape, averaged over those tetrahedra;
+/// - the material's inverse rest shapes ([`crate::NeoHookeanMaterial`]): `Dₜ⁻¹`.
 ///
 /// # Flow rule
 ///
@@ -274,6 +272,30 @@ impl Plasticity {
         };
         rest.refresh_all(self, rest_positions);
         true
+    }
+}
+
+impl Plasticity {
+    /// The plastic state of a piece of this body (after a split): tetrahedron `k` of the
+    /// piece is tetrahedron `from[k]` of this body and keeps its plastic stretch; the edge
+    /// incidence is that of the piece's `tets` and `edges`.
+    pub(crate) fn for_piece(
+        &self,
+        from: &[u32],
+        tets: &[[u32; 4]],
+        edges: Option<&EdgeConstraints>,
+    ) -> Plasticity {
+        let (edge_offsets, edge_corners) = match edges {
+            Some(e) => edge_incidence(tets, &e.edges),
+            None => (Vec::new(), Vec::new()),
+        };
+        Plasticity {
+            settings: self.settings,
+            stretch: from.iter().map(|&t| self.stretch[t as usize]).collect(),
+            inv_rest: from.iter().map(|&t| self.inv_rest[t as usize]).collect(),
+            edge_offsets,
+            edge_corners,
+        }
     }
 }
 

@@ -155,7 +155,7 @@ fn one(o: scalar::Outcome) -> ProjectionCount {
 /// `true` when the AVX2 + FMA build of the kernels can run on this CPU.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn avx2() -> bool {
+pub(crate) fn avx2() -> bool {
     std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
 }
 

@@ -27,21 +27,21 @@ pub(crate) const LANES: usize = 4;
 
 /// 3-vectors, one per lane.
 #[derive(Clone, Copy)]
-struct V3<L> {
-    x: L,
-    y: L,
-    z: L,
+pub(crate) struct V3<L> {
+    pub x: L,
+    pub y: L,
+    pub z: L,
 }
 
 impl<L: Lane> V3<L> {
-    const ZERO: V3<L> = V3 {
+    pub(crate) const ZERO: V3<L> = V3 {
         x: L::ZERO,
         y: L::ZERO,
         z: L::ZERO,
     };
 
     #[inline(always)]
-    fn add(self, o: V3<L>) -> V3<L> {
+    pub(crate) fn add(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.x + o.x,
             y: self.y + o.y,
@@ -50,7 +50,7 @@ impl<L: Lane> V3<L> {
     }
 
     #[inline(always)]
-    fn sub(self, o: V3<L>) -> V3<L> {
+    pub(crate) fn sub(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.x - o.x,
             y: self.y - o.y,
@@ -59,7 +59,7 @@ impl<L: Lane> V3<L> {
     }
 
     #[inline(always)]
-    fn scale(self, s: L) -> V3<L> {
+    pub(crate) fn scale(self, s: L) -> V3<L> {
         V3 {
             x: self.x * s,
             y: self.y * s,
@@ -68,7 +68,7 @@ impl<L: Lane> V3<L> {
     }
 
     #[inline(always)]
-    fn neg(self) -> V3<L> {
+    pub(crate) fn neg(self) -> V3<L> {
         V3 {
             x: -self.x,
             y: -self.y,
@@ -77,12 +77,12 @@ impl<L: Lane> V3<L> {
     }
 
     #[inline(always)]
-    fn dot(self, o: V3<L>) -> L {
+    pub(crate) fn dot(self, o: V3<L>) -> L {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
     #[inline(always)]
-    fn cross(self, o: V3<L>) -> V3<L> {
+    pub(crate) fn cross(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.y * o.z - self.z * o.y,
             y: self.z * o.x - self.x * o.z,
@@ -128,7 +128,7 @@ impl<'a, A: ParticleAccess, const N: usize> Bounded<'a, A, N> {
     /// Corner `k` of the `L::WIDTH` items from `at`: positions and inverse masses, one per
     /// lane.
     #[inline(always)]
-    fn gather<L: Lane>(&self, at: usize, k: usize) -> (V3<L>, L) {
+    pub(crate) fn gather<L: Lane>(&self, at: usize, k: usize) -> (V3<L>, L) {
         let mut rows = [[f32x4::ZERO; 4]; 2];
         for (c, r) in rows.iter_mut().enumerate().take(L::WIDTH / LANES) {
             let it = chunk(self.items, at + c * LANES);
@@ -144,7 +144,7 @@ impl<'a, A: ParticleAccess, const N: usize> Bounded<'a, A, N> {
 
     /// The four corners of the tetrahedra from `at`.
     #[inline(always)]
-    fn gather_corners<L: Lane>(&self, at: usize) -> ([V3<L>; 4], [L; 4]) {
+    pub(crate) fn gather_corners<L: Lane>(&self, at: usize) -> ([V3<L>; 4], [L; 4]) {
         let (p0, w0) = self.gather(at, 0);
         let (p1, w1) = self.gather(at, 1);
         let (p2, w2) = self.gather(at, 2);
@@ -154,7 +154,7 @@ impl<'a, A: ParticleAccess, const N: usize> Bounded<'a, A, N> {
 
     /// Moves corner `k` of item `at + l` by lane `l` of `d` (compensated).
     #[inline(always)]
-    fn scatter<L: Lane>(&mut self, at: usize, k: usize, d: V3<L>) {
+    pub(crate) fn scatter<L: Lane>(&mut self, at: usize, k: usize, d: V3<L>) {
         let rows = L::transpose_out([d.x, d.y, d.z]);
         for (c, r) in rows.iter().enumerate().take(L::WIDTH / LANES) {
             let it = chunk(self.items, at + c * LANES);
@@ -192,7 +192,7 @@ fn untranspose_rows<L: Lane>(lanes: [L; 4], rows: &mut [[f32; 4]], at: usize) {
 
 /// `L::WIDTH` consecutive values from `at` as lanes.
 #[inline(always)]
-fn lanes_of<L: Lane>(v: &[f32], at: usize) -> L {
+pub(crate) fn lanes_of<L: Lane>(v: &[f32], at: usize) -> L {
     let mut q = [f32x4::ZERO; 2];
     for (c, quarter) in q.iter_mut().enumerate().take(L::WIDTH / LANES) {
         *quarter = f32x4::new(*chunk(v, at + c * LANES));
@@ -202,7 +202,7 @@ fn lanes_of<L: Lane>(v: &[f32], at: usize) -> L {
 
 /// Stores lanes to `L::WIDTH` consecutive values from `at`.
 #[inline(always)]
-fn store_lanes<L: Lane>(l: L, v: &mut [f32], at: usize) {
+pub(crate) fn store_lanes<L: Lane>(l: L, v: &mut [f32], at: usize) {
     let q = l.quarters();
     for (c, quarter) in q.iter().enumerate().take(L::WIDTH / LANES) {
         *chunk_mut(v, at + c * LANES) = quarter.to_array();

@@ -6,6 +6,8 @@
 //! * [`scalar`] — one projection of one constraint, the reference kernel;
 //! * [`lanes`] — SIMD kernels: four or eight constraints of one colour class at once, over
 //!   the lane types of [`lane_types`];
+//! * [`neo_hookean`] — the material's scalar kernel, its class runs and its serial sweep;
+//!   [`neo_hookean_lanes`] its SIMD kernel;
 //! * [`class_runs`] — a colour class run through the kernels, and the instruction-set choice;
 //! * [`count`] — the kernel choice ([`Kernel`](count::Kernel)) and the projection counts.
 
@@ -15,6 +17,7 @@ pub(crate) mod count;
 pub(crate) mod lane_types;
 pub(crate) mod lanes;
 pub(crate) mod neo_hookean;
+pub(crate) mod neo_hookean_lanes;
 pub(crate) mod particle_runs;
 pub(crate) mod scalar;
 pub(crate) mod slots;

@@ -1,5 +1,7 @@
-//! The scalar kernel of the Neo-Hookean material: one coupled projection of a tetrahedron's
-//! two constraints on the working copy, and a sweep of one body in colour-class order.
+//! The scalar kernel of the Neo-Hookean material (the reference): one coupled projection of a
+//! tetrahedron's two constraints on the working copy; the runs of one colour class through it
+//! or the SIMD kernel ([`crate::kernels::neo_hookean_lanes`]); and the serial sweep of one
+//! body in colour-class order.
 //!
 //! Per tetrahedron (theory in `constraints/neo_hookean.rs`): `F = Ds Dm⁻¹`, the two
 //! constraints and their gradients, the 2×2 coupled XPBD update with damping
@@ -12,8 +14,16 @@ use nalgebra::{Matrix3, Vector3};
 use wide::f32x4;
 
 use crate::constraints::{self, Evaluated};
-use crate::kernels::count::ProjectionCount;
-use crate::kernels::slots::Slot;
+#[cfg(target_arch = "x86_64")]
+use crate::kernels::class_runs::avx2;
+use crate::kernels::count::{Kernel, ProjectionCount};
+#[cfg(target_arch = "x86_64")]
+use crate::kernels::lane_types::Y8;
+use crate::kernels::lane_types::{Lane, X2};
+use crate::kernels::lanes::{Bounded, LANES};
+use crate::kernels::neo_hookean_lanes::{one, tets};
+use crate::kernels::scalar::ParticleAccess;
+use crate::ordering::ColourClasses;
 
 /// The per-body constants of a sweep.
 #[derive(Clone, Copy, Debug)]
@@ -50,16 +60,10 @@ pub(crate) enum TetOutcome {
     Skipped,
 }
 
-#[inline(always)]
-fn xw(s: &Slot) -> (Vector3<f32>, f32) {
-    let [x, y, z, w] = s.xw.to_array();
-    (Vector3::new(x, y, z), w)
-}
-
 /// One coupled projection of the material of tetrahedron `tet`.
 #[inline]
-pub(crate) fn project_tet(
-    slots: &mut [Slot],
+pub(crate) fn project_tet<A: ParticleAccess>(
+    acc: &mut A,
     prev: &[Vector3<f32>],
     tet: [u32; 4],
     dm_inv: &Matrix3<f32>,
@@ -68,7 +72,10 @@ pub(crate) fn project_tet(
     k: &MaterialStep,
 ) -> TetOutcome {
     let idx = tet.map(|i| i as usize);
-    let xw = idx.map(|i| xw(&slots[i]));
+    let xw = idx.map(|i| {
+        let [x, y, z, w] = acc.row(i).to_array();
+        (Vector3::new(x, y, z), w)
+    });
     let w = xw.map(|(_, w)| w);
     if w.iter().all(|&w| w == 0.0) {
         return TetOutcome::Skipped;
@@ -100,7 +107,7 @@ pub(crate) fn project_tet(
         dx = dx.map(|v| v * s);
     }
     for i in 0..4 {
-        slots[idx[i]].add(f32x4::new([dx[i].x, dx[i].y, dx[i].z, 0.0]));
+        acc.add_row(idx[i], f32x4::new([dx[i].x, dx[i].y, dx[i].z, 0.0]));
     }
     lambdas[0] += dl[0];
     lambdas[1] += dl[1];
@@ -129,40 +136,122 @@ fn energy_change(f: &Matrix3<f32>, df: &Matrix3<f32>, c_h: f32, at: [f32; 2], h2
     d_norm / (2.0 * at[0] * h2) + d_det * (2.0 * c_h + d_det) / (2.0 * at[1] * h2)
 }
 
-/// One Gauss–Seidel sweep of a body's material on its working copy (`slots`), tetrahedra in
-/// solver order; `prev` are the substep's start positions (for the damping). Returns the
-/// counts and the elastic energy released since the substep start (J, summed over the
-/// tetrahedra, each taken when it was projected; negative where energy was stored).
-// The slices of one body's tetrahedra and material, and the constants: what a sweep takes.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn sweep(
-    slots: &mut [Slot],
+/// The slices of a run of tetrahedra of one colour class (indexed alike): rest shapes,
+/// rest volumes (m³), multipliers, and the energy each projection released (J; written by
+/// every projection, 0 where it did nothing).
+pub(crate) struct TetRun<'a> {
+    pub rest_inverse: &'a [Matrix3<f32>],
+    pub rest_volumes: &'a [f32],
+    pub lambdas: &'a mut [[f32; 2]],
+    pub released: &'a mut [f32],
+}
+
+/// A run of tetrahedra `tets` of one colour class: with the SIMD kernel and an independent
+/// class, in pairs of chunks of [`LANES`] (lane type `P`), then one chunk of four, on the
+/// run's items with their indices checked once; the rest one by one on the scalar kernel.
+#[inline(always)]
+pub(crate) fn run_base<P: Lane, A: ParticleAccess>(
+    acc: &mut A,
     prev: &[Vector3<f32>],
-    tets: &[[u32; 4]],
-    rest_volumes: &[f32],
-    rest_inverse: &[Matrix3<f32>],
-    lambdas: &mut [[f32; 2]],
+    tets_: &[[u32; 4]],
+    run: &mut TetRun<'_>,
     k: &MaterialStep,
-) -> (ProjectionCount, f64) {
+    kernel: Kernel,
+    independent: bool,
+) -> ProjectionCount {
     let mut count = ProjectionCount::default();
-    let mut released = 0.0f64;
-    for t in 0..tets.len() {
-        match project_tet(
-            slots,
-            prev,
-            tets[t],
-            &rest_inverse[t],
-            rest_volumes[t],
-            &mut lambdas[t],
-            k,
-        ) {
-            TetOutcome::Applied(e) => {
-                count.applied += 1;
-                released += f64::from(e);
-            }
-            TetOutcome::Degenerate => count.degenerate += 1,
-            TetOutcome::Skipped => {}
+    let mut start = 0;
+    let len = tets_.len();
+    if kernel == Kernel::Simd && independent && len >= LANES {
+        assert!(
+            prev.len() >= acc.len(),
+            "{} start positions for {} particles",
+            prev.len(),
+            acc.len()
+        );
+        let mut bounded = Bounded::new(acc, tets_);
+        while start + 2 * LANES <= len {
+            count += tets::<P, A>(&mut bounded, start, prev, run, k);
+            start += 2 * LANES;
+        }
+        if start + LANES <= len {
+            count += tets::<f32x4, A>(&mut bounded, start, prev, run, k);
+            start += LANES;
         }
     }
-    (count, released)
+    // Indexing several slices alike: a range reads plainer than a zip of five.
+    #[allow(clippy::needless_range_loop)]
+    for t in start..len {
+        let o = project_tet(
+            acc,
+            prev,
+            tets_[t],
+            &run.rest_inverse[t],
+            run.rest_volumes[t],
+            &mut run.lambdas[t],
+            k,
+        );
+        count += one(&mut run.released[t], o);
+    }
+    count
+}
+
+/// [`run_base`] on the widest build this CPU runs (AVX2 + FMA when it has them, SSE2
+/// otherwise; the two give the same bits).
+pub(crate) fn run<A: ParticleAccess>(
+    acc: &mut A,
+    prev: &[Vector3<f32>],
+    tets_: &[[u32; 4]],
+    run: &mut TetRun<'_>,
+    k: &MaterialStep,
+    kernel: Kernel,
+    independent: bool,
+) -> ProjectionCount {
+    #[cfg(target_arch = "x86_64")]
+    if kernel == Kernel::Simd && independent && avx2() {
+        // SAFETY: the CPU has AVX2 and FMA (checked just above).
+        return unsafe { run_avx2(acc, prev, tets_, run, k) };
+    }
+    run_base::<X2, A>(acc, prev, tets_, run, k, kernel, independent)
+}
+
+/// [`run_base`] compiled for AVX2 + FMA, on [`Y8`] pairs.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn run_avx2<A: ParticleAccess>(
+    acc: &mut A,
+    prev: &[Vector3<f32>],
+    tets_: &[[u32; 4]],
+    run: &mut TetRun<'_>,
+    k: &MaterialStep,
+) -> ProjectionCount {
+    run_base::<Y8, A>(acc, prev, tets_, run, k, Kernel::Simd, true)
+}
+
+/// One Gauss–Seidel sweep of a body's material on its working copy (`acc`), colour class by
+/// colour class on `kernel`; `prev` are the substep's start positions (for the damping and
+/// the energy). Each projection's released energy (J) goes to `run.released`.
+pub(crate) fn sweep<A: ParticleAccess>(
+    acc: &mut A,
+    prev: &[Vector3<f32>],
+    tets_: &[[u32; 4]],
+    classes: &ColourClasses,
+    run: &mut TetRun<'_>,
+    k: &MaterialStep,
+    kernel: Kernel,
+) -> ProjectionCount {
+    let mut count = ProjectionCount::default();
+    for (r, independent) in classes.ranges() {
+        let mut part = TetRun {
+            rest_inverse: &run.rest_inverse[r.clone()],
+            rest_volumes: &run.rest_volumes[r.clone()],
+            lambdas: &mut run.lambdas[r.clone()],
+            released: &mut run.released[r.clone()],
+        };
+        count += self::run(acc, prev, &tets_[r], &mut part, k, kernel, independent);
+    }
+    count
 }

@@ -21,6 +21,7 @@ use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstr
 use crate::body::mesh::Tetrahedra;
 use crate::kernels::class_runs::{edge_run, vertex_face_run, volume_run};
 use crate::kernels::count::{Kernel, ProjectionCount};
+use crate::kernels::neo_hookean::{self, MaterialStep, TetRun};
 use crate::kernels::particle_runs::{PredictRun, VelocityRun, VelocityUpdate};
 use crate::kernels::slots::{self, Slot, WorkAccess};
 use crate::ordering::colouring::{ColourClasses, Phase};
@@ -245,6 +246,34 @@ pub(crate) fn vertex_face(
             kernel,
             ind,
         )
+    })
+}
+
+/// The material's sweep of one body ([`crate::kernels::neo_hookean::sweep`]), each colour
+/// class split among the threads like the families'; each projection writes its own entry of
+/// `run.released`, summed afterwards in tetrahedron order.
+pub(crate) fn material(
+    p: &mut WorkAccess<'_>,
+    prev: &[Vector3<f32>],
+    tets: &Tetrahedra,
+    run: &mut TetRun<'_>,
+    k: &MaterialStep,
+    kernel: Kernel,
+) -> ProjectionCount {
+    let acc = SharedAccess::new(p);
+    let (rest_inverse, rest_volumes) = (run.rest_inverse, run.rest_volumes);
+    let released = Shared::new(&mut *run.released);
+    sweep(&tets.classes, run.lambdas, acc, |a, s, lam, ind| {
+        let r = s..s + lam.len();
+        let mut part = TetRun {
+            rest_inverse: &rest_inverse[r.clone()],
+            rest_volumes: &rest_volumes[r.clone()],
+            lambdas: lam,
+            // SAFETY: `sweep` hands each range of tetrahedra to one call only (the ranges of
+            // the multipliers it hands out), and `released` is indexed like them.
+            released: unsafe { released.run(r.clone()) },
+        };
+        neo_hookean::run(a, prev, &tets.indices[r], &mut part, k, kernel, ind)
     })
 }
 

@@ -8,21 +8,37 @@ use crate::body::activation::Asleep;
 use crate::body::mesh::Tetrahedra;
 use crate::body::neo_hookean::NeoHookeanMaterial;
 use crate::body::particles::Particles;
-use crate::kernels::count::ProjectionCount;
-use crate::kernels::neo_hookean::{sweep, MaterialStep};
+use crate::kernels::count::{Kernel, ProjectionCount};
+use crate::kernels::neo_hookean::{sweep, MaterialStep, TetRun};
+use crate::kernels::slots::WorkAccess;
 use crate::kernels::working_copy::{self, CopyMode};
 
-/// One Gauss–Seidel sweep over every awake body's [`NeoHookeanMaterial`], tetrahedra in
-/// solver (colour) order, on the scalar kernel: the two constraints of each tetrahedron
-/// projected together ([`crate::constraints::neo_hookean_update`]), with the
-/// material's damping. A tetrahedron collapsed to a point (no deviatoric direction) is
-/// skipped and counted as degenerate.
+/// One Gauss–Seidel sweep over every awake body's [`NeoHookeanMaterial`] with the default
+/// kernel.
 pub fn project_neo_hookean(world: &mut World, h: f32) -> ProjectionCount {
-    project_neo_hookean_in(world, h, CopyMode::PerSweep)
+    project_neo_hookean_with(world, h, Kernel::default())
 }
 
-/// [`project_neo_hookean`], reaching the particles as `mode` says.
-pub(crate) fn project_neo_hookean_in(world: &mut World, h: f32, mode: CopyMode) -> ProjectionCount {
+/// One Gauss–Seidel sweep over every awake body's [`NeoHookeanMaterial`], tetrahedra in
+/// solver (colour) order: the two constraints of each tetrahedron projected together
+/// ([`crate::constraints::neo_hookean_update`]), with the material's damping. A tetrahedron
+/// collapsed to a point (no deviatoric direction) is skipped and counted as degenerate.
+///
+/// [`Kernel::Simd`] projects four or eight tetrahedra of a colour class at once and agrees
+/// with [`Kernel::Scalar`] to rounding. With the `parallel` feature, the tetrahedra of one
+/// colour class (which share no particle) are projected concurrently; the result is
+/// bit-identical to the serial sweep.
+pub fn project_neo_hookean_with(world: &mut World, h: f32, kernel: Kernel) -> ProjectionCount {
+    project_neo_hookean_in(world, h, kernel, CopyMode::PerSweep)
+}
+
+/// [`project_neo_hookean_with`], reaching the particles as `mode` says.
+pub(crate) fn project_neo_hookean_in(
+    world: &mut World,
+    h: f32,
+    kernel: Kernel,
+    mode: CopyMode,
+) -> ProjectionCount {
     let mut count = ProjectionCount::default();
     let q = world.query_mut::<(&mut Particles, &Tetrahedra, &mut NeoHookeanMaterial)>();
     for (p, tets, m) in q.without::<&Asleep>() {
@@ -30,22 +46,42 @@ pub(crate) fn project_neo_hookean_in(world: &mut World, h: f32, mode: CopyMode) 
         if mode == CopyMode::PerSweep {
             working_copy::load(p);
         }
-        let (c, released) = sweep(
-            &mut p.work.0,
-            &p.prev_positions,
-            &tets.indices,
-            &tets.rest_volumes,
-            &m.rest_inverse,
-            &mut m.lambdas,
-            &k,
-        );
-        m.released = released;
+        let released = &mut m.tet_released.0;
+        released.resize(m.lambdas.len(), 0.0);
+        let mut acc = WorkAccess {
+            slots: &mut p.work.0,
+            rest: &p.rest_positions,
+        };
+        let mut run = TetRun {
+            rest_inverse: &m.rest_inverse,
+            rest_volumes: &tets.rest_volumes,
+            lambdas: &mut m.lambdas,
+            released,
+        };
+        count += sweep_body(&mut acc, &p.prev_positions, tets, &mut run, &k, kernel);
+        m.released = m.tet_released.0.iter().map(|&e| f64::from(e)).sum();
         if mode == CopyMode::PerSweep {
             working_copy::store(p);
         }
-        count += c;
     }
     count
+}
+
+/// One sweep of one body's material: in parallel on a large body, serially otherwise (the
+/// same bits either way).
+fn sweep_body(
+    acc: &mut WorkAccess<'_>,
+    prev: &[nalgebra::Vector3<f32>],
+    tets: &Tetrahedra,
+    run: &mut TetRun<'_>,
+    k: &MaterialStep,
+    kernel: Kernel,
+) -> ProjectionCount {
+    #[cfg(feature = "parallel")]
+    if crate::parallel::sweeps::worth_it(tets.len()) {
+        return crate::parallel::sweeps::material(acc, prev, tets, run, k, kernel);
+    }
+    sweep(acc, prev, &tets.indices, &tets.classes, run, k, kernel)
 }
 
 /// Sets the material's multipliers and released energy to zero (start of a substep).

@@ -13,3 +13,4 @@ pub(crate) mod sleeping;
 pub(crate) mod stats;
 pub(crate) mod step;
 pub mod systems;
+pub(crate) mod tearing_pass;

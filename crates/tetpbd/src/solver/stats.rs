@@ -125,6 +125,11 @@ pub struct StepStats {
     pub hook_time: Duration,
     /// Time measuring error after the step.
     pub measure_time: Duration,
+    /// Faces torn by the tearing pass ([`crate::Tearing`]) after the substeps; the events are
+    /// in [`crate::Solver::tear_events`].
+    pub faces_torn: usize,
+    /// Time of the tearing pass (the strain check, and the splits of a frame that tears).
+    pub tearing_time: Duration,
     /// Wall time of the whole step.
     pub total_time: Duration,
 }

@@ -33,6 +33,8 @@ use crate::stabilisation::{correction_energy, deformation_damping};
 ///     hook.end_substep
 /// after the last substep: the grabs' targets roll on (systems::roll_grab_targets), rest
 ///     shapes flow (systems::flow_plastically, bodies with a Plasticity)
+/// after the frame (hook's end of frame, sleeping): faces tear (systems::tear_by_strain,
+///     bodies with a Tearing); the events are in Solver::tear_events
 /// ```
 ///
 /// Threads (feature `parallel`): a step runs its parallel passes on the pool given to
@@ -50,6 +52,8 @@ pub struct Solver {
     thread_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
     /// Scratch of the sleeping systems, kept so that a step allocates nothing.
     sleep: SleepScratch,
+    /// What the last step's tearing pass did.
+    events: Vec<crate::TearEvent>,
 }
 
 impl Solver {
@@ -61,6 +65,7 @@ impl Solver {
             #[cfg(feature = "parallel")]
             thread_pool: None,
             sleep: SleepScratch::default(),
+            events: Vec::new(),
         })
     }
 
@@ -102,9 +107,25 @@ impl Solver {
         self.settings.validate_frame(dt, gravity)?;
         let frame = FrameContext::new(&self.settings, dt, gravity);
         let mut sleep = std::mem::take(&mut self.sleep);
-        let out = self.run_step_in_pool(world, frame, hook, &mut sleep);
+        let mut out = self.run_step_in_pool(world, frame, hook, &mut sleep);
         self.sleep = sleep;
+        // Tearing changes particle and surface counts: after the hook's end of frame, so a
+        // hook sees one mesh per frame.
+        let t = Instant::now();
+        self.events.clear();
+        let torn = systems::tear_by_strain(world, dt, &mut self.events);
+        if let Ok(stats) = &mut out {
+            stats.faces_torn = torn;
+            stats.tearing_time = t.elapsed();
+            stats.total_time += stats.tearing_time;
+        }
         out
+    }
+
+    /// What the last step's tearing pass did: one event per body that tore (empty in a
+    /// frame without tearing). Cuts ([`crate::cut`]) return their events directly.
+    pub fn tear_events(&self) -> &[crate::TearEvent] {
+        &self.events
     }
 
     /// [`Solver::run_step`] in the solver's pool (feature `parallel`).
@@ -317,8 +338,12 @@ impl Solver {
         working_copy::load_bodies(world);
         stats.copy_time += t.elapsed();
         let t = Instant::now();
-        let c =
-            crate::solver::material_systems::project_neo_hookean_in(world, h, CopyMode::Resident);
+        let c = crate::solver::material_systems::project_neo_hookean_in(
+            world,
+            h,
+            s.kernel,
+            CopyMode::Resident,
+        );
         stats.material.time += t.elapsed();
         stats.material.projections += c.applied;
         stats.material.degenerate += c.degenerate;

@@ -26,9 +26,12 @@ pub use crate::kernels::particle_runs::VelocityUpdate;
 use crate::kernels::particle_runs::{PredictRun, VelocityRun};
 use crate::kernels::slots::WorkAccess;
 use crate::kernels::working_copy::{self, CopyMode};
-pub use crate::solver::material_systems::{project_neo_hookean, reset_neo_hookean};
+pub use crate::solver::material_systems::{
+    project_neo_hookean, project_neo_hookean_with, reset_neo_hookean,
+};
 pub use crate::solver::plastic_flow::flow_plastically;
 use crate::solver::stats::{ErrorAccumulator, ErrorStats};
+pub use crate::solver::tearing_pass::tear_by_strain;
 pub use crate::stabilisation::deformation_damping::damp_deformation;
 
 /// Saves `x` as the substep start, applies gravity plus each body's

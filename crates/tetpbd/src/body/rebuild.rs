@@ -1,0 +1,206 @@
+//! The components of one piece of a split body, rebuilt with the builder's own functions.
+//!
+//! After a split (`crate::body::split`) a body's particles and tetrahedra are renumbered;
+//! what is derived from the mesh is built again the way [`crate::SoftBodyBuilder::build`]
+//! builds it (solver order and colour classes, edges and their rest lengths, surface), from
+//! the rest positions. What belongs to a tetrahedron travels with it: its rest volume,
+//! vertex–face rest heights, the material's rest shape and its plastic stretch; what belongs to a
+//! particle travels with it: position, velocity, masses, rest position, residual, forces.
+
+use nalgebra::Vector3;
+
+use crate::body::builder::{body_parts, edge_constraints, SoftBody, TetMesh};
+use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::body::forces::UserForces;
+use crate::body::mesh::{Surface, Tetrahedra};
+use crate::body::neo_hookean::{NeoHookeanMaterial, ReleasedScratch};
+use crate::body::particles::Particles;
+use crate::body::plastic_rest::RestState;
+use crate::body::plasticity::Plasticity;
+use crate::body::tearing::{interior_faces, Tearing};
+use crate::kernels::slots::{Slot, WorkCopy};
+use crate::ordering::partition::part_order;
+
+/// A split body's components, borrowed: particles with the copies appended, tetrahedra with
+/// their corners renumbered (still in the old order).
+pub(crate) struct SplitBody<'a> {
+    pub particles: &'a Particles,
+    pub tetrahedra: &'a Tetrahedra,
+    pub edges: Option<&'a EdgeConstraints>,
+    pub vertex_face: Option<&'a VertexFaceConstraints>,
+    pub volume: Option<&'a VolumeConstraints>,
+    pub plasticity: Option<&'a Plasticity>,
+    pub material: Option<&'a NeoHookeanMaterial>,
+    pub tearing: Option<&'a Tearing>,
+    pub forces: Option<&'a UserForces>,
+}
+
+/// The rebuilt components of one piece.
+pub(crate) struct PieceParts {
+    pub body: SoftBody,
+    pub forces: Option<UserForces>,
+    /// The split body's index of each of the piece's particles (ascending).
+    pub particles: Vec<u32>,
+    /// The split body's index of each of the piece's tetrahedra, in the piece's order.
+    pub from: Vec<u32>,
+}
+
+/// The piece made of the split body's particles `particles` (ascending) and tetrahedra
+/// `tets` (ascending), rebuilt as described in the module docs.
+pub(crate) fn assemble(b: &SplitBody, particles: &[u32], tets: &[u32]) -> PieceParts {
+    let p = b.particles;
+    let mut local = vec![u32::MAX; p.len()];
+    for (k, &i) in particles.iter().enumerate() {
+        local[i as usize] = k as u32;
+    }
+    let new_particles = piece_particles(p, particles);
+    let rest = &new_particles.rest_positions;
+    let local_tets: Vec<[u32; 4]> = tets
+        .iter()
+        .map(|&t| b.tetrahedra.indices[t as usize].map(|i| local[i as usize]))
+        .collect();
+    // Solver order and colour classes, as the builder makes them.
+    let (parts, part_of) = body_parts(rest, &local_tets, 0);
+    let (order, classes) = part_order(&local_tets, &part_of, parts, rest.len());
+    let from: Vec<u32> = order.iter().map(|&k| tets[k]).collect();
+    let pick = |t: &u32| *t as usize;
+    let tetrahedra = Tetrahedra {
+        indices: order.iter().map(|&k| local_tets[k]).collect(),
+        rest_volumes: from
+            .iter()
+            .map(|t| b.tetrahedra.rest_volumes[pick(t)])
+            .collect(),
+        source: from.iter().map(|t| b.tetrahedra.source[pick(t)]).collect(),
+        classes,
+    };
+    let count = tetrahedra.len();
+    let mesh = TetMesh {
+        vertices: rest.clone(),
+        tets: tetrahedra.indices.clone(),
+    };
+    let mut edges = b
+        .edges
+        .map(|e| edge_constraints(&mesh, &part_of, parts, e.compliance));
+    let mut vertex_face = b.vertex_face.map(|v| VertexFaceConstraints {
+        rest_heights: from.iter().map(|t| v.rest_heights[pick(t)]).collect(),
+        lambdas: vec![[0.0; 4]; count],
+        compliance: v.compliance,
+    });
+    let volume = b.volume.map(|v| VolumeConstraints {
+        lambdas: vec![0.0; count],
+        compliance: v.compliance,
+    });
+    let mut material = b.material.map(|m| NeoHookeanMaterial {
+        material: m.material,
+        rest_inverse: from.iter().map(|t| m.rest_inverse[pick(t)]).collect(),
+        lambdas: vec![[0.0; 2]; count],
+        released: 0.0,
+        tet_released: ReleasedScratch(vec![0.0; count]),
+    });
+    let plasticity = b
+        .plasticity
+        .map(|pl| pl.for_piece(&from, &tetrahedra.indices, edges.as_ref()));
+    let mut tetrahedra = tetrahedra;
+    if let Some(pl) = &plasticity {
+        // Edge rest lengths from the plastic rest shapes, as the flow pass sets them.
+        let mut state = RestState {
+            tetrahedra: &mut tetrahedra,
+            vertex_face: vertex_face.as_mut(),
+            edges: edges.as_mut(),
+            material: material.as_mut(),
+        };
+        state.refresh_edges(pl, rest);
+    }
+    let tearing = b
+        .tearing
+        .map(|old| piece_tearing(old, &from, &tetrahedra, rest));
+    let forces = b.forces.map(|f| UserForces {
+        forces: particles.iter().map(|&i| f.forces[i as usize]).collect(),
+    });
+    let surface = Surface::from_tetrahedra(&tetrahedra.indices, rest);
+    PieceParts {
+        body: SoftBody {
+            particles: new_particles,
+            tetrahedra,
+            surface,
+            edges,
+            vertex_face,
+            volume,
+            plasticity,
+            material,
+            tearing,
+        },
+        forces,
+        particles: particles.to_vec(),
+        from,
+    }
+}
+
+/// The particles `list` of `p`, in that order; the piece's vertex map names, for each
+/// input vertex, the first particle built from it (`u32::MAX` when none is in the piece).
+fn piece_particles(p: &Particles, list: &[u32]) -> Particles {
+    fn gather<T: Copy>(v: &[T], list: &[u32]) -> Vec<T> {
+        list.iter().map(|&i| v[i as usize]).collect()
+    }
+    let source = gather(&p.source, list);
+    let mut vertex_to_particle = vec![u32::MAX; p.vertex_to_particle.len()];
+    for (k, &s) in source.iter().enumerate() {
+        if let Some(slot) = vertex_to_particle.get_mut(s as usize) {
+            if *slot == u32::MAX {
+                *slot = k as u32;
+            }
+        }
+    }
+    Particles {
+        positions: gather(&p.positions, list),
+        prev_positions: gather(&p.prev_positions, list),
+        velocities: gather(&p.velocities, list),
+        inv_masses: gather(&p.inv_masses, list),
+        masses: gather(&p.masses, list),
+        rest_positions: gather(&p.rest_positions, list),
+        residuals: gather(&p.residuals, list),
+        source,
+        vertex_to_particle,
+        work: WorkCopy(vec![Slot::default(); list.len()]),
+        written: true,
+        hook: Default::default(),
+    }
+}
+
+/// The tearing state of a piece whose tetrahedron `k` was the split body's `from[k]`: its
+/// interior faces, each keeping the smoothed strain and torn flag it had.
+fn piece_tearing(
+    old: &Tearing,
+    from: &[u32],
+    tetrahedra: &Tetrahedra,
+    rest: &[Vector3<f32>],
+) -> Tearing {
+    let mut faces = interior_faces(&tetrahedra.indices, rest);
+    // The piece's index of each of the split body's tetrahedra in it, sorted by the latter.
+    let mut new_of: Vec<(u32, u32)> = from
+        .iter()
+        .enumerate()
+        .map(|(k, &t)| (t, k as u32))
+        .collect();
+    new_of.sort_unstable();
+    let map = |t: u32| {
+        new_of
+            .binary_search_by_key(&t, |e| e.0)
+            .ok()
+            .map(|j| new_of[j].1)
+    };
+    for f in &old.faces {
+        let (Some(a), Some(b)) = (map(f.tets[0]), map(f.tets[1])) else {
+            continue;
+        };
+        let key = [a.min(b), a.max(b)];
+        if let Ok(j) = faces.binary_search_by_key(&key, |g| g.tets) {
+            faces[j].smoothed = f.smoothed;
+            faces[j].torn = f.torn;
+        }
+    }
+    Tearing {
+        settings: old.settings,
+        faces,
+    }
+}
