@@ -18,7 +18,7 @@ use crate::report::{ContactReport, CouplingStats};
 use crate::settings::CouplingSettings;
 use crate::soft_soft::settings::SoftContactSettings;
 use crate::soft_soft::SoftContacts;
-use crate::substep::CouplingHook;
+use crate::substep::{CoupledHooks, CouplingHook};
 
 /// Two-way coupling of `tetpbd` soft bodies with a rapier scene.
 ///
@@ -286,19 +286,23 @@ impl Coupling {
                 self_weight_stacking: self.settings.self_weight_stacking,
                 reports: &mut self.reports,
             };
-            let mut off = ();
-            let soft_contacts: &mut dyn SubstepHook = match self.settings.soft_contacts {
+            let soft = match self.settings.soft_contacts {
                 Some(s) => {
                     self.soft_contacts.set_settings(s)?;
                     let default = self.settings.default_collider;
                     self.soft_contacts.set_default_collider(default);
-                    &mut self.soft_contacts
+                    let ratio = self.settings.stacking_mass_ratio;
+                    self.soft_contacts.set_carrying_ratio(ratio);
+                    Some(&mut self.soft_contacts)
                 }
-                None => &mut off,
+                None => None,
             };
-            let out =
-                self.solver
-                    .step_frame(world, dt, gravity, &mut (hook, (soft_contacts, extra)));
+            let mut hooks = CoupledHooks {
+                rigid: hook,
+                soft,
+                extra,
+            };
+            let out = self.solver.step_frame(world, dt, gravity, &mut hooks);
             // The coupling's components follow the pieces of the step's tears (also when
             // the step reports a restored particle: the frame ran to its end).
             for event in self.solver.tear_events() {

@@ -88,7 +88,7 @@ pub(crate) struct Stacking<'a> {
 }
 
 /// How a collider takes part: immovable (a support), a dynamic body, or neither.
-fn immovable(cp: &ColliderProxy, bodies: &[BodyProxy]) -> bool {
+pub(crate) fn immovable(cp: &ColliderProxy, bodies: &[BodyProxy]) -> bool {
     cp.body.is_none_or(|b| {
         matches!(
             bodies[b].kind,

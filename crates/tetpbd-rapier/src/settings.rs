@@ -33,6 +33,11 @@ pub struct CouplingSettings {
     /// once more from the ground up with the supported particles held, then the heavy body's
     /// contacts with the soft surface frozen (shock propagation, `heavy_loads` module docs).
     /// Without it, one iteration per substep lets a 1000 kg box crush a 1 kg slab.
+    ///
+    /// The same ratio decides soft–soft *carrying*: a soft body touching an immovable
+    /// support holds still under a soft body at least this many times heavier per particle
+    /// that rests on it (`soft_soft::carrying` module docs); without it a 1.5 t soft cube
+    /// landing on a 24 kg soft slab threw the slab out from under it at 240 m/s.
     pub stacking_mass_ratio: f32,
     /// Whether every soft body on an immovable support gets the ground-up sweep of the
     /// stacking pass under its own weight too, not only under a heavy rigid load (default

@@ -17,7 +17,7 @@ use crate::contacts::support::{
 };
 use crate::depenetration::{cap_depenetration, settle_substeps};
 use crate::gather::{Frame, GatherInput};
-use crate::heavy_loads::{stacked_velocity_pass, stacking_pass, Stacking};
+use crate::heavy_loads::{immovable, stacked_velocity_pass, stacking_pass, Stacking};
 use crate::impact::Impact;
 use crate::joints::project_joints;
 use crate::report::{ContactReport, SoftFeature};
@@ -25,6 +25,7 @@ use crate::response::restitution::restitution_pass;
 use crate::response::rolling::rolling_pass;
 use crate::rigid::shape_query::surface_point;
 use crate::soft_collider::SoftCollider;
+use crate::soft_soft::SoftContacts;
 
 /// Borrows the frame state and rapier's query pipeline for one soft step.
 pub(crate) struct CouplingHook<'q, 'a> {
@@ -43,6 +44,73 @@ pub(crate) struct CouplingHook<'q, 'a> {
     /// `CouplingSettings::self_weight_stacking`.
     pub self_weight_stacking: bool,
     pub reports: &'q mut Vec<ContactReport>,
+}
+
+/// The coupling's hooks in the order they run at every point: soft–rigid, then soft–soft
+/// contacts (when on), then the caller's. Before the soft–soft projection of an iteration
+/// the soft–soft contacts learn which soft bodies touch an immovable support in the substep
+/// (`soft_soft::carrying` module docs).
+pub(crate) struct CoupledHooks<'q, 'a, 'e> {
+    pub rigid: CouplingHook<'q, 'a>,
+    pub soft: Option<&'q mut SoftContacts>,
+    pub extra: &'e mut dyn SubstepHook,
+}
+
+impl SubstepHook for CoupledHooks<'_, '_, '_> {
+    fn begin_frame(&mut self, world: &mut World, frame: FrameContext) {
+        self.rigid.begin_frame(world, frame);
+        if let Some(soft) = self.soft.as_deref_mut() {
+            soft.begin_frame(world, frame);
+        }
+        self.extra.begin_frame(world, frame);
+    }
+
+    fn begin_substep(&mut self, world: &mut World, substep: SubstepContext) {
+        self.rigid.begin_substep(world, substep);
+        if let Some(soft) = self.soft.as_deref_mut() {
+            soft.begin_substep(world, substep);
+        }
+        self.extra.begin_substep(world, substep);
+    }
+
+    fn project(&mut self, world: &mut World, substep: SubstepContext) {
+        self.rigid.project(world, substep);
+        if let Some(soft) = self.soft.as_deref_mut() {
+            let f = &*self.rigid.frame;
+            soft.set_supported(f.soft.iter().filter_map(|s| {
+                let on_support = f.contacts[s.contacts.clone()]
+                    .iter()
+                    .any(|c| c.active && c.solve && immovable(&f.colliders[c.collider], &f.bodies));
+                on_support.then(|| s.entity.to_bits().get())
+            }));
+            soft.project(world, substep);
+        }
+        self.extra.project(world, substep);
+    }
+
+    fn end_substep(&mut self, world: &mut World, substep: SubstepContext) {
+        self.rigid.end_substep(world, substep);
+        if let Some(soft) = self.soft.as_deref_mut() {
+            soft.end_substep(world, substep);
+        }
+        self.extra.end_substep(world, substep);
+    }
+
+    fn end_frame(&mut self, world: &mut World, frame: FrameContext) {
+        self.rigid.end_frame(world, frame);
+        if let Some(soft) = self.soft.as_deref_mut() {
+            soft.end_frame(world, frame);
+        }
+        self.extra.end_frame(world, frame);
+    }
+
+    fn touching(&mut self, world: &mut World, touching: &mut tetpbd::Touching) {
+        self.rigid.touching(world, touching);
+        if let Some(soft) = self.soft.as_deref_mut() {
+            soft.touching(world, touching);
+        }
+        self.extra.touching(world, touching);
+    }
 }
 
 /// The fraction of the frame elapsed at the end of `substep`: where the rigid bodies stand

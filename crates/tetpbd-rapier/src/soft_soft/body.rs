@@ -69,16 +69,17 @@ pub(crate) fn relative_normal_velocity(
 }
 
 /// Changes the relative normal velocity of `a` against `b` along the unit normal `n` by `dv`
-/// (m/s) with opposite impulses on the two bodies, shared by their inverse masses `W`: `a`'s
-/// free particles all get `n dv W_a/(W_a+W_b)`, `b`'s `−n dv W_b/(W_a+W_b)` (momentum kept,
-/// no deformation added). Nothing when neither can move.
+/// (m/s) with opposite impulses on the two bodies, shared by the inverse masses `W` given
+/// (1/kg; the bodies' own, or 0 for a body held still): `a`'s free particles all get
+/// `n dv W_a/(W_a+W_b)`, `b`'s `−n dv W_b/(W_a+W_b)` (momentum kept when the `W` are the
+/// bodies', no deformation added). Nothing when neither can move.
 pub(crate) fn exchange(
     world: &mut World,
     (a, b): (&FrameBody, &FrameBody),
+    (wa, wb): (f32, f32),
     n: &Vector3<f32>,
     dv: f32,
 ) {
-    let (wa, wb) = (a.inv_mass, b.inv_mass);
     let wsum = wa + wb;
     if wsum.is_nan() || wsum <= 0.0 {
         return;

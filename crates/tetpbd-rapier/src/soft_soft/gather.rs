@@ -43,6 +43,12 @@ pub(crate) struct Candidate {
     pub group: [u32; 2],
     /// `w_p + Σ β² w` of the last projection, 1/kg.
     pub wsum: f32,
+    /// Inverse masses `[w_p, w_a, w_b, w_c]` of the last projection, 1/kg: the particles'
+    /// own, or zero on the side that carries the other (`carrying` module docs).
+    pub weights: [f32; 4],
+    /// Which side the last projection held still: 0 none, 1 the particle, 2 the triangle
+    /// (`carrying` module docs).
+    pub held: u8,
     /// Normal and barycentrics of the last projection.
     pub n: Vector3<f32>,
     pub bary: [f32; 3],
@@ -455,6 +461,8 @@ fn candidate(p: u32, tri: [u32; 3], props: SoftPair, depth_limit: f32) -> Candid
         prism_prev: false,
         group: [0, 0],
         wsum: 0.0,
+        weights: [0.0; 4],
+        held: 0,
         n: Vector3::zeros(),
         bary: [1.0 / 3.0; 3],
     }

@@ -88,6 +88,7 @@
 
 pub(crate) mod body;
 pub(crate) mod bvh;
+pub(crate) mod carrying;
 pub(crate) mod gather;
 pub(crate) mod project;
 pub(crate) mod restitution;
@@ -99,6 +100,7 @@ use tetpbd::{FrameContext, SubstepContext, SubstepHook};
 
 use crate::error::CouplingError;
 use crate::soft_collider::SoftCollider;
+use crate::soft_soft::carrying::Carrying;
 use crate::soft_soft::gather::{ContactFrame, Gather};
 use crate::soft_soft::restitution::BodyRestitution;
 use crate::soft_soft::separation::Separation;
@@ -146,6 +148,8 @@ pub struct SoftContacts {
     stats: SoftContactStats,
     /// Scratch of the waking pass (`sleeping` module docs).
     waking: crate::sleeping::Waking,
+    /// Which bodies rest on a support, for carried contacts (`carrying` module docs).
+    carrying: Carrying,
 }
 
 impl SoftContacts {
@@ -161,6 +165,7 @@ impl SoftContacts {
             waking: crate::sleeping::Waking::default(),
             restitution: BodyRestitution::default(),
             stats: SoftContactStats::default(),
+            carrying: Carrying::default(),
         })
     }
 
@@ -179,6 +184,22 @@ impl SoftContacts {
     /// Statistics of the last frame.
     pub fn stats(&self) -> &SoftContactStats {
         &self.stats
+    }
+
+    /// Sets the mass ratio from which a soft body resting on an immovable support holds a
+    /// heavier one above it still (`f32::INFINITY`: never; `carrying` module docs).
+    pub(crate) fn set_carrying_ratio(&mut self, ratio: f32) {
+        self.carrying.ratio = ratio;
+    }
+
+    /// The soft bodies touching an immovable support in the current substep (entity bits,
+    /// any order), before [`SubstepHook::project`].
+    pub(crate) fn set_supported(&mut self, supported: impl Iterator<Item = u64>) {
+        let list = &mut self.carrying.supported;
+        list.clear();
+        list.extend(supported);
+        list.sort_unstable();
+        list.dedup();
     }
 
     /// The collision properties of bodies without a [`SoftCollider`] component
@@ -233,8 +254,17 @@ impl SubstepHook for SoftContacts {
 
     fn project(&mut self, world: &mut World, substep: SubstepContext) {
         let h = substep.h();
-        self.frame
-            .project(world, &self.gather, &self.settings, h, &mut self.stats);
+        let up = -substep.gravity();
+        self.carrying.up = up
+            .try_normalize(1e-6)
+            .unwrap_or_else(nalgebra::Vector3::zeros);
+        self.frame.project(
+            world,
+            (&self.gather, &mut self.carrying),
+            &self.settings,
+            h,
+            &mut self.stats,
+        );
     }
 
     fn end_substep(&mut self, world: &mut World, substep: SubstepContext) {

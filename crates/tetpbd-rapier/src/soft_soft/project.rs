@@ -10,6 +10,7 @@ use tetpbd::Particles;
 use crate::convert::finite3;
 use crate::response::friction::{positional_friction, ContactStencil, Coulomb};
 use crate::soft_soft::bvh::{closest_barycentric, plane_barycentric, triangle_normal};
+use crate::soft_soft::carrying::Carrying;
 use crate::soft_soft::gather::{Candidate, ContactFrame, Gather};
 use crate::soft_soft::settings::{SoftContactSettings, SoftContactStats};
 
@@ -109,7 +110,7 @@ impl ContactFrame {
     pub fn project(
         &mut self,
         world: &mut World,
-        g: &Gather,
+        (g, carrying): (&Gather, &mut Carrying),
         s: &SoftContactSettings,
         h: f32,
         stats: &mut SoftContactStats,
@@ -118,6 +119,15 @@ impl ContactFrame {
             return;
         }
         self.load(world, g, Field::Position);
+        carrying.on_support.clear();
+        carrying.on_support.extend(g.bodies.iter().map(|b| {
+            carrying
+                .supported
+                .binary_search(&b.entity.to_bits().get())
+                .is_ok()
+        }));
+        let carrying = &*carrying;
+        let carries = carrying.any();
         let steps = (
             s.compliance / (h * h),
             s.max_separation_speed * h,
@@ -134,7 +144,28 @@ impl ContactFrame {
             if candidates[i].recovery {
                 continue;
             }
-            match project_one(candidates, i, x, x_prev, w, steps) {
+            let bodies = if carries {
+                let c = &candidates[i];
+                Some((
+                    g.body_of_slot(c.p as usize),
+                    g.body_of_slot(c.tri[0] as usize),
+                ))
+            } else {
+                None
+            };
+            let weights = |c: &Candidate, n: &Vector3<f32>| {
+                let own = [
+                    w[c.p as usize],
+                    w[c.tri[0] as usize],
+                    w[c.tri[1] as usize],
+                    w[c.tri[2] as usize],
+                ];
+                match bodies {
+                    Some((bp, bt)) => carrying.weights(bp, bt, own, n),
+                    None => own,
+                }
+            };
+            match project_one(candidates, i, x, x_prev, weights, steps) {
                 Outcome::Degenerate => stats.degenerate += 1,
                 Outcome::Clamped => stats.clamps += 1,
                 Outcome::Done => {}
@@ -150,22 +181,27 @@ impl ContactFrame {
             return;
         }
         self.load(world, g, Field::Velocity);
-        let ContactFrame {
-            v, w, candidates, ..
-        } = self;
+        let ContactFrame { v, candidates, .. } = self;
         for c in candidates.iter().filter(|c| c.active) {
-            let (p, n, bary) = (c.p as usize, c.n, c.bary);
+            let (p, n, bary, w) = (c.p as usize, c.n, c.bary, c.weights);
             let tri = c.tri.map(|i| i as usize);
             let vq: Vector3<f32> = (0..3).map(|k| v[tri[k]] * bary[k]).sum();
-            let vn = n.dot(&(v[p] - vq));
-            let wsum = w[p] + (0..3).map(|k| bary[k] * bary[k] * w[tri[k]]).sum::<f32>();
+            // A held side moves the other one no faster than the support it rests on
+            // (at rest): its own separating normal velocity is not handed on.
+            let (vp_n, vq_n) = match c.held {
+                1 => (n.dot(&v[p]).max(0.0), n.dot(&vq)),
+                2 => (n.dot(&v[p]), n.dot(&vq).min(0.0)),
+                _ => (n.dot(&v[p]), n.dot(&vq)),
+            };
+            let vn = vp_n - vq_n;
+            let wsum = w[0] + (0..3).map(|k| bary[k] * bary[k] * w[k + 1]).sum::<f32>();
             if !(vn > 0.0 && wsum > 0.0) {
                 continue;
             }
             let j = -vn / wsum;
-            v[p] += n * (w[p] * j);
+            v[p] += n * (w[0] * j);
             for k in 0..3 {
-                v[tri[k]] -= n * (w[tri[k]] * bary[k] * j);
+                v[tri[k]] -= n * (w[k + 1] * bary[k] * j);
             }
         }
         self.store(world, g, Field::Velocity);
@@ -212,7 +248,7 @@ fn project_one(
     i: usize,
     x: &mut [Vector3<f32>],
     x_prev: &[Vector3<f32>],
-    w: &[f32],
+    weights: impl Fn(&Candidate, &Vector3<f32>) -> [f32; 4],
     (alpha_tilde, step, skin_step): (f32, f32, f32),
 ) -> Outcome {
     let c = &candidates[i];
@@ -258,8 +294,9 @@ fn project_one(
     if cval.is_nan() || cval >= 0.0 {
         return Outcome::Done;
     }
-    let wp = w[p];
-    let wsum = wp + (0..3).map(|k| bary[k] * bary[k] * w[tri[k]]).sum::<f32>();
+    let w = weights(c, &n);
+    let wp = w[0];
+    let wsum = wp + (0..3).map(|k| bary[k] * bary[k] * w[k + 1]).sum::<f32>();
     let denom = wsum + alpha_tilde;
     if !(wsum > 0.0 && denom.is_finite()) {
         return Outcome::Done;
@@ -273,7 +310,7 @@ fn project_one(
     }
     x[p] += n * (wp * dl);
     for k in 0..3 {
-        x[tri[k]] -= n * (w[tri[k]] * bary[k] * dl);
+        x[tri[k]] -= n * (w[k + 1] * bary[k] * dl);
     }
     c.lambda_n += dl;
     c.active = true;
@@ -281,7 +318,13 @@ fn project_one(
     c.n = n;
     c.bary = bary;
     c.wsum = wsum;
-    friction(c, x, x_prev, w);
+    c.weights = w;
+    c.held = match (w[0] == 0.0, w[1..] == [0.0; 3]) {
+        (true, false) => 1,
+        (false, true) => 2,
+        _ => 0,
+    };
+    friction(c, x, x_prev);
     let clamped = target < 0.0 && !c.clamped;
     if clamped {
         c.clamped = true;
@@ -361,7 +404,8 @@ fn contact_target(d_prev: f32, thickness: f32, step: f32, skin_step: f32) -> f32
 struct ParticleOnTriangle<'s> {
     x: &'s mut [Vector3<f32>],
     x_prev: &'s [Vector3<f32>],
-    w: &'s [f32],
+    /// Inverse masses `[w_p, w_a, w_b, w_c]`, 1/kg.
+    w: [f32; 4],
     p: usize,
     tri: [usize; 3],
     bary: [f32; 3],
@@ -381,19 +425,19 @@ impl ContactStencil for ParticleOnTriangle<'_> {
 
     fn apply(&mut self, t: &Vector3<f32>, dl: f32) {
         let (w, tri) = (self.w, self.tri);
-        self.x[self.p] -= t * (w[self.p] * dl);
+        self.x[self.p] -= t * (w[0] * dl);
         for k in 0..3 {
-            self.x[tri[k]] += t * (w[tri[k]] * self.bary[k] * dl);
+            self.x[tri[k]] += t * (w[k + 1] * self.bary[k] * dl);
         }
     }
 }
 
 /// Coulomb friction of one contact just projected ([`crate::response::friction`]).
-fn friction(c: &mut Candidate, x: &mut [Vector3<f32>], x_prev: &[Vector3<f32>], w: &[f32]) {
+fn friction(c: &mut Candidate, x: &mut [Vector3<f32>], x_prev: &[Vector3<f32>]) {
     let mut stencil = ParticleOnTriangle {
         x,
         x_prev,
-        w,
+        w: c.weights,
         p: c.p as usize,
         tri: c.tri.map(|i| i as usize),
         bary: c.bary,

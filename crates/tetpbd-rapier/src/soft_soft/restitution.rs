@@ -46,6 +46,9 @@ use crate::soft_soft::gather::{ContactFrame, Gather};
 pub(crate) struct BodyRestitution {
     /// Per pair of the frame: sum of the contact normals of the substep.
     sums: Vec<Vector3<f32>>,
+    /// Per pair of the frame: the body a held contact of the substep holds still (one of
+    /// the pair's frame bodies; `carrying` module docs).
+    held: Vec<Option<usize>>,
     /// Per frame body: centre-of-mass velocity at the substep start (only when some pair
     /// has a restitution above 0).
     v_pre: Vec<Vector3<f32>>,
@@ -79,6 +82,8 @@ impl BodyRestitution {
     ) {
         self.sums.clear();
         self.sums.resize(g.pairs.len(), Vector3::zeros());
+        self.held.clear();
+        self.held.resize(g.pairs.len(), None);
         let mut any = false;
         for c in frame.candidates.iter().filter(|c| c.active) {
             let bp = g.body_of_slot(c.p as usize);
@@ -93,6 +98,11 @@ impl BodyRestitution {
             // The triangle's normal points from its body to the particle's.
             let n = if bp == key.0 { c.n } else { -c.n };
             self.sums[k] += n;
+            match c.held {
+                1 => self.held[k] = Some(bp),
+                2 => self.held[k] = Some(bt),
+                _ => {}
+            }
             any = true;
         }
         if any {
@@ -133,7 +143,14 @@ impl BodyRestitution {
             .episode(key, approach, threshold)
             .change(v_n, e, pull);
         if let Some(dv) = dv.filter(|dv| !dv.is_nan()) {
-            exchange(world, (ba, bb), &n, dv);
+            // A body resting on a support that holds a much heavier one still takes no
+            // share (`carrying` module docs).
+            let weights = match self.held[k] {
+                Some(h) if h == a => (0.0, bb.inv_mass),
+                Some(h) if h == b => (ba.inv_mass, 0.0),
+                _ => (ba.inv_mass, bb.inv_mass),
+            };
+            exchange(world, (ba, bb), weights, &n, dv);
         }
     }
 }

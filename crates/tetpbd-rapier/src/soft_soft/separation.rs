@@ -162,7 +162,7 @@ impl Separation {
             if rel.is_nan() || rel >= 0.0 {
                 continue;
             }
-            exchange(world, (a, b), &pair.dir, -rel);
+            exchange(world, (a, b), (a.inv_mass, b.inv_mass), &pair.dir, -rel);
         }
     }
 

@@ -39,6 +39,65 @@ struct Options {
     /// Print the chosen scene frame by frame.
     #[arg(long)]
     trace: bool,
+    /// With `--trace`: also print every body's kinetic energy after each substep of the
+    /// frames from this one on (to `--substeps-until`).
+    #[arg(long)]
+    substeps_from: Option<u32>,
+    /// Last frame whose substeps `--substeps-from` prints.
+    #[arg(long, default_value_t = u32::MAX)]
+    substeps_until: u32,
+}
+
+/// Prints every soft body's kinetic energy and fastest particle after each substep.
+struct SubstepTrace;
+
+impl tetpbd::SubstepHook for SubstepTrace {
+    fn project(&mut self, world: &mut hecs::World, substep: tetpbd::SubstepContext) {
+        let h = substep.h();
+        let bodies: Vec<String> = world
+            .query::<&Particles>()
+            .iter()
+            .map(|p| {
+                let ke: f32 = p
+                    .positions()
+                    .iter()
+                    .zip(p.prev_positions())
+                    .zip(p.masses())
+                    .map(|((x, x0), m)| 0.5 * m * ((x - x0) / h).norm_squared())
+                    .sum();
+                format!("{ke:.1}")
+            })
+            .collect();
+        println!("  projected {}: {bodies:?}", substep.substep());
+    }
+
+    fn end_substep(&mut self, world: &mut hecs::World, substep: tetpbd::SubstepContext) {
+        let bodies: Vec<String> = world
+            .query::<&Particles>()
+            .iter()
+            .map(|p| {
+                let (i, v) = p
+                    .velocities()
+                    .iter()
+                    .enumerate()
+                    .max_by(|a, b| a.1.norm().total_cmp(&b.1.norm()))
+                    .map_or((0, nalgebra::Vector3::zeros()), |(i, v)| (i, *v));
+                let x = p.positions().get(i).copied().unwrap_or_default();
+                format!(
+                    "KE {:.1} max {:.1} #{i} at {:.3} {:.3} {:.3} v {:.1} {:.1} {:.1}",
+                    p.kinetic_energy(),
+                    p.max_speed(),
+                    x.x,
+                    x.y,
+                    x.z,
+                    v.x,
+                    v.y,
+                    v.z
+                )
+            })
+            .collect();
+        println!("  substep {}: {bodies:?}", substep.substep());
+    }
 }
 
 /// A small deterministic generator (SplitMix64).
@@ -241,6 +300,7 @@ fn run_scene(k: u64, o: &Options) -> (String, Outcome) {
         e
     };
     let trace = o.trace;
+    let o_substeps = (o.substeps_from, o.substeps_until);
     let mut o = Outcome {
         scale: ke0.abs() + mass * 9.81 * (scale_size + top),
         start_speed: (start_speed * start_speed + 2.0 * 9.81 * (top + scale_size)).sqrt(),
@@ -249,10 +309,19 @@ fn run_scene(k: u64, o: &Options) -> (String, Outcome) {
     };
     let frames = 240;
     for f in 0..frames {
-        if let Err(err) = s.step() {
-            o.error = Some(format!("frame {f}: {err}"));
-            return (what, o);
-        }
+        let substep_trace = trace && o_substeps.0.is_some_and(|a| f >= a) && f <= o_substeps.1;
+        let stepped = if substep_trace {
+            s.step_with(&mut SubstepTrace)
+        } else {
+            s.step()
+        };
+        let stats = match stepped {
+            Ok(stats) => stats,
+            Err(err) => {
+                o.error = Some(format!("frame {f}: {err}"));
+                return (what, o);
+            }
+        };
         let (e, fastest) = energy(&s);
         if !e.is_finite() {
             o.error = Some(format!("frame {f}: energy {e}"));
@@ -266,11 +335,15 @@ fn run_scene(k: u64, o: &Options) -> (String, Outcome) {
                 .iter()
                 .map(|p| {
                     let c = p.center_of_mass();
-                    let v = p.linear_momentum() / p.total_mass();
+                    let m = p.total_mass();
+                    let v = p.linear_momentum() / m;
                     format!(
-                        "{:.2} v {:.2} @ {:.2} {:.2} {:.2}",
+                        "{m:.1} kg max {:.2} v {:.2} KE {:.1} PE {:.1} low {:.3} @ {:.2} {:.2} {:.2}",
                         p.max_speed(),
                         v.norm(),
+                        p.kinetic_energy(),
+                        m * 9.81 * c.y,
+                        p.aabb().0.y,
                         c.x,
                         c.y,
                         c.z
@@ -284,7 +357,16 @@ fn run_scene(k: u64, o: &Options) -> (String, Outcome) {
                     format!("{:.2}@{:.2}", b.linvel().length(), b.translation().y)
                 })
                 .collect();
-            println!("frame {f}: E {:.1} soft {speeds:?} rigid {rigid:?}", e - e0);
+            let c = &stats.soft_contacts;
+            println!(
+                "frame {f}: E {:.1} soft {speeds:?} rigid {rigid:?} soft contacts {} deep {} clamps {} pen {:.3}, rigid pen {:.3}",
+                e - e0,
+                c.contacts,
+                c.deep,
+                c.clamps,
+                c.max_penetration,
+                stats.max_penetration
+            );
         }
         if f > 2 {
             o.fastest = o.fastest.max(fastest);
