@@ -4,7 +4,7 @@
 use std::process::{Command, Output};
 
 /// The binaries and one option of each that takes a value.
-const BINS: [(&str, &str); 10] = [
+const BINS: [(&str, &str); 11] = [
     (env!("CARGO_BIN_EXE_error_vs_time"), "--out"),
     (env!("CARGO_BIN_EXE_plastic_cost"), "--frames"),
     (env!("CARGO_BIN_EXE_projections"), "--cells"),
@@ -14,6 +14,7 @@ const BINS: [(&str, &str); 10] = [
     (env!("CARGO_BIN_EXE_spin_cost"), "--frames"),
     (env!("CARGO_BIN_EXE_stack_rest"), "--cubes"),
     (env!("CARGO_BIN_EXE_stacking"), "--frames"),
+    (env!("CARGO_BIN_EXE_tearing_cost"), "--frames"),
     (env!("CARGO_BIN_EXE_vs_rapier"), "--frames"),
 ];
 

@@ -1,0 +1,149 @@
+//! Cost of [`tetpbd::Tearing`]: a free cube of about 1k, 10k and 100k tetrahedra (edges +
+//! volume), slowly spinning, stepped with and without the component in alternating frames
+//! (two copies, so a change of the machine's load hits both alike) while nothing tears;
+//! then the frame in which the same cube, stretched to twice its length, tears everywhere
+//! (the tearing pass's time from [`tetpbd::StepStats::tearing_time`]) and a plane cut
+//! through its middle ([`tetpbd::cut`]). Prints medians, ms per frame.
+//!
+//! ```text
+//! cargo run --release -p tetpbd-bench --bin tearing_cost [-- --frames F]
+//! ```
+
+use std::time::Instant;
+
+use clap::Parser;
+use nalgebra::Vector3;
+use tetpbd::generators::{box_grid, CellSplit};
+use tetpbd::{Blade, Particles, SoftBodyBuilder, Solver, SolverSettings, TearingSettings};
+use tetpbd_bench::DT;
+
+/// Cost of tearing: free cubes of about 1k, 10k and 100k tetrahedra with and without the
+/// component while nothing tears, then a frame that tears everywhere and a cut.
+#[derive(Parser)]
+#[command(name = "tearing_cost")]
+struct Args {
+    /// Frames measured per column (the median is printed).
+    #[arg(long, default_value_t = 40)]
+    frames: usize,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The cube, tearing at `strain` (`None`: without the component).
+fn body(
+    mesh: &tetpbd::TetMesh,
+    strain: Option<f32>,
+) -> Result<tetpbd::SoftBody, tetpbd::BuildError> {
+    let b = SoftBodyBuilder::new(mesh.clone())
+        .density(1000.0)
+        .edges(1e-6)
+        .volume(1e-9);
+    match strain {
+        Some(strain) => b
+            .tearing(TearingSettings {
+                strain,
+                smoothing_time: 0.0,
+                ..Default::default()
+            })
+            .build(),
+        None => b.build(),
+    }
+}
+
+fn solver() -> Result<Solver, tetpbd::SettingsError> {
+    Solver::new(SolverSettings {
+        dt: DT,
+        gravity: Vector3::zeros(),
+        ..Default::default()
+    })
+}
+
+/// Median ms per frame without and with the component, spinning at 2 rad/s, nothing torn,
+/// and the median ms of the tearing pass in the frames with it.
+fn untorn(
+    mesh: &tetpbd::TetMesh,
+    frames: usize,
+) -> Result<(f64, f64, f64), Box<dyn std::error::Error>> {
+    let mut runs = Vec::new();
+    for strain in [None, Some(0.5)] {
+        let mut world = hecs::World::new();
+        let e = body(mesh, strain)?.spawn(&mut world);
+        world.insert_one(e, tetpbd::Activation::never_sleeps())?;
+        {
+            let mut p = world.get::<&mut Particles>(e)?;
+            let c = p.center_of_mass();
+            for i in 0..p.len() {
+                let v = Vector3::new(0.0, 2.0, 0.0).cross(&(p.positions()[i] - c));
+                p.set_velocity(i, v)?;
+            }
+        }
+        runs.push((world, solver()?, Vec::new()));
+    }
+    let mut pass = Vec::new();
+    for f in 0..frames + 2 {
+        for (world, solver, times) in runs.iter_mut() {
+            let t = Instant::now();
+            let stats = solver.step(world)?;
+            if f >= 2 {
+                times.push(t.elapsed().as_secs_f64() * 1e3);
+                if !stats.tearing_time.is_zero() {
+                    pass.push(stats.tearing_time.as_secs_f64() * 1e3);
+                }
+            }
+            if !solver.tear_events().is_empty() {
+                return Err("the spinning cube tore".into());
+            }
+        }
+    }
+    let without = median(std::mem::take(&mut runs[0].2));
+    let with = median(std::mem::take(&mut runs[1].2));
+    Ok((without, with, median(pass)))
+}
+
+/// The tearing pass's ms in the frame the cube, stretched to twice its length along x,
+/// tears (strain 0.3), with the faces torn; then the ms of a plane cut through its middle.
+fn torn(mesh: &tetpbd::TetMesh) -> Result<(f64, usize, f64), Box<dyn std::error::Error>> {
+    let mut world = hecs::World::new();
+    let e = body(mesh, Some(0.3))?.spawn(&mut world);
+    {
+        let mut p = world.get::<&mut Particles>(e)?;
+        for i in 0..p.len() {
+            let x = p.rest_positions()[i];
+            p.set_position(i, Vector3::new(2.0 * x.x, x.y, x.z))?;
+        }
+    }
+    let mut solver = solver()?;
+    let stats = solver.step(&mut world)?;
+    let faces: usize = solver.tear_events().iter().map(|ev| ev.faces_torn).sum();
+    let tearing = stats.tearing_time.as_secs_f64() * 1e3;
+    let mut world = hecs::World::new();
+    let e = body(mesh, None)?.spawn(&mut world);
+    let blade = Blade::Plane {
+        point: Vector3::new(0.013, 0.0, 0.0),
+        normal: Vector3::x(),
+    };
+    let t = Instant::now();
+    tetpbd::cut(&mut world, e, &blade)?;
+    Ok((tearing, faces, t.elapsed().as_secs_f64() * 1e3))
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let frames = Args::parse().frames;
+    println!("free cube, edges 1e-6 m/N + volume 1e-9 m⁵/N, zero gravity; 10 substeps × 1 iteration per 1/60 s frame; median of {frames} frames");
+    println!("| tetrahedra | without, ms/frame | with, nothing torn, ms/frame | with/without | its tearing pass, ms/frame | tearing pass of a frame tearing everywhere, ms (faces torn) | plane cut, ms |");
+    println!("|---|---|---|---|---|---|---|");
+    for cells in [6u32, 13, 28] {
+        let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Five)?;
+        let (without, with, pass) = untorn(&mesh, frames)?;
+        let (tearing, faces, cut) = torn(&mesh)?;
+        println!(
+            "| {} | {without:.3} | {with:.3} | {:.3} | {pass:.3} | {tearing:.2} ({faces}) | {cut:.2} |",
+            mesh.tets.len(),
+            with / without,
+        );
+    }
+    Ok(())
+}
