@@ -10,8 +10,9 @@
 //! So after the ordinary projections of an iteration, a soft body that
 //!
 //! * touches an immovable support — a fixed or kinematic collider, a *supported* rigid
-//!   body (infinitely heavy inside the substeps, `rigid::body` module docs) — or has pinned
-//!   particles, and
+//!   body (infinitely heavy inside the substeps, `rigid::body` module docs), an anchored body
+//!   its own supports hold in the substep (`contacts::support` module docs: a light box on
+//!   the ground under a soft slab carrying a heavy box) — or has pinned particles, and
 //! * carries a dynamic rigid body at least [`crate::CouplingSettings::stacking_mass_ratio`]
 //!   times heavier than the particles it touches (the body's generalized mass at the
 //!   contact against the particle's mass, or the triangle's mean particle mass),
@@ -87,18 +88,25 @@ pub(crate) struct Stacking<'a> {
     pub max_push: f32,
 }
 
-/// How a collider takes part: immovable (a support), a dynamic body, or neither.
+/// Whether a collider is an immovable support in the current substep: fixed, kinematic, a
+/// supported body, or an anchored body its own supports hold (`contacts::support` module
+/// docs; a held body takes no soft impulse, so it is a support like the ground).
 pub(crate) fn immovable(cp: &ColliderProxy, bodies: &[BodyProxy]) -> bool {
     cp.body.is_none_or(|b| {
-        matches!(
-            bodies[b].kind,
-            BodyKind::Fixed | BodyKind::Kinematic | BodyKind::Supported
-        )
+        let body = &bodies[b];
+        body.is_held()
+            || matches!(
+                body.kind,
+                BodyKind::Fixed | BodyKind::Kinematic | BodyKind::Supported
+            )
     })
 }
 
+/// The proxy index of a collider's body when that body moves under soft impulses in the
+/// current substep (dynamic, not held).
 fn dynamic(cp: &ColliderProxy, bodies: &[BodyProxy]) -> Option<usize> {
-    cp.body.filter(|&b| bodies[b].kind == BodyKind::Dynamic)
+    cp.body
+        .filter(|&b| bodies[b].kind == BodyKind::Dynamic && !bodies[b].is_held())
 }
 
 /// Whether the soft body carries a dynamic body at least `ratio` times heavier than the

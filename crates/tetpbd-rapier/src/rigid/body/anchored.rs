@@ -44,6 +44,12 @@ impl BodyProxy {
         self.kind == BodyKind::Dynamic && self.support_normal != Vector3::zeros()
     }
 
+    /// `true` for an anchored body its supports hold in this substep ([`Self::hold`]): no
+    /// soft impulse moves it, so for the soft bodies on it it is as immovable as the ground.
+    pub fn is_held(&self) -> bool {
+        self.is_anchored() && self.held
+    }
+
     /// Whether an impulse along `push` presses an anchored body into its supports (more
     /// than 60° against their mean normal).
     pub(super) fn presses(&self, push: &Vector3<f32>) -> bool {
