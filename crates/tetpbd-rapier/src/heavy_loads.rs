@@ -300,6 +300,7 @@ fn project_on_frozen_surface(
                 s.colliders,
                 s.set,
                 CornerPass::Frozen,
+                s.max_push,
                 &mut Impact::new(f32::INFINITY),
             );
         }

@@ -190,6 +190,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 colliders,
                 self.qp.colliders,
                 CornerPass::Crossing,
+                self.max_depenetration_speed * h,
                 &mut impact,
             );
             stats.degenerate_contacts += project_contacts(
@@ -210,6 +211,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 colliders,
                 self.qp.colliders,
                 CornerPass::Ordinary,
+                self.max_depenetration_speed * h,
                 &mut impact,
             );
             project_attachments(&mut attachments[s.attachments.clone()], p, bodies, frac, h);
@@ -325,7 +327,9 @@ impl SubstepHook for CouplingHook<'_, '_> {
             finish_substep(&mut contacts[range], h, self.max_depenetration_speed * h);
         }
         episodes.end_substep();
+        let max_push = self.max_depenetration_speed * h;
         for k in corners.iter_mut() {
+            k.allowance = (k.allowance - max_push).max(0.0);
             k.active = false;
             k.impulse += k.sub_impulse / h;
             k.sub_impulse = nalgebra::Vector3::zeros();

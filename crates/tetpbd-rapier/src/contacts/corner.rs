@@ -33,6 +33,15 @@
 //! collider: one particle alone cannot stop a fast body, and its contact normal may be tilted
 //! enough to let the body slip past it.
 //!
+//! A point found behind its triangle without crossing it in the substep (the soft surface
+//! slid over a corner already inside the body, or a body created overlapping) is an overlap,
+//! not an impact: as for particle contacts (`contacts::particle` module docs), the depth it
+//! had at the substep start, less `max_depenetration_speed · h`, is tolerated and shrinks by
+//! that much every substep, so it is pushed out at the depenetration speed. (A draped soft
+//! body whose bottom triangle slid over a box corner 15 cm inside it otherwise took the
+//! whole depth at once, most of it as the whole body's motion (`impact` module docs), and
+//! jumped off the box at 5 m/s.)
+//!
 //! A support point over a triangle with a vertex that *holds* the collider is skipped in the
 //! ordinary pass: a vertex in contact with the collider (in the same iteration) whose contact
 //! normal lies within 30° of the triangle's normal. There the particle contact holds the
@@ -105,6 +114,11 @@ pub(crate) struct CornerContact {
     pub point: Vector3<f32>,
     /// Barycentric weights of `point` on the triangle at its last projection.
     pub beta: [f32; 3],
+    /// Depth (m) this contact tolerates: an overlap found at its first evaluation in the
+    /// frame, less one substep's push, shrinking by that push every substep (module docs).
+    pub allowance: f32,
+    /// Whether `allowance` was decided for the frame.
+    pub allowance_fresh: bool,
     pub sub_impulse: Vector3<f32>,
     pub impulse: Vector3<f32>,
 }
@@ -135,6 +149,7 @@ pub(crate) fn project_corners(
     colliders: &[ColliderProxy],
     set: &ColliderSet,
     pass: CornerPass,
+    max_push: f32,
     impact: &mut Impact,
 ) {
     if pass == CornerPass::Crossing {
@@ -154,7 +169,7 @@ pub(crate) fn project_corners(
                     bodies,
                     colliders,
                     set,
-                    pass,
+                    (pass, max_push),
                     impact,
                 );
             }
@@ -162,7 +177,15 @@ pub(crate) fn project_corners(
         }
     } else {
         sweep_corners(
-            corners, contacts, p, surface, bodies, colliders, set, pass, impact,
+            corners,
+            contacts,
+            p,
+            surface,
+            bodies,
+            colliders,
+            set,
+            (pass, max_push),
+            impact,
         );
     }
 }
@@ -176,7 +199,7 @@ fn sweep_corners(
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
     set: &ColliderSet,
-    pass: CornerPass,
+    (pass, max_push): (CornerPass, f32),
     impact: &mut Impact,
 ) {
     let crossing_only = pass == CornerPass::Crossing;
@@ -243,10 +266,22 @@ fn sweep_corners(
             let a_prev = p.prev_positions()[idx[0]];
             crossing_point(&v, &v_start, &a, &a_prev, &n, shortest)
         });
-        let q = if let Some(Some(q)) = crossing {
-            q
+        let (q, c_val) = if let Some(Some(q)) = crossing {
+            (q, c_val)
         } else if s >= -0.5 * shortest && !crossing_only {
-            v
+            // Found behind the plane, not crossing it now: an overlap already there at the
+            // substep start is pushed out at the depenetration speed (module docs).
+            if !k.allowance_fresh {
+                k.allowance_fresh = true;
+                let v_start = (cp.prev_pose(bodies) * Point3::from(local)).coords;
+                let s_start = (v_start - p.prev_positions()[idx[0]]).dot(&n);
+                k.allowance = (k.thickness - s_start - max_push).max(0.0);
+            }
+            let c_val = c_val + k.allowance;
+            if c_val >= 0.0 {
+                continue;
+            }
+            (v, c_val)
         } else {
             continue;
         };

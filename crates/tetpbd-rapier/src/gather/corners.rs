@@ -139,6 +139,8 @@ impl CornerContact {
             normal: Vector3::zeros(),
             point: Vector3::zeros(),
             beta: [0.0; 3],
+            allowance: 0.0,
+            allowance_fresh: false,
             sub_impulse: Vector3::zeros(),
             impulse: Vector3::zeros(),
         }
