@@ -1,7 +1,8 @@
 //! A slab pulled apart by two rigid bodies at 1, 5 and 20 m/s tears into pieces that stay
-//! finite, keep positive masses and uninverted rest shapes, and (up to 5 m/s) end on the
-//! ground; under the hard families (α = 0) no tetrahedron is left inverted. The fastest fragment is printed, not asserted: released elastic energy launches
-//! fragments of the stiff slab well past the boxes' speed (a known limit).
+//! finite, keep positive masses and uninverted rest shapes, and end on the ground; under the
+//! hard families (α = 0) no tetrahedron is left inverted. The fastest fragment is printed,
+//! not asserted: released elastic energy launches fragments of the stiff slab well past the
+//! boxes' speed (a known limit).
 
 use tetpbd_bench::{SlabPull, TearEngine};
 use tetpbd_stability::{pull_apart, Config, ConstraintSet, PULL_SPEEDS};
@@ -26,7 +27,7 @@ fn a_slab_pulled_apart_at_1_to_20_m_s_tears_into_sound_pieces() {
     for (label, f) in sweep() {
         println!("{label} at {} m/s: {f:?}", f.speed);
         let at = format!("{label} at {} m/s", f.speed);
-        assert!(f.finite, "{at}: not finite");
+        assert!(f.finite && !f.blown_up, "{at}: not finite or blown up");
         assert!(f.events > 0 && f.pieces > 1, "{at}: did not come apart");
         assert!(f.min_mass > 0.0, "{at}: a particle of mass {}", f.min_mass);
         assert_eq!(f.inverted_rest, 0, "{at}: inverted rest shapes");
@@ -34,10 +35,11 @@ fn a_slab_pulled_apart_at_1_to_20_m_s_tears_into_sound_pieces() {
         if label != "stiff" {
             assert_eq!(f.inverted, 0, "{at}: inverted tetrahedra at the end");
         }
-        // Pieces end on the ground, not in it. While it tears, the compliant slab (`stiff`)
-        // dips about 6 cm into the ground for a few frames at 1 m/s: not asserted.
+        // Pieces end on the ground, not in it, at every speed (fragments that fly past the
+        // ground's edge fall, and are not counted). While it tears, the compliant slab
+        // (`stiff`) dips about 6 cm into the ground for a few frames at 1 m/s: not asserted.
         assert!(
-            f.speed > 5.0 || f.on_the_ground(),
+            f.on_the_ground(),
             "{at}: a particle {} m under the ground at the end",
             f.final_lowest
         );

@@ -22,7 +22,7 @@ use joints::{jointed, Joint};
 use loads::{rigid_on_soft, soft_on_box};
 use projectiles::{into_slabs, soft_into_rigid, Projectile};
 use tearing::pulled_apart;
-pub use tearing::{pull_apart, PullFigures, PULL_SPEEDS};
+pub use tearing::{pull_apart, PullFigures, BLOWN_UP_SPEED, PULL_SPEEDS};
 use trimesh::{onto, Ground};
 
 /// A fixed ground cuboid (40 × 1 × 40 m) whose top is at y = 0.

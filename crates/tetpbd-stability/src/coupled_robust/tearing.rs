@@ -20,6 +20,9 @@ pub const PULL_SPEEDS: [f32; 3] = [1.0, 5.0, 20.0];
 const SETTLE_FRAMES: usize = 120;
 /// How far below the ground's top a particle over it may be, m.
 const GROUND_TOLERANCE: f32 = 0.05;
+/// A piece faster than this, m/s, has blown up: the run stops there (its cost grows with the
+/// space the fragments fill) and fails.
+pub const BLOWN_UP_SPEED: f32 = 1000.0;
 
 /// What one pull measured.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,6 +49,8 @@ pub struct PullFigures {
     pub lowest: f32,
     /// Lowest particle over the ground's top face at the end, m.
     pub final_lowest: f32,
+    /// A piece passed [`BLOWN_UP_SPEED`], and the run was stopped there.
+    pub blown_up: bool,
 }
 
 impl PullFigures {
@@ -77,6 +82,7 @@ pub fn pull_apart(
         final_fastest: 0.0,
         lowest: f32::INFINITY,
         final_lowest: f32::INFINITY,
+        blown_up: false,
     };
     for _ in 0..scene.pull_frames() + SETTLE_FRAMES {
         match scene.step() {
@@ -95,6 +101,10 @@ pub fn pull_apart(
             .map(Fragment::lowest_over_ground)
             .fold(f32::INFINITY, f32::min);
         f.lowest = f.lowest.min(f.final_lowest);
+        if f.final_fastest > BLOWN_UP_SPEED {
+            f.blown_up = true;
+            break;
+        }
     }
     let pieces = scene.fragments();
     f.pieces = pieces.len();
@@ -130,18 +140,23 @@ pub(crate) fn pulled_apart(engine: Engine) -> Result<CoupledOutcome, String> {
         out.peak_speed = out.peak_speed.max(f.fastest_fragment);
         out.final_speed = out.final_speed.max(f.final_fastest);
         out.inverted += f.inverted;
-        ok &= f.pieces > 1
+        ok &= !f.blown_up
+            && f.pieces > 1
             && f.min_mass > 0.0
             && f.inverted_rest == 0
             && (speed > 5.0 || f.on_the_ground());
         cols[0].push(f.pieces.to_string());
-        cols[1].push(format!("{:.1}", f.fastest_fragment));
-        cols[2].push(format!("{:.2}/{:.2}", f.lowest, f.final_lowest));
+        cols[1].push(if f.blown_up {
+            format!("> {BLOWN_UP_SPEED:.0} (stopped)")
+        } else {
+            format!("{:.1}", f.fastest_fragment)
+        });
+        cols[2].push(format!("{:.2}→{:.2}", f.lowest, f.final_lowest));
     }
     out.criterion = (
         ok,
         format!(
-            "pieces {}, fastest fragment {} m/s, lowest over the run/at the end {} m",
+            "pieces {}, fastest fragment {} m/s, lowest particle (over the run→at the end) {} m",
             cols[0].join("/"),
             cols[1].join("/"),
             cols[2].join("/")
