@@ -54,7 +54,7 @@ pub struct PullFigures {
 }
 
 impl PullFigures {
-    /// At the end, no particle over the ground more than [`GROUND_TOLERANCE`] below it: no
+    /// At the end, no particle over the ground more than 5 cm below it: no
     /// piece sank into it. (While the slab tears, a compliant slab's particles may dip
     /// deeper for a few frames: [`PullFigures::lowest`].)
     pub fn on_the_ground(&self) -> bool {
