@@ -26,6 +26,8 @@ mod sleeping_pile;
 mod soft_on_rigid_stack;
 #[path = "../examples/cli/soft_pile.rs"]
 mod soft_pile;
+#[path = "../examples/cli/tearing.rs"]
+mod tearing;
 
 /// Each example's command, by name.
 fn commands() -> Vec<clap::Command> {
@@ -38,6 +40,7 @@ fn commands() -> Vec<clap::Command> {
         soft_on_rigid_stack::Cli::command(),
         soft_pile::Cli::command(),
         sleeping_pile::Cli::command(),
+        tearing::Cli::command(),
     ]
 }
 
@@ -173,6 +176,25 @@ fn the_documented_invocations_parse() {
     let cli = sleeping_pile::Cli::try_parse_from(["sleeping_pile", "field", "200"]).unwrap();
     assert_eq!((cli.scene, cli.cubes), (sleeping_pile::Scene::Field, 200));
 
+    // .ci/run, the README and docs/decisions/tearing.md.
+    let cli = tearing::Cli::try_parse_from([
+        "tearing",
+        "--speed",
+        "5",
+        "--settle-frames",
+        "30",
+        "--export",
+        "frames/tear",
+    ])
+    .unwrap();
+    assert_eq!(
+        (cli.speed, cli.settle_frames, cli.no_rapier),
+        (5.0, 30, false)
+    );
+    assert_eq!(cli.viz.export.as_deref(), Some(Path::new("frames/tear")));
+    let cli = tearing::Cli::try_parse_from(["tearing"]).unwrap();
+    assert_eq!((cli.speed, cli.settle_frames), (3.0, 60));
+
     // docs/guide/building-bodies.md.
     let cli = asset_drop::Cli::try_parse_from(["asset_drop"]).unwrap();
     assert!(cli.obj.ends_with("examples/assets/bunny_blob.obj"));
@@ -194,7 +216,7 @@ fn the_documented_invocations_parse() {
 
 #[test]
 fn a_bad_argument_is_rejected_with_a_message_naming_it() {
-    let cases: [(clap::Command, &[&str], &str); 17] = [
+    let cases: [(clap::Command, &[&str], &str); 19] = [
         (rigid_ball_on_soft::Cli::command(), &["x", "ten"], "FRAMES"),
         (rigid_ball_on_soft::Cli::command(), &["x", "-3"], "FRAMES"),
         (soft_on_rigid_stack::Cli::command(), &["x", "1.5"], "FRAMES"),
@@ -243,6 +265,12 @@ fn a_bad_argument_is_rejected_with_a_message_naming_it() {
             integrating::Cli::command(),
             &["x", "--frames", "-3"],
             "--frames",
+        ),
+        (tearing::Cli::command(), &["x", "--speed", "-1"], "--speed"),
+        (
+            tearing::Cli::command(),
+            &["x", "--settle-frames", "-5"],
+            "--settle-frames",
         ),
     ];
     for (command, args, name) in cases {

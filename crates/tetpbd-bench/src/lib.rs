@@ -2,7 +2,8 @@
 //! and, for `error_vs_time` and `vs_rapier`, how rapier's built-in soft bodies are set up next
 //! to tetpbd's, the contact scenes (a soft cube dropped on rigid ground, a pile of nine cubes)
 //! in both engines, the observables measured the same way from either engine's particle
-//! positions, and [`Xpbd64`], tetpbd's XPBD model stepped in `f64` for converged references.
+//! positions, the tearing scene ([`SlabPull`]: a slab pulled apart by two boxes, in either
+//! engine), and [`Xpbd64`], tetpbd's XPBD model stepped in `f64` for converged references.
 #![warn(missing_docs)]
 
 mod args;
@@ -12,6 +13,7 @@ mod contact_scene;
 mod contact_sim;
 mod perturb;
 mod rapier_setup;
+mod tear_scene;
 mod xpbd64;
 
 pub use args::{orders, FamilySet, SpatialOrder};
@@ -26,6 +28,10 @@ pub use perturb::perturb;
 pub use rapier_setup::{
     lumped_masses, rapier_label, rapier_material, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON,
     RAPIER_YOUNG,
+};
+pub use tear_scene::{
+    Fragment, SlabPull, TearEngine, TearSummary, PULL_DISTANCE, TEAR_GROUND_HALF_EXTENTS,
+    TEAR_SMOOTHING, TEAR_STRAIN, TEAR_SUBSTEPS,
 };
 pub use xpbd64::{Xpbd64, Xpbd64Error};
 

@@ -22,6 +22,7 @@ pub use cases::{all_cases, Case, CaseKind, SWEEP_SUBSTEPS};
 pub use config::{Config, ConstraintSet};
 pub use coupled::{coupled_cases, CoupledCase, CoupledOutcome};
 pub use coupled_rapier::rapier_comparison;
+pub use coupled_robust::{pull_apart, PullFigures, BLOWN_UP_SPEED, PULL_SPEEDS};
 pub use ground::Ground;
 pub use report::{markdown, verdict, Verdict};
 pub use run::{

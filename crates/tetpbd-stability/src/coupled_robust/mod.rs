@@ -1,12 +1,14 @@
 //! Coupled cases of the scene families next to the coupling's simple ones, each also run with
 //! rapier 0.36's own soft bodies in the same scene: loads both ways at mass ratios 1:1 to
 //! 1000:1 (`loads`), jointed bodies carrying soft bodies (`joints`), fast projectiles both
-//! ways (`projectiles`), triangle-mesh ground of either winding (`trimesh`).
+//! ways (`projectiles`), triangle-mesh ground of either winding (`trimesh`), a slab pulled
+//! apart until it tears (`tearing`).
 
 mod body;
 mod joints;
 mod loads;
 mod projectiles;
+mod tearing;
 mod trimesh;
 
 use rapier3d::math::Vector;
@@ -19,6 +21,8 @@ use body::{Engine, Soft};
 use joints::{jointed, Joint};
 use loads::{rigid_on_soft, soft_on_box};
 use projectiles::{into_slabs, soft_into_rigid, Projectile};
+use tearing::pulled_apart;
+pub use tearing::{pull_apart, PullFigures, BLOWN_UP_SPEED, PULL_SPEEDS};
 use trimesh::{onto, Ground};
 
 /// A fixed ground cuboid (40 × 1 × 40 m) whose top is at y = 0.
@@ -169,10 +173,20 @@ fn impact_and_mesh_cases() -> Vec<CoupledCase> {
     ]
 }
 
+/// The tearing case.
+fn tearing_cases() -> Vec<CoupledCase> {
+    vec![case!(
+        "slab pulled apart at 1–20 m/s",
+        "a 1 × 0.1 × 0.4 m slab (10 × 1 × 4 cells, 40 kg) on the ground, its end faces held by two kinematic boxes moving apart at 1, 5 and 20 m/s for 0.6 m each, tearing past a strain of 0.3 smoothed over 0.05 s, then 2 s: more than one piece, every mass positive, no inverted rest shape or tetrahedron, and up to 5 m/s no particle over the ground more than 5 cm below it at the end; the cell lists per speed the pieces, the fastest fragment's centre of mass (the peak) and the lowest particle over the run and at the end (known limit: released elastic energy launches fragments of the stiff slab at 20–40 m/s)",
+        |e| pulled_apart(e)
+    )]
+}
+
 /// The cases of this module, in report order.
 pub(crate) fn robust_cases() -> Vec<CoupledCase> {
     let mut v = load_cases();
     v.extend(joint_cases());
     v.extend(impact_and_mesh_cases());
+    v.extend(tearing_cases());
     v
 }
