@@ -145,9 +145,7 @@ fn a_slab_pulled_apart_by_two_bodies_tears_and_each_piece_keeps_its_body() {
             assert!(p.masses().iter().all(|&m| m > 0.0));
             // Nothing fell through the ground: no particle above the ground's 10 × 10 m
             // top face is under it. (A fragment the tear flings off the edge may fall
-            // past it; that is not tunnelling.) Known limit: at 20 m/s the slab shreds
-            // into about 40 fragments and one sinks 0.4 m, so the ground is checked up
-            // to 5 m/s only.
+            // past it; that is not tunnelling.)
             let sunk = p
                 .positions()
                 .iter()
@@ -155,7 +153,7 @@ fn a_slab_pulled_apart_by_two_bodies_tears_and_each_piece_keeps_its_body() {
                 .map(|x| x.y)
                 .fold(f32::INFINITY, f32::min);
             assert!(
-                speed > 5.0 || sunk > -0.05,
+                sunk > -0.05,
                 "speed {speed}: a piece sank to {sunk}"
             );
         }
