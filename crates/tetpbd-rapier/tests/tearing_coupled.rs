@@ -152,10 +152,7 @@ fn a_slab_pulled_apart_by_two_bodies_tears_and_each_piece_keeps_its_body() {
                 .filter(|x| x.x.abs() < 5.0 && x.z.abs() < 5.0)
                 .map(|x| x.y)
                 .fold(f32::INFINITY, f32::min);
-            assert!(
-                sunk > -0.05,
-                "speed {speed}: a piece sank to {sunk}"
-            );
+            assert!(sunk > -0.05, "speed {speed}: a piece sank to {sunk}");
         }
     }
 }

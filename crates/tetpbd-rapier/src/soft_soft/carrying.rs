@@ -32,6 +32,13 @@
 //! the light body must rest on one. Contacts of bodies of similar masses, of bodies neither
 //! of which rests on a support, or side by side, are untouched. A bare
 //! [`crate::SoftContacts`] (no coupling) has no supports and never carries.
+//!
+//! The light side is held, not immovable: where its own motion in the substep drove it into
+//! the heavy side (a squeezed light body springing back), that part of the violation is
+//! handed to the heavy side at no more than the separation speed
+//! ([`crate::SoftContactSettings::max_separation_speed`]). Otherwise a recoil of the light
+//! body's particles became the heavy body's velocity at any speed: a 218 kg body on a squeezed
+//! 4.7 kg one gained 35 kJ in a frame (the seeded random-scene search, scene 44).
 
 use nalgebra::Vector3;
 

@@ -161,8 +161,11 @@ impl ContactFrame {
                     w[c.tri[2] as usize],
                 ];
                 match bodies {
-                    Some((bp, bt)) => carrying.weights(bp, bt, own, n),
-                    None => own,
+                    Some((bp, bt)) => {
+                        let carried = carrying.weights(bp, bt, own, n);
+                        (carried, carried != own)
+                    }
+                    None => (own, false),
                 }
             };
             match project_one(candidates, i, x, x_prev, weights, steps) {
@@ -248,7 +251,7 @@ fn project_one(
     i: usize,
     x: &mut [Vector3<f32>],
     x_prev: &[Vector3<f32>],
-    weights: impl Fn(&Candidate, &Vector3<f32>) -> [f32; 4],
+    weights: impl Fn(&Candidate, &Vector3<f32>) -> ([f32; 4], bool),
     (alpha_tilde, step, skin_step): (f32, f32, f32),
 ) -> Outcome {
     let c = &candidates[i];
@@ -290,11 +293,27 @@ fn project_one(
     let q = a * bary[0] + b * bary[1] + t * bary[2];
     let dist = (xp - q).dot(&n);
     let target = contact_target(c.d_prev, c.props.thickness, step, skin_step);
-    let cval = dist - target;
+    let mut cval = dist - target;
     if cval.is_nan() || cval >= 0.0 {
         return Outcome::Done;
     }
-    let w = weights(c, &n);
+    let (w, carried) = weights(c, &n);
+    if carried {
+        // The carrying side is held still, but it is not immovable: the part of the violation
+        // its own motion made in this substep (a squeezed light body springing back) is
+        // handed to the carried side at no more than the separation speed (`carrying`
+        // module docs).
+        let light_in = if w[0] == 0.0 {
+            -(x[p] - x_prev[p]).dot(&n)
+        } else {
+            (0..3)
+                .map(|k| bary[k] * (x[tri[k]] - x_prev[tri[k]]).dot(&n))
+                .sum::<f32>()
+        };
+        if light_in > 0.0 {
+            cval = cval.max(-((-cval - light_in).max(0.0) + step));
+        }
+    }
     let wp = w[0];
     let wsum = wp + (0..3).map(|k| bary[k] * bary[k] * w[k + 1]).sum::<f32>();
     let denom = wsum + alpha_tilde;
