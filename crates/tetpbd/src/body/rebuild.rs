@@ -116,8 +116,13 @@ pub(crate) fn assemble(b: &SplitBody, particles: &[u32], tets: &[u32]) -> PieceP
         t.prepare_forces(&tetrahedra, edges.as_ref());
         t
     });
+    // A copy made by the split has no force of its own (the force stays on the particle it
+    // copies, so the body's total force is kept).
     let forces = b.forces.map(|f| UserForces {
-        forces: particles.iter().map(|&i| f.forces[i as usize]).collect(),
+        forces: particles
+            .iter()
+            .map(|&i| f.forces.get(i as usize).copied().unwrap_or_default())
+            .collect(),
     });
     let surface = Surface::from_tetrahedra(&tetrahedra.indices, rest);
     PieceParts {
