@@ -40,6 +40,7 @@ pub struct TearingSettings {
     /// Force at which a face tears, N (finite, `> 0`; `None` = never by force): the smoothed
     /// force pulling the face open, estimated from the constraint multipliers of every family
     /// acting on its two tetrahedra (see `crate::body::face_forces`). Default `None`.
+    #[cfg_attr(feature = "serde", serde(default))]
     pub force: Option<f32>,
     /// Time constant of the exponential filter smoothing each face's strain and force, s
     /// (finite, `≥ 0`; 0 = no smoothing). Default 0.05 s.
@@ -104,6 +105,7 @@ pub(crate) struct InteriorFace {
     pub smoothed: f32,
     /// Smoothed force pulling the face open, N (negative: pressed shut; stays 0 while the
     /// body does not tear by force).
+    #[cfg_attr(feature = "serde", serde(default))]
     pub smoothed_force: f32,
     /// Torn, while both tetrahedra still share its particles (the split waits until the
     /// torn faces around a particle separate its tetrahedra).
