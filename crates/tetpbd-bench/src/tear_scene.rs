@@ -317,7 +317,7 @@ fn spawn_tetpbd(
     let b = SoftBodyBuilder::new(mesh).density(DENSITY);
     let body = families(b)
         .tearing(TearingSettings {
-            strain: TEAR_STRAIN,
+            strain: Some(TEAR_STRAIN),
             smoothing_time: TEAR_SMOOTHING,
             ..Default::default()
         })

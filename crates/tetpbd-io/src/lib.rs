@@ -55,6 +55,7 @@ mod obj;
 pub mod shapes;
 #[cfg(feature = "mesher")]
 mod skin;
+mod skin_follow;
 #[cfg(feature = "mesher")]
 mod surface;
 mod tetgen;
@@ -71,6 +72,7 @@ pub use mesher_error::{SkinError, SurfaceError};
 pub use obj::{surface_obj, triangles_obj, write_surface_obj};
 #[cfg(feature = "mesher")]
 pub use skin::{Skin, SkinBinding};
+pub use skin_follow::PieceSkin;
 #[cfg(feature = "mesher")]
 pub use surface::SurfaceMesh;
 pub use tetgen::{read_tetgen_files, read_tetgen_str, write_tetgen};

@@ -198,6 +198,12 @@ pub enum SkinError {
         /// Length given.
         found: usize,
     },
+    /// After a tear, no piece holds the tetrahedron an embedded point is bound to (the event
+    /// is not the body's, or the pieces' tetrahedra were not given in the event's order).
+    LostTetrahedron {
+        /// Index of the point.
+        point: usize,
+    },
 }
 
 impl fmt::Display for SkinError {
@@ -223,6 +229,9 @@ impl fmt::Display for SkinError {
                 expected,
                 found,
             } => write!(f, "{what} has length {found}, expected {expected}"),
+            SkinError::LostTetrahedron { point } => {
+                write!(f, "point {point}: no piece holds its tetrahedron")
+            }
         }
     }
 }

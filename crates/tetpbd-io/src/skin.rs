@@ -57,8 +57,8 @@ pub struct SkinBinding {
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Skin {
-    bindings: Vec<SkinBinding>,
-    vertex_count: usize,
+    pub(crate) bindings: Vec<SkinBinding>,
+    pub(crate) vertex_count: usize,
 }
 
 impl Skin {

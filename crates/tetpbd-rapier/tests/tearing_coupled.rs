@@ -31,7 +31,7 @@ fn slab_between_bodies(s: &mut CoupledWorld, speed: f32) -> (Entity, [RigidBodyH
         .edges(1e-6)
         .volume(1e-8)
         .tearing(TearingSettings {
-            strain: 0.3,
+            strain: Some(0.3),
             ..Default::default()
         })
         .translation(Vector3::new(0.0, 0.06, 0.0))

@@ -410,6 +410,11 @@ pub enum TearingError {
         /// The value given (dimensionless).
         value: f32,
     },
+    /// The tearing force must be finite and > 0, N.
+    BadForce {
+        /// The value given, N.
+        value: f32,
+    },
     /// The smoothing time must be finite and ≥ 0, s.
     BadSmoothingTime {
         /// The value given, s.
@@ -422,6 +427,9 @@ impl fmt::Display for TearingError {
         match self {
             TearingError::BadStrain { value } => {
                 write!(f, "tearing strain must be finite and > 0, got {value}")
+            }
+            TearingError::BadForce { value } => {
+                write!(f, "tearing force must be finite and > 0 N, got {value}")
             }
             TearingError::BadSmoothingTime { value } => write!(
                 f,

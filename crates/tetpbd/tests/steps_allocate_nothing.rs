@@ -131,10 +131,30 @@ fn plastic_flow_allocates_nothing() {
 }
 
 /// The tearing pass of a frame that tears nothing allocates nothing: a bar held stretched
-/// below its tearing strain has its faces' strains smoothed every frame.
+/// below its tearing strain has its faces' strains smoothed every frame, and bars of every
+/// family hung from their tops below their tearing force have their faces' forces smoothed.
 #[test]
 fn a_frame_without_tearing_allocates_nothing() {
     let mut world = hecs::World::new();
+    let by_force = tetpbd::TearingSettings {
+        strain: None,
+        force: Some(1e6),
+        ..Default::default()
+    };
+    let mut hung = Vec::new();
+    for family in 0..3 {
+        let mesh = box_grid(Vector3::new(0.2, 0.6, 0.2), [2, 6, 2], CellSplit::Six).unwrap();
+        let top: Vec<u32> = (0..mesh.vertices.len() as u32)
+            .filter(|&i| mesh.vertices[i as usize].y > 0.299)
+            .collect();
+        let b = SoftBodyBuilder::new(mesh).tearing(by_force).pinned(top);
+        let b = match family {
+            0 => b.material(tetpbd::Material::new(1e6, 0.3).unwrap()),
+            1 => b.edges(1e-6).vertex_face(1e-6),
+            _ => b.edges(0.0).volume(0.0),
+        };
+        hung.push(b.build().unwrap().spawn(&mut world));
+    }
     let mesh = box_grid(Vector3::new(2.0, 0.4, 0.4), [8, 2, 2], CellSplit::Six).unwrap();
     let e = SoftBodyBuilder::new(mesh)
         .edges(1e-5)
@@ -152,7 +172,11 @@ fn a_frame_without_tearing_allocates_nothing() {
             p.set_pinned(i, true).unwrap();
         }
     }
-    let mut solver = Solver::new(SolverSettings::default()).unwrap();
+    let mut solver = Solver::new(SolverSettings {
+        substeps: 30,
+        ..Default::default()
+    })
+    .unwrap();
     solver.step(&mut world).unwrap();
     let before = allocations();
     for _ in 0..10 {
@@ -165,4 +189,11 @@ fn a_frame_without_tearing_allocates_nothing() {
         .unwrap()
         .max_smoothed_strain();
     assert!(strain > 0.1, "the strain was not read: {strain}");
+    for e in hung {
+        let force = world
+            .get::<&tetpbd::Tearing>(e)
+            .unwrap()
+            .max_smoothed_force();
+        assert!(force > 0.1, "the force was not read: {force} N");
+    }
 }

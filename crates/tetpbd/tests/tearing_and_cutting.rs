@@ -86,7 +86,7 @@ fn bodies(world: &World) -> usize {
 #[test]
 fn a_bar_pulled_past_its_strain_tears_in_two() {
     let settings = TearingSettings {
-        strain: 0.3,
+        strain: Some(0.3),
         ..Default::default()
     };
     let mut world = World::new();
@@ -101,7 +101,7 @@ fn a_bar_pulled_past_its_strain_tears_in_two() {
 #[test]
 fn a_bar_pulled_below_its_strain_never_tears() {
     let settings = TearingSettings {
-        strain: 0.3,
+        strain: Some(0.3),
         ..Default::default()
     };
     for stretch in [0.05, 0.1, 0.15] {
@@ -122,7 +122,8 @@ fn smoothing_keeps_a_one_frame_spike_from_tearing() {
     for (smoothing_time, tears) in [(0.1, false), (0.0, true)] {
         let mut world = World::new();
         let settings = TearingSettings {
-            strain: 0.3,
+            strain: Some(0.3),
+            force: None,
             smoothing_time,
             pieces: Pieces::KeepOne,
         };
@@ -136,7 +137,7 @@ fn smoothing_keeps_a_one_frame_spike_from_tearing() {
                     .unwrap();
             }
         }
-        let torn = tetpbd::systems::tear_by_strain(&mut world, 1.0 / 60.0, &mut events);
+        let torn = tetpbd::systems::tear_faces(&mut world, 1.0 / 60.0, 1.0 / 600.0, &mut events);
         {
             let mut p = world.get::<&mut Particles>(e).unwrap();
             for i in 0..p.len() {
@@ -146,7 +147,7 @@ fn smoothing_keeps_a_one_frame_spike_from_tearing() {
         }
         let mut later = 0;
         for _ in 0..30 {
-            later += tetpbd::systems::tear_by_strain(&mut world, 1.0 / 60.0, &mut events);
+            later += tetpbd::systems::tear_faces(&mut world, 1.0 / 60.0, 1.0 / 600.0, &mut events);
         }
         assert_eq!(later, 0);
         assert_eq!(torn > 0, tears, "smoothing {smoothing_time} s");
@@ -211,7 +212,8 @@ fn torn_bodies_stay_sound_and_gain_no_energy() {
         let body = SoftBodyBuilder::new(mesh)
             .material(Material::new(2e5, 0.3).unwrap())
             .tearing(TearingSettings {
-                strain: 0.2,
+                strain: Some(0.2),
+                force: None,
                 smoothing_time: 0.02,
                 pieces,
             })
@@ -345,7 +347,7 @@ fn bad_tearing_settings_and_blades_are_named() {
         ),
     ] {
         let s = TearingSettings {
-            strain,
+            strain: Some(strain),
             smoothing_time: tau,
             ..Default::default()
         };
@@ -382,7 +384,7 @@ fn bad_tearing_settings_and_blades_are_named() {
 #[test]
 fn tearing_repeats_exactly() {
     let settings = TearingSettings {
-        strain: 0.3,
+        strain: Some(0.3),
         ..Default::default()
     };
     let run = || {

@@ -44,7 +44,7 @@ fn body(
     match strain {
         Some(strain) => b
             .tearing(TearingSettings {
-                strain,
+                strain: Some(strain),
                 smoothing_time: 0.0,
                 ..Default::default()
             })

@@ -175,7 +175,8 @@ impl SoftBodyBuilder {
     }
 
     /// Lets the body tear (a [`crate::Tearing`] component): a face shared by two
-    /// tetrahedra splits once its smoothed strain passes `settings.strain`. Checked by
+    /// tetrahedra splits once its smoothed strain passes `settings.strain` or its smoothed
+    /// force `settings.force`. Checked by
     /// [`Self::build`] ([`BuildError::Tearing`]).
     pub fn tearing(mut self, settings: crate::TearingSettings) -> Self {
         self.tearing = Some(settings);
@@ -361,7 +362,9 @@ impl SoftBodyBuilder {
         }
         if let Some(settings) = tearing {
             let (p, t) = (&body.particles, &body.tetrahedra);
-            body.tearing = Some(crate::Tearing::new(settings, p, t)?);
+            let mut tearing = crate::Tearing::new(settings, p, t)?;
+            tearing.prepare_forces(t, body.edges.as_ref());
+            body.tearing = Some(tearing);
         }
         Ok(body)
     }

@@ -11,6 +11,7 @@
 pub(crate) mod activation;
 pub(crate) mod builder;
 pub(crate) mod cutting;
+pub(crate) mod face_forces;
 pub(crate) mod families;
 pub(crate) mod forces;
 pub mod generators;

@@ -111,11 +111,18 @@ pub(crate) fn assemble(b: &SplitBody, particles: &[u32], tets: &[u32]) -> PieceP
         };
         state.refresh_edges(pl, rest);
     }
-    let tearing = b
-        .tearing
-        .map(|old| piece_tearing(old, &from, &tetrahedra, rest));
+    let tearing = b.tearing.map(|old| {
+        let mut t = piece_tearing(old, &from, &tetrahedra, rest);
+        t.prepare_forces(&tetrahedra, edges.as_ref());
+        t
+    });
+    // A copy made by the split has no force of its own (the force stays on the particle it
+    // copies, so the body's total force is kept).
     let forces = b.forces.map(|f| UserForces {
-        forces: particles.iter().map(|&i| f.forces[i as usize]).collect(),
+        forces: particles
+            .iter()
+            .map(|&i| f.forces.get(i as usize).copied().unwrap_or_default())
+            .collect(),
     });
     let surface = Surface::from_tetrahedra(&tetrahedra.indices, rest);
     PieceParts {
@@ -168,7 +175,7 @@ fn piece_particles(p: &Particles, list: &[u32]) -> Particles {
 }
 
 /// The tearing state of a piece whose tetrahedron `k` was the split body's `from[k]`: its
-/// interior faces, each keeping the smoothed strain and torn flag it had.
+/// interior faces, each keeping the smoothed strain and force and torn flag it had.
 fn piece_tearing(
     old: &Tearing,
     from: &[u32],
@@ -196,11 +203,13 @@ fn piece_tearing(
         let key = [a.min(b), a.max(b)];
         if let Ok(j) = faces.binary_search_by_key(&key, |g| g.tets) {
             faces[j].smoothed = f.smoothed;
+            faces[j].smoothed_force = f.smoothed_force;
             faces[j].torn = f.torn;
         }
     }
     Tearing {
         settings: old.settings,
         faces,
+        forces: Default::default(),
     }
 }

@@ -1,12 +1,15 @@
-//! Tearing by strain: the settings and per-face state of a body that tears.
+//! Tearing by strain or force: the settings and per-face state of a body that tears.
 //!
 //! The strain measure, its time smoothing and what a tear does are documented on
-//! [`Tearing`]; the pass that reads it is `crate::solver::tearing_pass`, the split itself
-//! `crate::body::split` (mesh) and `crate::body::pieces` (components and entities).
+//! [`Tearing`], the force measure in `crate::body::face_forces`; the pass that reads them is
+//! `crate::solver::tearing_pass`, the split itself `crate::body::split` (mesh) and
+//! `crate::body::pieces` (components and entities).
 
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
+use crate::body::face_forces::FaceForceScratch;
+use crate::body::families::EdgeConstraints;
 use crate::body::mesh::Tetrahedra;
 use crate::body::particles::Particles;
 use crate::error::TearingError;
@@ -24,15 +27,23 @@ pub enum Pieces {
     KeepOne,
 }
 
-/// The settings of a body's tearing (see [`Tearing`]).
+/// The settings of a body's tearing (see [`Tearing`]). A face tears when either criterion
+/// it has passes its threshold; a body with neither never tears by itself (it can still be
+/// cut).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct TearingSettings {
-    /// Strain at which a face tears (dimensionless, finite, `> 0`): the smoothed stretch
-    /// across the face, `|xₐ − x_b| / |rₐ − r_b| − 1`. Default 0.5 (50 % stretch).
-    pub strain: f32,
-    /// Time constant of the exponential filter smoothing each face's strain, s (finite,
-    /// `≥ 0`; 0 = no smoothing). Default 0.05 s.
+    /// Strain at which a face tears (dimensionless, finite, `> 0`; `None` = never by
+    /// strain): the smoothed stretch across the face, `|xₐ − x_b| / |rₐ − r_b| − 1`.
+    /// Default `Some(0.5)` (50 % stretch).
+    pub strain: Option<f32>,
+    /// Force at which a face tears, N (finite, `> 0`; `None` = never by force): the smoothed
+    /// force pulling the face open, estimated from the constraint multipliers of every family
+    /// acting on its two tetrahedra (see `crate::body::face_forces`). Default `None`.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub force: Option<f32>,
+    /// Time constant of the exponential filter smoothing each face's strain and force, s
+    /// (finite, `≥ 0`; 0 = no smoothing). Default 0.05 s.
     pub smoothing_time: f32,
     /// Whether disconnected pieces become separate entities. Default [`Pieces::Split`].
     pub pieces: Pieces,
@@ -41,7 +52,8 @@ pub struct TearingSettings {
 impl Default for TearingSettings {
     fn default() -> Self {
         TearingSettings {
-            strain: 0.5,
+            strain: Some(0.5),
+            force: None,
             smoothing_time: 0.05,
             pieces: Pieces::Split,
         }
@@ -51,9 +63,15 @@ impl Default for TearingSettings {
 impl TearingSettings {
     /// Checks every setting, naming the first bad one and its value.
     pub fn validate(&self) -> Result<(), TearingError> {
-        let s = self.strain;
-        if !(s.is_finite() && s > 0.0) {
-            return Err(TearingError::BadStrain { value: s });
+        if let Some(s) = self.strain {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(TearingError::BadStrain { value: s });
+            }
+        }
+        if let Some(f) = self.force {
+            if !(f.is_finite() && f > 0.0) {
+                return Err(TearingError::BadForce { value: f });
+            }
         }
         let tau = self.smoothing_time;
         if !(tau.is_finite() && tau >= 0.0) {
@@ -73,7 +91,7 @@ impl TearingSettings {
     }
 }
 
-/// A face shared by two tetrahedra, with its smoothed strain.
+/// A face shared by two tetrahedra, with its smoothed strain and force.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub(crate) struct InteriorFace {
@@ -85,13 +103,17 @@ pub(crate) struct InteriorFace {
     pub inv_rest: f32,
     /// Smoothed strain (dimensionless).
     pub smoothed: f32,
+    /// Smoothed force pulling the face open, N (negative: pressed shut; stays 0 while the
+    /// body does not tear by force).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub smoothed_force: f32,
     /// Torn, while both tetrahedra still share its particles (the split waits until the
     /// torn faces around a particle separate its tetrahedra).
     pub torn: bool,
 }
 
-/// A body's tearing (a hecs component): its [`TearingSettings`] and the smoothed strain of
-/// each face shared by two tetrahedra. A body without it never tears by itself (it can still be
+/// A body's tearing (a hecs component): its [`TearingSettings`] and the smoothed strain and
+/// force of each face shared by two tetrahedra. A body without it never tears by itself (it can still be
 /// cut, `crate::cut`).
 ///
 /// # Strain
@@ -106,6 +128,16 @@ pub(crate) struct InteriorFace {
 /// [`TearingSettings::strain`]. The rest positions are the built ones: plastic flow does not
 /// move the tearing reference, so a body stretched plastically is that much closer to tearing.
 ///
+/// # Force
+///
+/// With [`TearingSettings::force`], the force pulling each interior face open (N, from the
+/// constraint multipliers of the frame's last substep: `crate::body::face_forces` derives
+/// it) is smoothed by the same filter, and a face also tears when it exceeds the threshold.
+/// The per-tetrahedron scratch this needs (about 80 bytes per tetrahedron) exists only while
+/// the body tears by force; it is made with the component by the builder and by a split, and
+/// once on the first frame for a component made by [`Tearing::new`] or given a force
+/// threshold by [`Tearing::set_settings`].
+///
 /// # Tear
 ///
 /// A torn face splits when its particles can be duplicated so that the two sides no longer
@@ -119,6 +151,10 @@ pub struct Tearing {
     pub(crate) settings: TearingSettings,
     /// The interior faces, sorted by their tetrahedra.
     pub(crate) faces: Vec<InteriorFace>,
+    /// The per-tetrahedron forces and edge shares of the force estimate (scratch; empty while
+    /// the body does not tear by force).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub(crate) forces: FaceForceScratch,
 }
 
 impl Tearing {
@@ -133,7 +169,21 @@ impl Tearing {
         Ok(Tearing {
             settings,
             faces: interior_faces(&tetrahedra.indices, &particles.rest_positions),
+            forces: FaceForceScratch::default(),
         })
+    }
+
+    /// Makes the force estimate's scratch for a body with these tetrahedra and edges when the
+    /// body tears by force (allocates; the builder and a split call it, the tearing pass when
+    /// the scratch does not fit).
+    pub(crate) fn prepare_forces(
+        &mut self,
+        tetrahedra: &Tetrahedra,
+        edges: Option<&EdgeConstraints>,
+    ) {
+        if self.settings.force.is_some() {
+            self.forces = FaceForceScratch::new(&tetrahedra.indices, edges);
+        }
     }
 
     /// The settings.
@@ -145,6 +195,9 @@ impl Tearing {
     pub fn set_settings(&mut self, settings: TearingSettings) -> Result<(), TearingError> {
         settings.validate()?;
         self.settings = settings;
+        if settings.force.is_none() {
+            self.forces = FaceForceScratch::default();
+        }
         Ok(())
     }
 
@@ -164,6 +217,16 @@ impl Tearing {
             .iter()
             .filter(|f| !f.torn)
             .map(|f| f.smoothed)
+            .fold(0.0, f32::max)
+    }
+
+    /// The largest smoothed force pulling an untorn face open, N (0 without interior faces
+    /// or while the body does not tear by force).
+    pub fn max_smoothed_force(&self) -> f32 {
+        self.faces
+            .iter()
+            .filter(|f| !f.torn)
+            .map(|f| f.smoothed_force)
             .fold(0.0, f32::max)
     }
 
@@ -206,6 +269,7 @@ pub(crate) fn interior_faces(
             apex: [a, b],
             inv_rest: if d > 0.0 { 1.0 / d } else { 0.0 },
             smoothed: 0.0,
+            smoothed_force: 0.0,
             torn: false,
         });
     }

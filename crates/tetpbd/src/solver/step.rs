@@ -33,7 +33,7 @@ use crate::stabilisation::{correction_energy, deformation_damping};
 ///     hook.end_substep
 /// after the last substep: the grabs' targets roll on (systems::roll_grab_targets), rest
 ///     shapes flow (systems::flow_plastically, bodies with a Plasticity)
-/// after the frame (hook's end of frame, sleeping): faces tear (systems::tear_by_strain,
+/// after the frame (hook's end of frame, sleeping): faces tear (systems::tear_faces,
 ///     bodies with a Tearing); the events are in Solver::tear_events
 /// ```
 ///
@@ -113,7 +113,7 @@ impl Solver {
         // hook sees one mesh per frame.
         let t = Instant::now();
         self.events.clear();
-        let torn = systems::tear_by_strain(world, dt, &mut self.events);
+        let torn = systems::tear_faces(world, dt, frame.h(), &mut self.events);
         if let Ok(stats) = &mut out {
             stats.faces_torn = torn;
             stats.tearing_time = t.elapsed();

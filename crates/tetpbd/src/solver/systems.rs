@@ -31,7 +31,7 @@ pub use crate::solver::material_systems::{
 };
 pub use crate::solver::plastic_flow::flow_plastically;
 use crate::solver::stats::{ErrorAccumulator, ErrorStats};
-pub use crate::solver::tearing_pass::tear_by_strain;
+pub use crate::solver::tearing_pass::tear_faces;
 pub use crate::stabilisation::deformation_damping::damp_deformation;
 
 /// Saves `x` as the substep start, applies gravity plus each body's
