@@ -31,10 +31,7 @@ pub fn tip_drop(scene: &Scene, trajectory: &[Vec<Vector3<f64>>]) -> Option<f64> 
     let tip: Vec<usize> = (0..rest.len())
         .filter(|&i| (rest[i].x - max).abs() <= tol)
         .collect();
-    let sum: f64 = tip
-        .iter()
-        .map(|&i| f64::from(rest[i].y) - last[i].y)
-        .sum();
+    let sum: f64 = tip.iter().map(|&i| f64::from(rest[i].y) - last[i].y).sum();
     (!tip.is_empty()).then(|| sum / tip.len() as f64)
 }
 

@@ -190,12 +190,7 @@ pub fn build(model: Model, scene: &Scene, substeps: u32, iterations: u32) -> Box
             substeps,
             iterations,
         )),
-        Model::Material => Box::new(Ours::new(
-            material_body(scene),
-            scene,
-            substeps,
-            iterations,
-        )),
+        Model::Material => Box::new(Ours::new(material_body(scene), scene, substeps, iterations)),
         Model::Rapier { cell, solver, hard } => Box::new(Rapier::new(
             cell,
             solver,
@@ -243,9 +238,7 @@ pub fn ours_body(set: ConstraintSet, soft: bool, scene: &Scene) -> SoftBody {
 /// tetpbd's body of a material scene: the scene's [`tetpbd::Material`] alone (a scene without
 /// one gets [`crate::scenes::scene_material`]), start positions set.
 pub fn material_body(scene: &Scene) -> SoftBody {
-    let material = scene
-        .material
-        .unwrap_or_else(crate::scenes::scene_material);
+    let material = scene.material.unwrap_or_else(crate::scenes::scene_material);
     let b = SoftBodyBuilder::new(scene.mesh.clone())
         .density(scene.density)
         .pinned(scene.pinned.iter().copied())

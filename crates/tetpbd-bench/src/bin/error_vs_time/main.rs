@@ -135,8 +135,7 @@ fn material_models(quick: bool) -> Vec<Model> {
         (SoftBodyCellModel::Corotational, SoftBodySolver::Constraints),
         (SoftBodyCellModel::Corotational, SoftBodySolver::Fem),
     ] {
-        if quick && (cell, solver) != (SoftBodyCellModel::NeoHookean, SoftBodySolver::Constraints)
-        {
+        if quick && (cell, solver) != (SoftBodyCellModel::NeoHookean, SoftBodySolver::Constraints) {
             continue;
         }
         m.push(Model::RapierMaterial { cell, solver });
@@ -192,10 +191,11 @@ fn repeats(quick: bool) -> usize {
 /// 1e-6 criterion by 2048 (see [`mod@reference`]); the squash does not converge at these substeps
 /// and is capped lower. The quick run starts at 32 so that its three runs can be checked for
 /// second order too. tetpbd's material has no `f64` stepper: its references run the `f32`
-/// solver, like rapier's, up to 512 substeps.
+/// solver, like rapier's, up to 2048 substeps (cheap: one body of a few hundred
+/// tetrahedra).
 fn reference_range(model: &Model, scene: &Scene, quick: bool) -> (u32, u32) {
     match (model, quick) {
-        (Model::Material, false) => (32, 512),
+        (Model::Material, false) => (32, 2048),
         (Model::Ours { .. }, false) => match scene.kind {
             SceneKind::HangingBeam => (256, 2048),
             SceneKind::Squash => (128, 1024),
@@ -223,7 +223,10 @@ fn jobs(scenes: &[Scene], quick: bool) -> Vec<(&Scene, Model)> {
 fn all_references(jobs: &[(&Scene, Model)], quick: bool) -> Vec<Reference> {
     // A bar on a terminal, plain periodic lines otherwise (CI); the per-reference lines go
     // through `suspend` so they do not tear the bar.
-    let progress = Mutex::new(Progress::new("scenes a, b, e, f: references", jobs.len() as u64));
+    let progress = Mutex::new(Progress::new(
+        "scenes a, b, e, f: references",
+        jobs.len() as u64,
+    ));
     let one = |&(scene, model): &(&Scene, Model)| {
         let (lo, hi) = reference_range(&model, scene, quick);
         let t = Instant::now();

@@ -144,7 +144,12 @@ pub fn draw(out: &Path, scenes: &[Scene], rows: &[Row]) -> Result<(), String> {
         .partition(|r| matches!(r.model, Model::Material | Model::RapierMaterial { .. }));
     for (stem, panels, rows, size) in [
         ("plot", &PANELS[..], &constraint_rows[..], SIZE),
-        ("materials", &MATERIAL_PANELS[..], &material_rows[..], (SIZE.0, 650)),
+        (
+            "materials",
+            &MATERIAL_PANELS[..],
+            &material_rows[..],
+            (SIZE.0, 650),
+        ),
     ] {
         let png = out.join(format!("{stem}.png"));
         let svg = out.join(format!("{stem}.svg"));
@@ -268,11 +273,7 @@ fn draw_panel<DB: DrawingBackend>(
             .filter_map(|r| value(panel, r).map(|p| (r.substeps, p)))
             .collect();
         line.sort_by_key(|(s, _)| *s);
-        let width = if model.is_ours() {
-            2
-        } else {
-            3
-        };
+        let width = if model.is_ours() { 2 } else { 3 };
         chart.draw_series(LineSeries::new(
             line.iter().map(|(_, p)| *p),
             c.stroke_width(width),
