@@ -130,6 +130,9 @@ pub fn setup(s: &mut String, scenes: &[Scene], rows: &[Row], references: &[RefIn
     }
 }
 
+/// Whether a reference belongs to a group of the convergence list.
+type Belongs = fn(&RefInfo) -> bool;
+
 /// How far the numerical references got towards the issue's "until the answer stops changing
 /// at 1e-6", from the references themselves.
 fn convergence(s: &mut String, references: &[RefInfo]) {
@@ -147,7 +150,7 @@ fn convergence(s: &mut String, references: &[RefInfo]) {
         crate::reference::TARGET_CHANGE,
         crate::report::REFERENCE_TOLERANCE
     );
-    let groups: [(fn(&RefInfo) -> bool, &str); 3] = [
+    let groups: [(Belongs, &str); 3] = [
         (
             |r| r.conv.f64,
             "tetpbd's soft models, run in f64 by `tetpbd_bench::Xpbd64`",
