@@ -82,3 +82,34 @@ pub fn answers(jobs: &[(&Scene, Model)], refs: &[Reference]) -> Vec<Answer> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tip drop reads the vertices at the free end only, and the Euler–Bernoulli figure is
+    /// the closed form for the 2 m × 0.2 m beam (1.5 ρ g L⁴ / (E a²)); a scene without a
+    /// material has none.
+    #[test]
+    fn tip_drop_and_euler_bernoulli_read_the_beam() {
+        let scene = Scene::material_beam(true);
+        let rest: Vec<Vector3<f64>> = scene.mesh.vertices.iter().map(|v| v.cast()).collect();
+        // Lower the free end by 0.3 m and the rest of the beam by less (x · 0.1 m).
+        let bent: Vec<Vector3<f64>> = rest
+            .iter()
+            .map(|v| {
+                let drop = if v.x > 1.999 { 0.3 } else { 0.1 * v.x };
+                v - Vector3::y() * drop
+            })
+            .collect();
+        assert_eq!(tip_drop(&scene, std::slice::from_ref(&rest)), Some(0.0));
+        let tip = tip_drop(&scene, &[rest, bent]).expect("frames");
+        assert!((tip - 0.3).abs() < 1e-6, "tip drop {tip}");
+        let material = scene.material.expect("material scene");
+        let eb = euler_bernoulli_tip(&scene).expect("material beam");
+        let expected = 1.5 * 1000.0 * 9.81 * 16.0 / (f64::from(material.young_modulus()) * 0.04);
+        assert!((eb / expected - 1.0).abs() < 1e-5, "{eb} vs {expected}");
+        assert_eq!(euler_bernoulli_tip(&Scene::hanging_beam(true)), None);
+        assert_eq!(euler_bernoulli_tip(&Scene::material_squash(true)), None);
+    }
+}

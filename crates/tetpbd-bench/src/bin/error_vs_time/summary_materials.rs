@@ -10,8 +10,8 @@ use crate::engines::{material_body, Model};
 use crate::report::RefInfo;
 use crate::scenes::{Scene, DT};
 
-/// tetpbd's largest stable substep for the scene's body ([`NeoHookeanMaterial::
-/// max_stable_substep`]), s.
+/// tetpbd's largest stable substep for the scene's body, s (see
+/// [`NeoHookeanMaterial::max_stable_substep`]).
 fn stable_substep(scene: &Scene) -> Option<f32> {
     let mut world = tetpbd::hecs::World::new();
     let e = material_body(scene).spawn(&mut world);
