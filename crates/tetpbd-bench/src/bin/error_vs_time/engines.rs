@@ -7,7 +7,7 @@ use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{
     PhysicsWorld, SoftBodyBuilder as RapierBuilder, SoftBodyCellModel, SoftBodyHandle,
-    SoftBodySolver,
+    SoftBodyMaterial, SoftBodySolver,
 };
 use tetpbd::systems::{self, Measured};
 use tetpbd::{
@@ -20,7 +20,7 @@ use tetpbd_bench::{
     RAPIER_YOUNG,
 };
 
-use crate::scenes::{Scene, DT};
+use crate::scenes::{Scene, DT, MATERIAL_POISSON, MATERIAL_YOUNG};
 
 /// Soft compliance of the length constraints (edges, vertex–face), m/N.
 pub const SOFT_LENGTH_COMPLIANCE: f32 = 1e-7;
@@ -58,14 +58,24 @@ pub enum Model {
         /// default 30 Hz softness.
         hard: bool,
     },
+    /// tetpbd's Neo-Hookean material (the material scene's [`tetpbd::Material`]) and no
+    /// constraint family.
+    Material,
+    /// rapier's elastic cell model with the material scene's E and ν.
+    RapierMaterial {
+        /// Cell model (corotational or Neo-Hookean).
+        cell: SoftBodyCellModel,
+        /// Solver.
+        solver: SoftBodySolver,
+    },
 }
 
 impl Model {
     /// The engine's name.
     pub fn engine(&self) -> &'static str {
         match self {
-            Model::Ours { .. } => "tetpbd",
-            Model::Rapier { .. } => "rapier",
+            Model::Ours { .. } | Model::Material => "tetpbd",
+            Model::Rapier { .. } | Model::RapierMaterial { .. } => "rapier",
         }
     }
 
@@ -81,7 +91,16 @@ impl Model {
                 format!("tetpbd {s} {}", if soft { "soft" } else { "α=0" })
             }
             Model::Rapier { cell, solver, hard } => rapier_label(cell, solver, hard),
+            Model::Material => format!("tetpbd Neo-Hookean E={MATERIAL_YOUNG:e}"),
+            Model::RapierMaterial { cell, solver } => {
+                format!("{} E={MATERIAL_YOUNG:e}", rapier_label(cell, solver, false))
+            }
         }
+    }
+
+    /// `true` for tetpbd's models.
+    pub fn is_ours(&self) -> bool {
+        self.engine() == "tetpbd"
     }
 
     /// `true` for the models whose converged answer keeps every edge and volume at rest
@@ -90,6 +109,7 @@ impl Model {
         match *self {
             Model::Ours { soft, .. } => !soft,
             Model::Rapier { cell, hard, .. } => hard && cell == SoftBodyCellModel::Volume,
+            Model::Material | Model::RapierMaterial { .. } => false,
         }
     }
 
@@ -121,6 +141,12 @@ impl Model {
                     "no edges, E={RAPIER_YOUNG:e} Pa, ν={RAPIER_POISSON}, elastic damping ratio 1"
                 ),
             },
+            Model::Material => format!(
+                "`Material::new({MATERIAL_YOUNG:e} Pa, {MATERIAL_POISSON})`: stable Neo-Hookean, no material damping, no other constraint"
+            ),
+            Model::RapierMaterial { .. } => format!(
+                "no edges, E={MATERIAL_YOUNG:e} Pa, ν={MATERIAL_POISSON}, elastic damping ratio 1 (rapier's default)"
+            ),
         }
     }
 }
@@ -158,9 +184,27 @@ fn timed(f: impl FnOnce()) -> (f64, f64) {
 /// `num_solver_iterations` is the substep count; it has no separate iteration count).
 pub fn build(model: Model, scene: &Scene, substeps: u32, iterations: u32) -> Box<dyn Sim> {
     match model {
-        Model::Ours { set, soft } => Box::new(Ours::new(set, soft, scene, substeps, iterations)),
-        Model::Rapier { cell, solver, hard } => {
-            Box::new(Rapier::new(cell, solver, hard, scene, substeps))
+        Model::Ours { set, soft } => Box::new(Ours::new(
+            ours_body(set, soft, scene),
+            scene,
+            substeps,
+            iterations,
+        )),
+        Model::Material => Box::new(Ours::new(material_body(scene), scene, substeps, iterations)),
+        Model::Rapier { cell, solver, hard } => Box::new(Rapier::new(
+            cell,
+            solver,
+            rapier_material(cell, hard),
+            scene,
+            substeps,
+        )),
+        Model::RapierMaterial { cell, solver } => {
+            let material = SoftBodyMaterial {
+                young_modulus: MATERIAL_YOUNG,
+                poisson_ratio: MATERIAL_POISSON,
+                ..rapier_material(cell, false)
+            };
+            Box::new(Rapier::new(cell, solver, material, scene, substeps))
         }
     }
 }
@@ -188,6 +232,22 @@ pub fn ours_body(set: ConstraintSet, soft: bool, scene: &Scene) -> SoftBody {
         ConstraintSet::VertexFace => b.vertex_face(l),
         ConstraintSet::VertexFaceEdges => b.vertex_face(l).edges(l),
     };
+    started(b, scene)
+}
+
+/// tetpbd's body of a material scene: the scene's [`tetpbd::Material`] alone (a scene without
+/// one gets [`crate::scenes::scene_material`]), start positions set.
+pub fn material_body(scene: &Scene) -> SoftBody {
+    let material = scene.material.unwrap_or_else(crate::scenes::scene_material);
+    let b = SoftBodyBuilder::new(scene.mesh.clone())
+        .density(scene.density)
+        .pinned(scene.pinned.iter().copied())
+        .material(material);
+    started(b, scene)
+}
+
+/// Builds `b` and moves its particles to the scene's start positions.
+fn started(b: SoftBodyBuilder, scene: &Scene) -> SoftBody {
     let mut body = b.build().expect("scene meshes are valid");
     for (i, x) in scene.start.iter().enumerate() {
         body.particles
@@ -210,9 +270,9 @@ pub fn ours_settings(scene: &Scene, substeps: u32, iterations: u32) -> SolverSet
 }
 
 impl Ours {
-    fn new(set: ConstraintSet, soft: bool, scene: &Scene, substeps: u32, iterations: u32) -> Ours {
+    fn new(body: SoftBody, scene: &Scene, substeps: u32, iterations: u32) -> Ours {
         let mut world = hecs::World::new();
-        let e = ours_body(set, soft, scene).spawn(&mut world);
+        let e = body.spawn(&mut world);
         // The error is measured on the moving body: sleeping would freeze it.
         world
             .insert_one(e, tetpbd::Activation::never_sleeps())
@@ -240,7 +300,10 @@ impl Sim for Ours {
         FrameCost {
             ms,
             cpu_ms,
-            projections: s.edge.projections + s.vertex_face.projections + s.volume.projections,
+            projections: s.edge.projections
+                + s.vertex_face.projections
+                + s.volume.projections
+                + s.material.projections,
         }
     }
 
@@ -274,7 +337,7 @@ impl Rapier {
     fn new(
         cell: SoftBodyCellModel,
         solver: SoftBodySolver,
-        hard: bool,
+        material: SoftBodyMaterial,
         scene: &Scene,
         substeps: u32,
     ) -> Rapier {
@@ -288,7 +351,7 @@ impl Rapier {
             .pinned_particles(scene.pinned.iter().copied())
             .cell_model(cell)
             .solver(solver)
-            .material(rapier_material(cell, hard))
+            .material(material)
             .linear_damping(scene.damping)
             .no_surface_collider()
             .can_sleep(false);

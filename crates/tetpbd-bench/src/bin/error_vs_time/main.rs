@@ -1,17 +1,21 @@
 //! `cargo run --release -p tetpbd-bench --bin error_vs_time [-- [--quick] [--out DIR]]`
 //! (`-- --help` lists the options)
 //!
-//! Error against run time, tetpbd next to rapier 0.36's built-in soft bodies, on the scenes of
-//! four scenes: a) a hanging beam settling to static equilibrium, b) a block squashed to 50 %
-//! height and released, c) a soft cube dropped onto rigid ground, d) a pile of nine cubes
-//! (soft–soft contacts). Writes `docs/error-vs-time/` (results.csv, contacts.csv,
-//! squash_volume.csv, plot.png, plot.svg, contacts.png, contacts.svg, squash_volume.png,
+//! Error against run time, tetpbd next to rapier 0.36's built-in soft bodies, on six scenes:
+//! a) a hanging beam settling to static equilibrium, b) a block squashed to 50 % height and
+//! released, c) a soft cube dropped onto rigid ground, d) a pile of nine cubes (soft–soft
+//! contacts), and the material scenes e) and f): scenes a and b with the body made of one
+//! elastic material (the same Young's modulus, Poisson's ratio and density in both engines:
+//! tetpbd's Neo-Hookean material, rapier's Neo-Hookean and corotational cells). Writes
+//! `docs/error-vs-time/` (results.csv, contacts.csv, squash_volume.csv, plot.png, plot.svg,
+//! materials.png, materials.svg, contacts.png, contacts.svg, squash_volume.png,
 //! squash_volume.svg, summary.md);
 //! `--quick` (a smoke run) writes `target/error-vs-time-quick/`. With `--features parallel`
-//! the references of scenes a and b (see [`mod@reference`]) are computed on rayon's threads
+//! the references of scenes a, b, e and f (see [`mod@reference`]) are computed on rayon's threads
 //! before the timed runs, and the contact sweep adds a 12³-cell drop run by tetpbd on 1 and 2
 //! threads.
 
+mod answers;
 mod contacts;
 mod engines;
 mod metrics;
@@ -24,6 +28,7 @@ mod report;
 mod scenes;
 mod summary;
 mod summary_contacts;
+mod summary_materials;
 mod summary_setup;
 
 use std::path::PathBuf;
@@ -41,8 +46,9 @@ use report::Row;
 use scenes::{Scene, SceneKind};
 
 /// Error against run time, tetpbd next to rapier 0.36's built-in soft bodies: a hanging beam,
-/// a squashed block, a soft cube dropped on rigid ground and a pile of nine cubes. Writes the
-/// report's tables, plots and summary.
+/// a squashed block, a soft cube dropped on rigid ground, a pile of nine cubes, and the beam
+/// and the block again made of one elastic material in both engines. Writes the report's
+/// tables, plots and summary.
 #[derive(Debug, Parser)]
 #[command(name = "error_vs_time")]
 struct Args {
@@ -69,9 +75,12 @@ impl Args {
     }
 }
 
-/// The swept models: every tetpbd constraint set at α = 0 and soft, and rapier's cell models
-/// and solvers.
-fn models(quick: bool) -> Vec<Model> {
+/// The swept models of `scene`: on a material scene [`material_models`], otherwise every
+/// tetpbd constraint set at α = 0 and soft, and rapier's cell models and solvers.
+fn models(scene: &Scene, quick: bool) -> Vec<Model> {
+    if scene.material.is_some() {
+        return material_models(quick);
+    }
     let mut m = Vec::new();
     for soft in [false, true] {
         for set in [
@@ -115,6 +124,25 @@ fn models(quick: bool) -> Vec<Model> {
     m
 }
 
+/// The models of a material scene, all with the same E, ν and density: tetpbd's Neo-Hookean
+/// material, rapier's Neo-Hookean and corotational cells on both its solvers (the quick run:
+/// Neo-Hookean on the constraints solver only).
+fn material_models(quick: bool) -> Vec<Model> {
+    let mut m = vec![Model::Material];
+    for (cell, solver) in [
+        (SoftBodyCellModel::NeoHookean, SoftBodySolver::Constraints),
+        (SoftBodyCellModel::NeoHookean, SoftBodySolver::Fem),
+        (SoftBodyCellModel::Corotational, SoftBodySolver::Constraints),
+        (SoftBodyCellModel::Corotational, SoftBodySolver::Fem),
+    ] {
+        if quick && (cell, solver) != (SoftBodyCellModel::NeoHookean, SoftBodySolver::Constraints) {
+            continue;
+        }
+        m.push(Model::RapierMaterial { cell, solver });
+    }
+    m
+}
+
 /// `(substeps, iterations)` swept for a model at the 1/60 s frame: substeps × 1 iteration
 /// from 1 up to the point where tetpbd costs about as much per frame as rapier's most
 /// expensive runs, plus a few iteration-heavy budgets.
@@ -129,14 +157,15 @@ fn budgets(model: &Model, quick: bool) -> Vec<(u32, u32)> {
             false,
         ) => 256,
         (Model::Ours { .. }, false) => 128,
-        (Model::Rapier { .. }, false) => 32,
+        (Model::Material, false) => 256,
+        (Model::Rapier { .. } | Model::RapierMaterial { .. }, false) => 32,
     };
     let step = if quick { 4 } else { 2 };
     let mut b: Vec<(u32, u32)> = std::iter::successors(Some(1u32), |s| Some(s * step))
         .take_while(|s| *s <= top)
         .map(|s| (s, 1))
         .collect();
-    if let Model::Ours { .. } = model {
+    if model.is_ours() {
         match quick {
             true => b.push((1, 4)),
             false => b.extend([(1, 4), (1, 16), (1, 32), (4, 4)]),
@@ -161,31 +190,43 @@ fn repeats(quick: bool) -> usize {
 /// 4.2e-5 of its length at 2048 substeps), so its Richardson-extrapolated answer meets the
 /// 1e-6 criterion by 2048 (see [`mod@reference`]); the squash does not converge at these substeps
 /// and is capped lower. The quick run starts at 32 so that its three runs can be checked for
-/// second order too.
+/// second order too. tetpbd's material has no `f64` stepper: its references run the `f32`
+/// solver, like rapier's, up to 2048 substeps (cheap: one body of a few hundred
+/// tetrahedra).
 fn reference_range(model: &Model, scene: &Scene, quick: bool) -> (u32, u32) {
     match (model, quick) {
+        (Model::Material, false) => (32, 2048),
         (Model::Ours { .. }, false) => match scene.kind {
             SceneKind::HangingBeam => (256, 2048),
             SceneKind::Squash => (128, 1024),
         },
         (Model::Ours { .. }, true) => (32, 128),
-        (Model::Rapier { .. }, false) => (32, 128),
-        (Model::Rapier { .. }, true) => (32, 64),
+        (Model::Material, true) => (32, 128),
+        (Model::Rapier { .. } | Model::RapierMaterial { .. }, false) => (32, 128),
+        (Model::Rapier { .. } | Model::RapierMaterial { .. }, true) => (32, 64),
     }
 }
 
-/// Every scene's reference for every model, in `scenes × models` order, computed before any
-/// timed run. With the `parallel` feature they run on rayon's threads (nothing is timed
-/// meanwhile; each reference is deterministic, so the answers are the same as one after the
-/// other), without it one after the other.
-fn all_references(scenes: &[Scene], quick: bool) -> Vec<Reference> {
-    let jobs: Vec<(&Scene, Model)> = scenes
+/// Every `(scene, model)` pair of the sweep, scenes in order, each scene's models in
+/// [`models`] order.
+fn jobs(scenes: &[Scene], quick: bool) -> Vec<(&Scene, Model)> {
+    scenes
         .iter()
-        .flat_map(|sc| models(quick).into_iter().map(move |m| (sc, m)))
-        .collect();
+        .flat_map(|sc| models(sc, quick).into_iter().map(move |m| (sc, m)))
+        .collect()
+}
+
+/// The reference of every job (see [`jobs`]), computed before any timed run. With the
+/// `parallel` feature they run on rayon's threads (nothing is timed meanwhile; each reference
+/// is deterministic, so the answers are the same as one after the other), without it one
+/// after the other.
+fn all_references(jobs: &[(&Scene, Model)], quick: bool) -> Vec<Reference> {
     // A bar on a terminal, plain periodic lines otherwise (CI); the per-reference lines go
     // through `suspend` so they do not tear the bar.
-    let progress = Mutex::new(Progress::new("scenes a-b: references", jobs.len() as u64));
+    let progress = Mutex::new(Progress::new(
+        "scenes a, b, e, f: references",
+        jobs.len() as u64,
+    ));
     let one = |&(scene, model): &(&Scene, Model)| {
         let (lo, hi) = reference_range(&model, scene, quick);
         let t = Instant::now();
@@ -224,47 +265,57 @@ fn all_references(scenes: &[Scene], quick: bool) -> Vec<Reference> {
     refs
 }
 
+/// Every timed run of scenes a, b, e and f against its reference, and the references as the
+/// summary lists them.
+fn sweep(scenes: &[Scene], quick: bool) -> (Vec<Row>, Vec<report::RefInfo>) {
+    let mut rows = Vec::new();
+    let mut references = Vec::new();
+    let jobs = jobs(scenes, quick);
+    let computed = all_references(&jobs, quick);
+    let answers = answers::answers(&jobs, &computed);
+    let mut progress = Progress::new("scenes a, b, e, f: budgets", jobs.len() as u64);
+    for (k, &(scene, model)) in jobs.iter().enumerate() {
+        let r = &computed[k];
+        progress.suspend(|| eprintln!("{:<18} {}", scene.name, model.label()));
+        for (substeps, iterations) in budgets(&model, quick) {
+            let mut res = run(build(model, scene, substeps, iterations).as_mut(), scene);
+            for _ in 1..repeats(quick) {
+                let again = run(build(model, scene, substeps, iterations).as_mut(), scene);
+                res.pool_timing(&again);
+            }
+            let dev = deviation(scene, &widen(&res.trajectory), &r.trajectory);
+            progress.suspend(|| {
+                eprintln!(
+                    "    {substeps:>3}x{iterations:<3} {:>9.3} ms  dev max {:.2e} rms {:.2e}  vol {:+.3}%  strain {:.2e}",
+                    res.ms_median, dev.max, dev.rms, res.last.volume_err_pct, res.last.edge_strain_rms
+                )
+            });
+            rows.push(Row::new(scene, model, substeps, iterations, &res, dev, r));
+        }
+        references.push(report::RefInfo {
+            scene: scene.name,
+            model,
+            conv: r.conv,
+            answer: answers[k],
+        });
+        progress.inc(1);
+    }
+    progress.finish();
+    (rows, references)
+}
+
 fn main() {
     let args = Args::parse();
     let out = args.out_dir();
     let started = Instant::now();
     let load_start = report::load_average();
-    let scenes = [Scene::hanging_beam(args.quick), Scene::squash(args.quick)];
-    let mut rows = Vec::new();
-    let mut references = Vec::new();
-    let mut computed = all_references(&scenes, args.quick).into_iter();
-    let mut progress = Progress::new(
-        "scenes a-b: budgets",
-        (scenes.len() * models(args.quick).len()) as u64,
-    );
-    for scene in &scenes {
-        for model in models(args.quick) {
-            let r = computed.next().expect("one reference per scene and model");
-            progress.suspend(|| eprintln!("{:<18} {}", scene.name, model.label()));
-            for (substeps, iterations) in budgets(&model, args.quick) {
-                let mut res = run(build(model, scene, substeps, iterations).as_mut(), scene);
-                for _ in 1..repeats(args.quick) {
-                    let again = run(build(model, scene, substeps, iterations).as_mut(), scene);
-                    res.pool_timing(&again);
-                }
-                let dev = deviation(scene, &widen(&res.trajectory), &r.trajectory);
-                progress.suspend(|| {
-                    eprintln!(
-                        "    {substeps:>3}x{iterations:<3} {:>9.3} ms  dev max {:.2e} rms {:.2e}  vol {:+.3}%  strain {:.2e}",
-                        res.ms_median, dev.max, dev.rms, res.last.volume_err_pct, res.last.edge_strain_rms
-                    )
-                });
-                rows.push(Row::new(scene, model, substeps, iterations, &res, dev, &r));
-            }
-            references.push(report::RefInfo {
-                scene: scene.name,
-                model,
-                conv: r.conv,
-            });
-            progress.inc(1);
-        }
-    }
-    progress.finish();
+    let scenes = [
+        Scene::hanging_beam(args.quick),
+        Scene::squash(args.quick),
+        Scene::material_beam(args.quick),
+        Scene::material_squash(args.quick),
+    ];
+    let (rows, references) = sweep(&scenes, args.quick);
     let contact_scenes = match contacts::scenes(args.quick) {
         Ok(s) => s,
         Err(e) => {

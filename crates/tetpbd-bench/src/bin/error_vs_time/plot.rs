@@ -1,5 +1,6 @@
-//! The plot: error (log) against median ms per frame (log), one curve per model, four panels
-//! (two per scene), drawn once as PNG and once as SVG with plotters. Text uses a subset of
+//! The plots: error (log) against median ms per frame (log), one curve per model; plot.png has
+//! four panels (two per scene a and b), materials.png two (the deviation panels of the
+//! material scenes e and f); each drawn once as PNG and once as SVG with plotters. Text uses a subset of
 //! DejaVu Sans shipped in `assets/`, so no system font is needed.
 
 use std::path::Path;
@@ -19,6 +20,8 @@ const FLOOR: f64 = 1e-9;
 /// One panel: which rows, which metric.
 struct Panel {
     kind: SceneKind,
+    /// A panel of a material scene (see [`Scene::material`]).
+    material: bool,
     title: &'static str,
     metric: fn(&Row) -> f64,
     only_hard: bool,
@@ -29,6 +32,7 @@ struct Panel {
 const PANELS: [Panel; 4] = [
     Panel {
         kind: SceneKind::HangingBeam,
+        material: false,
         title: "a) hanging beam at rest: max deviation from converged reference / length",
         metric: |r| f64::from(r.dev.max),
         only_hard: false,
@@ -36,6 +40,7 @@ const PANELS: [Panel; 4] = [
     },
     Panel {
         kind: SceneKind::HangingBeam,
+        material: false,
         title: "a) hanging beam, hard models: RMS edge strain at rest (exact: 0)",
         metric: |r| f64::from(r.edge_strain_rms),
         only_hard: true,
@@ -43,6 +48,7 @@ const PANELS: [Panel; 4] = [
     },
     Panel {
         kind: SceneKind::Squash,
+        material: false,
         title: "b) squash & release: max deviation from converged reference / size",
         metric: |r| f64::from(r.dev.max),
         only_hard: false,
@@ -50,10 +56,30 @@ const PANELS: [Panel; 4] = [
     },
     Panel {
         kind: SceneKind::Squash,
+        material: false,
         title: "b) squash & release: max |volume error| %, second half of the run",
         metric: |r| f64::from(r.late_volume_err_pct),
         only_hard: false,
         needs_reference: false,
+    },
+];
+
+const MATERIAL_PANELS: [Panel; 2] = [
+    Panel {
+        kind: SceneKind::HangingBeam,
+        material: true,
+        title: "e) material beam at rest: max deviation from converged reference / length",
+        metric: |r| f64::from(r.dev.max),
+        only_hard: false,
+        needs_reference: true,
+    },
+    Panel {
+        kind: SceneKind::Squash,
+        material: true,
+        title: "f) material squash & release: max deviation from converged reference / size",
+        metric: |r| f64::from(r.dev.max),
+        only_hard: false,
+        needs_reference: true,
     },
 ];
 
@@ -87,9 +113,10 @@ fn color(model: &Model, k: usize) -> RGBColor {
         RGBColor(200, 170, 0),
     ];
 
-    match model {
-        Model::Ours { .. } => OURS[k % OURS.len()],
-        Model::Rapier { .. } => RAPIER[k % RAPIER.len()],
+    if model.is_ours() {
+        OURS[k % OURS.len()]
+    } else {
+        RAPIER[k % RAPIER.len()]
     }
 }
 
@@ -98,33 +125,43 @@ pub fn palette(models: &[Model]) -> Vec<RGBColor> {
     let (mut o, mut r) = (0, 0);
     models
         .iter()
-        .map(|m| match m {
-            Model::Ours { .. } => {
-                o += 1;
-                color(m, o - 1)
-            }
-            Model::Rapier { .. } => {
-                r += 1;
-                color(m, r - 1)
-            }
+        .map(|m| {
+            let k = if m.is_ours() { &mut o } else { &mut r };
+            *k += 1;
+            color(m, *k - 1)
         })
         .collect()
 }
 
-/// Writes `plot.png` and `plot.svg` into `out`.
+/// Writes `plot.png` and `plot.svg` (scenes a and b), and `materials.png` and
+/// `materials.svg` (the material scenes) into `out`.
 pub fn draw(out: &Path, scenes: &[Scene], rows: &[Row]) -> Result<(), String> {
     // Registering twice (a second call of `draw`) is harmless: the first font stays.
     register_font("sans-serif", FontStyle::Normal, FONT).map_err(|_| "invalid embedded font")?;
-    let png = out.join("plot.png");
-    let svg = out.join("plot.svg");
-    {
-        let root = BitMapBackend::new(&png, SIZE).into_drawing_area();
-        draw_on(&root, scenes, rows).map_err(|e| e.to_string())?;
+    let (material_rows, constraint_rows): (Vec<Row>, Vec<Row>) = rows
+        .iter()
+        .cloned()
+        .partition(|r| matches!(r.model, Model::Material | Model::RapierMaterial { .. }));
+    for (stem, panels, rows, size) in [
+        ("plot", &PANELS[..], &constraint_rows[..], SIZE),
+        (
+            "materials",
+            &MATERIAL_PANELS[..],
+            &material_rows[..],
+            (SIZE.0, 650),
+        ),
+    ] {
+        let png = out.join(format!("{stem}.png"));
+        let svg = out.join(format!("{stem}.svg"));
+        {
+            let root = BitMapBackend::new(&png, size).into_drawing_area();
+            draw_on(&root, panels, scenes, rows).map_err(|e| e.to_string())?;
+            root.present().map_err(|e| e.to_string())?;
+        }
+        let root = SVGBackend::new(&svg, size).into_drawing_area();
+        draw_on(&root, panels, scenes, rows).map_err(|e| e.to_string())?;
         root.present().map_err(|e| e.to_string())?;
     }
-    let root = SVGBackend::new(&svg, SIZE).into_drawing_area();
-    draw_on(&root, scenes, rows).map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())?;
     Ok(())
 }
 
@@ -132,6 +169,7 @@ type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::Er
 
 fn draw_on<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
+    panels: &[Panel],
     scenes: &[Scene],
     rows: &[Row],
 ) -> DrawResult<DB> {
@@ -143,9 +181,12 @@ fn draw_on<DB: DrawingBackend>(
     let (main, legend) = root.split_horizontally(SIZE.0 - 330);
     let all_models = models(rows);
     let colors = palette(&all_models);
-    let cells = main.split_evenly((2, 2));
-    for (panel, area) in PANELS.iter().zip(cells.iter()) {
-        let Some(scene) = scenes.iter().find(|s| s.kind == panel.kind) else {
+    let cells = main.split_evenly((panels.len().div_ceil(2), 2));
+    for (panel, area) in panels.iter().zip(cells.iter()) {
+        let Some(scene) = scenes
+            .iter()
+            .find(|s| s.kind == panel.kind && s.material.is_some() == panel.material)
+        else {
             continue;
         };
         let sel: Vec<&Row> = rows
@@ -232,22 +273,19 @@ fn draw_panel<DB: DrawingBackend>(
             .filter_map(|r| value(panel, r).map(|p| (r.substeps, p)))
             .collect();
         line.sort_by_key(|(s, _)| *s);
-        let width = if matches!(model, Model::Ours { .. }) {
-            2
-        } else {
-            3
-        };
+        let width = if model.is_ours() { 2 } else { 3 };
         chart.draw_series(LineSeries::new(
             line.iter().map(|(_, p)| *p),
             c.stroke_width(width),
         ))?;
         for (_, p) in &line {
-            match model {
-                Model::Ours { .. } => chart.draw_series([Circle::new(*p, 4, c.filled())])?,
-                Model::Rapier { .. } => chart.draw_series([
+            if model.is_ours() {
+                chart.draw_series([Circle::new(*p, 4, c.filled())])?;
+            } else {
+                chart.draw_series([
                     EmptyElement::at(*p) + Rectangle::new([(-4, -4), (4, 4)], c.filled())
-                ])?,
-            };
+                ])?;
+            }
         }
         let iterated = mine
             .iter()
@@ -267,11 +305,10 @@ fn draw_legend<DB: DrawingBackend>(
     let mut y = 60;
     for (m, c) in models.iter().zip(colors) {
         area.draw(&PathElement::new(vec![(10, y), (40, y)], c.stroke_width(3)))?;
-        match m {
-            Model::Ours { .. } => area.draw(&Circle::new((25, y), 4, c.filled()))?,
-            Model::Rapier { .. } => {
-                area.draw(&Rectangle::new([(21, y - 4), (29, y + 4)], c.filled()))?
-            }
+        if m.is_ours() {
+            area.draw(&Circle::new((25, y), 4, c.filled()))?;
+        } else {
+            area.draw(&Rectangle::new([(21, y - 4), (29, y + 4)], c.filled()))?;
         }
         area.draw(&Text::new(m.label(), (48, y - 8), text.clone()))?;
         y += 28;

@@ -86,14 +86,14 @@ pub fn exact_rest(scene: &Scene) -> Reference {
     }
 }
 
-/// The converged reference of a numerical model: tetpbd's models in `f64` (same model, see
-/// [`run64`]; extrapolated where second order is observed), rapier's with its own `f32`
-/// solver (plain). Doubles the substeps from `start` up to `max` (see the module docs).
+/// The converged reference of a numerical model: tetpbd's constraint models in `f64` (same
+/// model, see [`run64`]; extrapolated where second order is observed), tetpbd's material and
+/// rapier's models with the engine's own `f32` solver (plain). Doubles the substeps from `start` up to `max` (see the module docs).
 pub fn converged(model: Model, scene: &Scene, start: u32, max: u32) -> Reference {
     let f64 = matches!(model, Model::Ours { .. });
     let mut r = converge(scene, start, max, f64, |s| match model {
         Model::Ours { set, soft } => run64(set, soft, scene, s),
-        Model::Rapier { .. } => widen(&run(build(model, scene, s, 1).as_mut(), scene).trajectory),
+        _ => widen(&run(build(model, scene, s, 1).as_mut(), scene).trajectory),
     });
     r.conv.f64 = f64;
     r

@@ -28,6 +28,8 @@ pub struct RefInfo {
     pub model: Model,
     /// How far the reference is from converged.
     pub conv: Convergence,
+    /// Its answer next to the other engine's (material scenes only).
+    pub answer: crate::answers::Answer,
 }
 
 /// One run of one configuration, summarised.

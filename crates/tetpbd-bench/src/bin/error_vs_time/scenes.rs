@@ -3,7 +3,18 @@
 use nalgebra::Vector3;
 use tetpbd::constraint::signed_volume;
 use tetpbd::generators::{self, CellSplit};
-use tetpbd::{unique_edges, TetMesh};
+use tetpbd::{unique_edges, Material, TetMesh};
+
+/// Young's modulus of the material scenes, Pa (both engines): a soft rubber.
+pub const MATERIAL_YOUNG: f32 = 1e6;
+/// Poisson's ratio of the material scenes (both engines).
+pub const MATERIAL_POISSON: f32 = 0.3;
+
+/// The material of the material scenes: [`MATERIAL_YOUNG`], [`MATERIAL_POISSON`], no material
+/// damping (the scene's linear damping settles both engines alike).
+pub fn scene_material() -> Material {
+    Material::new(MATERIAL_YOUNG, MATERIAL_POISSON).expect("valid material constants")
+}
 
 /// Which scene of the report.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,6 +50,10 @@ pub struct Scene {
     pub size: f32,
     /// Density, kg/m³ (masses are lumped per tetrahedron corner, the same in both engines).
     pub density: f32,
+    /// A material scene: both engines model the body as this elastic material (tetpbd's
+    /// Neo-Hookean material, rapier's Neo-Hookean and corotational cells with the same E and
+    /// ν) instead of the constraint models of scenes a and b.
+    pub material: Option<Material>,
     /// Unique edges of the mesh with their rest lengths.
     pub edges: Vec<[u32; 2]>,
     /// Rest length of each edge, m.
@@ -114,6 +129,27 @@ impl Scene {
         )
     }
 
+    /// e) The beam of [`Scene::hanging_beam`] made of [`scene_material`] in both engines.
+    pub fn material_beam(quick: bool) -> Scene {
+        Scene {
+            name: "e_material_beam",
+            material: Some(scene_material()),
+            ..Scene::hanging_beam(quick)
+        }
+    }
+
+    /// f) The squashed cube of [`Scene::squash`] made of [`scene_material`] in both engines,
+    /// damped at 10 1/s instead of 2 (the elastic wobble is fast and its trajectory sensitive:
+    /// the stronger damping brings the references nearer to convergence).
+    pub fn material_squash(quick: bool) -> Scene {
+        Scene {
+            name: "f_material_squash",
+            material: Some(scene_material()),
+            damping: 10.0,
+            ..Scene::squash(quick)
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn new(
         kind: SceneKind,
@@ -148,6 +184,7 @@ impl Scene {
             warmup: 10.min(frames / 4),
             size,
             density: 1000.0,
+            material: None,
             edges,
             rest_lengths,
             rest_volumes,

@@ -122,12 +122,22 @@ pub struct Brief {
     pub points: usize,
 }
 
-/// One line of the headline table: by wall time (`b`) and by CPU time (`c`).
-pub fn brief_row(scene: &str, hard: bool, metric: &str, b: &Brief, c: &Brief) -> String {
+/// Which models a headline compares: the hard ones, all of a constraint scene, or the
+/// material models of a material scene.
+pub fn selection(hard: bool, material: bool) -> &'static str {
+    match (hard, material) {
+        (true, _) => "hard",
+        (false, false) => "all",
+        (false, true) => "same E, ν",
+    }
+}
+
+/// One line of the headline table: by wall time (`b`) and by CPU time (`c`); `models` says
+/// which models are compared (see [`selection`]).
+pub fn brief_row(scene: &str, models: &str, metric: &str, b: &Brief, c: &Brief) -> String {
     let f = |x: Option<f64>| x.map(sig).unwrap_or_else(|| "n/a".to_string());
     format!(
-        "| {scene} | {} | {metric} | **{}** | **{}** | {} | {} | {} |",
-        if hard { "hard" } else { "all" },
+        "| {scene} | {models} | {metric} | **{}** | **{}** | {} | {} | {} |",
         f(b.speed),
         f(b.gain),
         b.points,
@@ -161,10 +171,13 @@ fn headline(
         &points(rows, &sel("tetpbd"), m, cpu),
         &points(rows, &sel("rapier"), m, cpu),
     );
-    let which = if hard_only {
-        "hard models only"
-    } else {
-        "all models"
+    let material = rows
+        .iter()
+        .any(|r| r.scene == scene && r.model == crate::engines::Model::Material);
+    let which = match (hard_only, material) {
+        (true, _) => "hard models only",
+        (false, false) => "all models",
+        (false, true) => "the material models (same E, ν and density in both engines)",
     };
     let _ = writeln!(s, "**{scene}, {which}, error = {}.** ", m.name);
     if m.needs_reference {
@@ -292,16 +305,18 @@ pub fn markdown(
     if quick {
         let _ = writeln!(s, "**This is a `--quick` smoke run: fewer models, budgets, frames and a cheaper reference. Do not quote it.**\n");
     }
-    let _ = writeln!(s, "- Machine: {}\n- Date: {date}\n- Commit: {}\n- Load average (1/5/15 min) at start: {}, at end: {} (the machine is shared; a load above 1 on 2 cores inflates the times of both engines alike).\n- Every timed run one after the other, single-threaded unless marked '2 threads'{}. rapier is built without its `parallel` feature. tetpbd's `parallel` feature (colour-class Gauss–Seidel on rayon) only parallelises a family with at least 4096 constraints, more than the meshes of scenes a, b, c and d have (at most 1920 per family per body), so for those a parallel column would repeat the serial one; {}\n", machine(), commit(), info.load_start, info.load_end, if cfg!(feature = "parallel") { " (the references of scenes a and b, which are not timed, are computed first, on rayon's threads)" } else { "" }, if cfg!(feature = "parallel") { "this run was built with it and adds a 12³-cell drop (c_drop_12, 10 368 tetrahedra) run by tetpbd on 1 and 2 threads (see 'Parallel' below)." } else { "this run was built without it (see 'Parallel' below); large bodies on 2 threads are also measured by the `scaling` binary." });
-    let _ = writeln!(s, "![error vs time](plot.png)\n\nData: [results.csv](results.csv) (one row per run of scenes a and b), [contacts.csv](contacts.csv) (one row per run of scenes c and d), [squash_volume.csv](squash_volume.csv) (volume error per frame of every squash run), drawn for one budget in [squash_volume.png](squash_volume.png).\n");
+    let _ = writeln!(s, "- Machine: {}\n- Date: {date}\n- Commit: {}\n- Load average (1/5/15 min) at start: {}, at end: {} (the machine is shared; a load above 1 on 2 cores inflates the times of both engines alike).\n- Every timed run one after the other, single-threaded unless marked '2 threads'{}. rapier is built without its `parallel` feature. tetpbd's `parallel` feature (colour-class Gauss–Seidel on rayon) only parallelises a family with at least 4096 constraints, more than the meshes of scenes a, b, c and d have (at most 1920 per family per body), so for those a parallel column would repeat the serial one; {}\n", machine(), commit(), info.load_start, info.load_end, if cfg!(feature = "parallel") { " (the references of scenes a, b, e and f, which are not timed, are computed first, on rayon's threads)" } else { "" }, if cfg!(feature = "parallel") { "this run was built with it and adds a 12³-cell drop (c_drop_12, 10 368 tetrahedra) run by tetpbd on 1 and 2 threads (see 'Parallel' below)." } else { "this run was built without it (see 'Parallel' below); large bodies on 2 threads are also measured by the `scaling` binary." });
+    let _ = writeln!(s, "![error vs time](plot.png)\n\n![material scenes](materials.png)\n\nData: [results.csv](results.csv) (one row per run of scenes a, b, e and f), [contacts.csv](contacts.csv) (one row per run of scenes c and d), [squash_volume.csv](squash_volume.csv) (volume error per frame of every squash run), drawn for one budget in [squash_volume.png](squash_volume.png).\n");
     let _ = writeln!(s, "## Headline (Pareto fronts)\n");
-    let _ = writeln!(s, "Each engine's Pareto front is the set of its runs that no other run of the same engine beats in both median ms per frame and error. At each rapier front point we take tetpbd's cheapest run with an error at most rapier's (equal error) and tetpbd's most accurate run costing at most rapier's (equal time), and quote the medians over rapier's front: **speed** = rapier ms / tetpbd ms at equal error, **accuracy** = rapier error / tetpbd error at equal time; above 1 favours tetpbd. The hard models are the like-for-like comparison (same exact answer in both engines); 'all models' mixes materials that differ between the engines, each measured against its own reference. Contact runs (scenes c and d) that did not come to rest are left out of the fronts on both sides and listed under 'Runs that did not come to rest'; scenes a and b leave out non-finite runs (a beam still swinging at the last frame counts its motion as deviation).\n");
+    let _ = writeln!(s, "Each engine's Pareto front is the set of its runs that no other run of the same engine beats in both median ms per frame and error. At each rapier front point we take tetpbd's cheapest run with an error at most rapier's (equal error) and tetpbd's most accurate run costing at most rapier's (equal time), and quote the medians over rapier's front: **speed** = rapier ms / tetpbd ms at equal error, **accuracy** = rapier error / tetpbd error at equal time; above 1 favours tetpbd. The hard models are the like-for-like comparison (same exact answer in both engines); 'all models' mixes materials that differ between the engines, each measured against its own reference. The material scenes e and f give both engines the same elastic material (Young's modulus, Poisson's ratio, density): see 'Material scenes e) and f)'. Contact runs (scenes c and d) that did not come to rest are left out of the fronts on both sides and listed under 'Runs that did not come to rest'; scenes a and b leave out non-finite runs (a beam still swinging at the last frame counts its motion as deviation).\n");
     let mut details = String::new();
     let mut briefs: Vec<String> = Vec::new();
     for scene in scenes {
-        let cases: &[(&Metric, bool)] = match scene.kind {
-            SceneKind::HangingBeam => &[(&DEV, true), (&STRAIN, true), (&DEV, false)],
-            SceneKind::Squash => &[
+        let cases: &[(&Metric, bool)] = match (scene.kind, scene.material.is_some()) {
+            (SceneKind::HangingBeam, true) => &[(&DEV, false)],
+            (SceneKind::Squash, true) => &[(&DEV, false), (&LATE_VOLUME, false)],
+            (SceneKind::HangingBeam, false) => &[(&DEV, true), (&STRAIN, true), (&DEV, false)],
+            (SceneKind::Squash, false) => &[
                 (&DEV, true),
                 (&LATE_VOLUME, true),
                 (&DEV, false),
@@ -311,7 +326,8 @@ pub fn markdown(
         for (m, hard) in cases {
             let b = headline(&mut details, rows, scene.name, m, *hard, false);
             let c = headline(&mut String::new(), rows, scene.name, m, *hard, true);
-            briefs.push(brief_row(scene.name, *hard, m.name, &b, &c));
+            let models = selection(*hard, scene.material.is_some());
+            briefs.push(brief_row(scene.name, models, m.name, &b, &c));
         }
     }
     briefs.extend(crate::summary_contacts::headlines(
@@ -336,6 +352,7 @@ pub fn markdown(
     crate::summary_contacts::unsettled(&mut s, contacts.1);
     let _ = writeln!(s, "\n### Details\n\n{details}");
     crate::summary_setup::setup(&mut s, scenes, rows, references);
+    crate::summary_materials::section(&mut s, scenes, references);
     crate::summary_contacts::section(&mut s, contacts.0, contacts.1);
     s
 }

@@ -8,7 +8,7 @@ use tetpbd_bench::{ContactKind, ContactScene, GROUND_HALF_EXTENTS, SETTLED_SPEED
 
 use crate::contacts::ContactRow;
 use crate::pareto::{compare, median, Point};
-use crate::summary::{brief_row, pareto_text, sig, Brief};
+use crate::summary::{brief_row, pareto_text, selection, sig, Brief};
 
 /// A named error observable of a contact run.
 struct Metric {
@@ -100,7 +100,7 @@ pub fn headlines(
                 }
                 let b = one(details, rows, sc.name, m, hard, false);
                 let c = one(&mut String::new(), rows, sc.name, m, hard, true);
-                out.push(brief_row(sc.name, hard, m.name, &b, &c));
+                out.push(brief_row(sc.name, selection(hard, false), m.name, &b, &c));
             }
         }
     }

@@ -12,13 +12,17 @@ use crate::scenes::{Scene, SceneKind, DT};
 pub fn setup(s: &mut String, scenes: &[Scene], rows: &[Row], references: &[RefInfo]) {
     let _ = writeln!(s, "## Scenes (one mesh each, handed to both engines)\n");
     for sc in scenes {
+        let material = match sc.material {
+            Some(m) => format!(" Made of one elastic material in both engines: E = {:e} Pa, ν = {} (see 'Material scenes e) and f)').", m.young_modulus(), m.poisson_ratio()),
+            None => String::new(),
+        };
         let what = match sc.kind {
             SceneKind::HangingBeam => "2 m × 0.2 m × 0.2 m beam (`tetpbd::generators::beam`, 20×2×2 cells, six tetrahedra per cell), the vertices at x = 0 pinned, gravity −9.81 m/s², started straight and at rest; compared after the last frame (static equilibrium)",
             SceneKind::Squash => "1 m cube (`generators::box_grid`, 4×4×4 cells, six tetrahedra per cell), every vertex's y halved about the centre (50 % height, x and z unchanged), released at rest without gravity; compared over every frame",
         };
         let _ = writeln!(
             s,
-            "- **{}**: {what}. {} vertices, {} tetrahedra, {} edges; density {} kg/m³ with the same lumped masses in both engines (ρ·|V|/4 per tetrahedron corner); linear damping {} 1/s in both; {} frames of {:.4} s, the first {} excluded from the timing median.",
+            "- **{}**: {what}.{material} {} vertices, {} tetrahedra, {} edges; density {} kg/m³ with the same lumped masses in both engines (ρ·|V|/4 per tetrahedron corner); linear damping {} 1/s in both; {} frames of {:.4} s, the first {} excluded from the timing median.",
             sc.name,
             sc.mesh.vertices.len(),
             sc.mesh.tets.len(),
@@ -126,6 +130,9 @@ pub fn setup(s: &mut String, scenes: &[Scene], rows: &[Row], references: &[RefIn
     }
 }
 
+/// Whether a reference belongs to a group of the convergence list.
+type Belongs = fn(&RefInfo) -> bool;
+
 /// How far the numerical references got towards the issue's "until the answer stops changing
 /// at 1e-6", from the references themselves.
 fn convergence(s: &mut String, references: &[RefInfo]) {
@@ -143,17 +150,22 @@ fn convergence(s: &mut String, references: &[RefInfo]) {
         crate::reference::TARGET_CHANGE,
         crate::report::REFERENCE_TOLERANCE
     );
-    for (f64_, who) in [
+    let groups: [(Belongs, &str); 3] = [
         (
-            true,
+            |r| r.conv.f64,
             "tetpbd's soft models, run in f64 by `tetpbd_bench::Xpbd64`",
         ),
         (
-            false,
+            |r| !r.conv.f64 && r.model.is_ours(),
+            "tetpbd's Neo-Hookean material, run by tetpbd's own f32 solver (the f64 stepper has no material)",
+        ),
+        (
+            |r| !r.model.is_ours(),
             "rapier's soft models, run by rapier's own f32 solver",
         ),
-    ] {
-        let mine: Vec<&&RefInfo> = numeric.iter().filter(|r| r.conv.f64 == f64_).collect();
+    ];
+    for (belongs, who) in groups {
+        let mine: Vec<&&RefInfo> = numeric.iter().filter(|r| belongs(r)).collect();
         if mine.is_empty() {
             continue;
         }
