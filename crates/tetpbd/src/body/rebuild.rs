@@ -211,5 +211,6 @@ fn piece_tearing(
         settings: old.settings,
         faces,
         forces: Default::default(),
+        largest_index: None,
     }
 }

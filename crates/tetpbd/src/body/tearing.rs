@@ -155,6 +155,10 @@ pub struct Tearing {
     /// the body does not tear by force).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) forces: FaceForceScratch,
+    /// How many tetrahedra and particles the faces need, once measured (scratch: the faces
+    /// only change by being rebuilt, which starts it anew).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub(crate) largest_index: Option<(u32, u32)>,
 }
 
 impl Tearing {
@@ -170,6 +174,7 @@ impl Tearing {
             settings,
             faces: interior_faces(&tetrahedra.indices, &particles.rest_positions),
             forces: FaceForceScratch::default(),
+            largest_index: None,
         })
     }
 
@@ -233,10 +238,37 @@ impl Tearing {
     /// Whether this state was made for a body with these particles and tetrahedra (the
     /// solver skips a body it does not fit).
     pub fn fits(&self, particles: &Particles, tetrahedra: &Tetrahedra) -> bool {
-        let (n, t) = (particles.len() as u32, tetrahedra.len() as u32);
-        self.faces
-            .iter()
-            .all(|f| f.tets[1] < t && f.apex[0] < n && f.apex[1] < n)
+        let needed = self.largest_index.unwrap_or_else(|| self.needed_lengths());
+        Self::fits_within(needed, particles, tetrahedra)
+    }
+
+    /// [`Self::fits`], measuring the faces' largest indices once (the tearing pass's check:
+    /// one comparison per frame instead of a pass over the faces).
+    pub(crate) fn fits_cached(&mut self, particles: &Particles, tetrahedra: &Tetrahedra) -> bool {
+        let needed = match self.largest_index {
+            Some(l) => l,
+            None => *self.largest_index.insert(self.needed_lengths()),
+        };
+        Self::fits_within(needed, particles, tetrahedra)
+    }
+
+    fn fits_within(
+        (tets, particles_needed): (u32, u32),
+        particles: &Particles,
+        tetrahedra: &Tetrahedra,
+    ) -> bool {
+        tets as usize <= tetrahedra.len() && particles_needed as usize <= particles.len()
+    }
+
+    /// How many tetrahedra and particles the faces need: one more than the largest index
+    /// each names (0 without faces).
+    fn needed_lengths(&self) -> (u32, u32) {
+        self.faces.iter().fold((0, 0), |(t, n), f| {
+            (
+                t.max(f.tets[1] + 1),
+                n.max(f.apex[0] + 1).max(f.apex[1] + 1),
+            )
+        })
     }
 }
 

@@ -39,7 +39,7 @@ pub fn tear_faces(world: &mut World, dt: f32, h: f32, events: &mut Vec<TearEvent
         Option<&NeoHookeanMaterial>,
     )>();
     for (entity, p, t, tearing, edges, vertex_face, volume, material) in q.without::<&Asleep>() {
-        if !tearing.fits(p, t) {
+        if !tearing.fits_cached(p, t) {
             continue;
         }
         let families = BodyFamilies {
