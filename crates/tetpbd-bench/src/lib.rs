@@ -37,3 +37,9 @@ pub use xpbd64::{Xpbd64, Xpbd64Error};
 
 /// Frame time step of every benchmark run, s.
 pub const DT: f32 = 1.0 / 60.0;
+
+/// The median of `samples` (the upper one of an even count; NaN when there are none).
+pub fn median(mut samples: Vec<f64>) -> f64 {
+    samples.sort_by(f64::total_cmp);
+    samples.get(samples.len() / 2).copied().unwrap_or(f64::NAN)
+}

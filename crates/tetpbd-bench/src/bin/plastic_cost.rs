@@ -14,7 +14,7 @@ use clap::Parser;
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Particles, PlasticitySettings, SoftBodyBuilder, Solver, SolverSettings};
-use tetpbd_bench::DT;
+use tetpbd_bench::{median, DT};
 
 /// Cost of plasticity: free cubes of about 1k, 10k and 100k tetrahedra with and without the
 /// component, then the flow pass alone with every tetrahedron flowing.
@@ -24,11 +24,6 @@ struct Args {
     /// Frames measured per column (the median is printed).
     #[arg(long, default_value_t = 40)]
     frames: usize,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn body(mesh: &tetpbd::TetMesh, plastic: bool) -> Result<tetpbd::SoftBody, tetpbd::BuildError> {

@@ -13,7 +13,7 @@ use clap::Parser;
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{SoftBodyBuilder, Solver, SolverSettings, StepStats};
-use tetpbd_bench::{FamilySet, DT};
+use tetpbd_bench::{median, FamilySet, DT};
 
 /// Cost of the angular-momentum removal: free cubes of about 1k, 10k and 100k tetrahedra
 /// stepped with the removal on and off in alternating frames.
@@ -26,11 +26,6 @@ struct Args {
     /// The family set of the cube.
     #[arg(long, value_enum, default_value = "edges+volume")]
     set: FamilySet,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn ms(d: std::time::Duration) -> f64 {

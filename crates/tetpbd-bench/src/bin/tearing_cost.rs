@@ -15,7 +15,7 @@ use clap::Parser;
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Blade, Particles, SoftBodyBuilder, Solver, SolverSettings, TearingSettings};
-use tetpbd_bench::DT;
+use tetpbd_bench::{median, DT};
 
 /// Cost of tearing: free cubes of about 1k, 10k and 100k tetrahedra with and without the
 /// component while nothing tears, then a frame that tears everywhere and a cut.
@@ -25,11 +25,6 @@ struct Args {
     /// Frames measured per column (the median is printed).
     #[arg(long, default_value_t = 40)]
     frames: usize,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// The cube, tearing at `strain` (`None`: without the component).
