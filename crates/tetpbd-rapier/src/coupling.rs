@@ -253,6 +253,7 @@ impl Coupling {
         let without_surface = crate::validate::check_soft_bodies(world)?;
 
         self.frame.capture_start(ctx.bodies);
+        self.frame.rigid_slop = ctx.integration_parameters.allowed_linear_error();
         let rigid_time = step_rapier(&mut ctx);
         // The soft load of the previous frame has acted over that step: take it off again.
         for (handle, force, torque) in self.frame.loads.drain(..) {

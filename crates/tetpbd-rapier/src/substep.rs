@@ -149,7 +149,8 @@ impl SubstepHook for CouplingHook<'_, '_> {
         for b in &mut self.frame.bodies {
             b.begin_substep(frac, h);
         }
-        hold_supported(&self.frame.supports, &mut self.frame.bodies);
+        let slop = self.frame.rigid_slop;
+        hold_supported(&self.frame.supports, &mut self.frame.bodies, slop);
         for a in &mut self.frame.attachments {
             a.lambda = 0.0;
         }

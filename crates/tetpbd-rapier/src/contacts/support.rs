@@ -22,8 +22,9 @@
 //! Gauss–Seidel alone would let a heavy soft body sink into a light anchored body: each soft
 //! projection moves mostly the body, the support moves it back, and the soft penetration
 //! stays. So, as in shock propagation, an anchored body is *held* by its supports in a
-//! substep when it stands on them (its clearance, the smallest support constraint value, at
-//! most 1 µm) and the soft positional impulses on it in the previous substep, summed, lie
+//! substep when it rests on them (its clearance, the smallest support constraint value, at
+//! most its *resting reach*, below) and the soft positional impulses on it in the previous
+//! substep, summed, lie
 //! in their friction cone: pressing it into them (along their mean normal), their
 //! tangential part at most μ times their normal part (μ the smallest coefficient of its
 //! supports). A held body keeps its offset of the previous substep (it follows rapier's
@@ -31,6 +32,17 @@
 //! supports would take that load (a fixed ground cancels it), so it is not handed to rapier
 //! either: a soft load handed to a light body a frame late is what made it unstable. The
 //! cost: such a load neither tips the body nor weighs on a dynamic support below it.
+//!
+//! *Resting reach.* A body resting on its supports does not sit exactly on them at a
+//! substep's start: rapier's path, the offset kept from the previous substep and the support
+//! projections leave it micrometres above or below. The reach is what the body's smooth
+//! acceleration `a_s` (gravity, user force) moves it in one substep, `a_s h²` (27 µm under
+//! `g` at 60 Hz and 10 substeps, 1.7 µm at 40), at least 1 µm: a body that close would land
+//! within the substep anyway. With a fixed 1 µm instead, a 1 kg box under a 1000 kg soft cube
+//! started every other substep 1.2 µm above the ground, was not held there, and took the
+//! cube's impulses with its own 1 kg: it was held and free by turns, the cube rattled at
+//! 0.16–0.5 m/s and the box walked and turned by up to 13 cm and 8° in 3 s (measurements:
+//! `docs/decisions/resting-reach.md`).
 //!
 //! A body that is not held moves with its generalized inverse mass under every soft impulse, except
 //! that one pressing it into its supports (more than 60° against their mean normal) does not move
@@ -181,13 +193,13 @@ pub(crate) fn measure_clearance(supports: &[Support], bodies: &mut [BodyProxy]) 
 }
 
 /// Starts a substep of the anchored bodies: measures their clearance and decides which are
-/// held on their supports ([`BodyProxy::hold`]).
-pub(crate) fn hold_supported(supports: &[Support], bodies: &mut [BodyProxy]) {
+/// held on their supports ([`BodyProxy::hold`]; `slop`: rapier's allowed linear error, m).
+pub(crate) fn hold_supported(supports: &[Support], bodies: &mut [BodyProxy], slop: f32) {
     measure_clearance(supports, bodies);
     let mut last = usize::MAX;
     for s in supports {
         if s.body != last {
-            bodies[s.body].hold();
+            bodies[s.body].hold(slop);
             last = s.body;
         }
     }

@@ -105,6 +105,9 @@ pub(crate) struct Frame {
     pub dt: f32,
     /// Magnitude of the frame's gravity, m/s².
     pub gravity: f32,
+    /// rapier's allowed linear error (its contacts' slop), m: the least *resting reach* of an
+    /// anchored body (`contacts::support` module docs).
+    pub rigid_slop: f32,
     pub stats: CouplingStats,
 }
 

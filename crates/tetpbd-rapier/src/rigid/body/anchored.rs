@@ -62,17 +62,27 @@ impl BodyProxy {
         !self.is_anchored() || !(self.held || (self.presses(push) && self.clearance() <= TOUCH))
     }
 
+    /// How far from its supports (m) an anchored body still rests on them when a substep
+    /// starts (`contacts::support` module docs, *resting reach*): rapier's allowed linear
+    /// error `slop` (m), or what its smooth acceleration (gravity, user force) moves it in one
+    /// substep of `h`, `a_s h²`, whichever is larger, and at least 1 µm.
+    fn resting_reach(&self, slop: f32) -> f32 {
+        TOUCH.max(slop).max(self.smooth_accel * self.h * self.h)
+    }
+
     /// Starts a substep of an anchored body, its clearance measured at its new pose: it is
-    /// *held* when it stands on its supports and the soft impulses of the previous substep,
-    /// summed, lie in their friction cone (pressing it into them, their tangential part at
-    /// most μ times their normal part). A held body keeps its offset from the previous
-    /// substep (it moves along rapier's path only) and soft impulses do not move it.
-    pub fn hold(&mut self) {
+    /// *held* when it rests on its supports (its clearance within its resting reach, `slop`
+    /// rapier's allowed linear error, m)
+    /// and the soft impulses of the previous substep, summed, lie in their friction cone
+    /// (pressing it into them, their tangential part at most μ times their normal part). A
+    /// held body keeps its offset from the previous substep (it moves along rapier's path
+    /// only) and soft impulses do not move it.
+    pub fn hold(&mut self, slop: f32) {
         let n = self.support_normal;
         let load = self.soft_load.1;
         let press = -n.dot(&load);
         self.held = self.is_anchored()
-            && self.clearance() <= TOUCH
+            && self.clearance() <= self.resting_reach(slop)
             && press >= 0.0
             && (load + n * press).norm() <= self.friction * press;
         if self.held {
