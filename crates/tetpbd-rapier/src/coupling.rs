@@ -142,16 +142,16 @@ use crate::substep::{CoupledHooks, CouplingHook};
 /// * Joints inside the substeps: their limits and motors, and a single locked angular axis,
 ///   are left to rapier's step; the joint reaction on a body that does not take part in the
 ///   substeps (a chain's far end) reaches it through rapier a frame later.
-/// * Anchoring at extreme ratios (`tests/loads.rs`): a 0.3 m soft cube 1000× heavier than a
-///   0.3 m box it rests on flush (edges aligned) creeps off it at about 1 cm/s, one particle
-///   rattling at 0.15 m/s (the box moves 7 mm, turns 0.3°); on a larger box it rests. A
-///   rigid box 1000× lighter than the slab under it (1 g on 1 kg) is pushed 7 cm and turned
+/// * Anchoring at extreme ratios (`tests/loads.rs`): soft cubes 100–1000× heavier than the
+///   light boxes they rest on come to rest at 5–40 substeps (`contacts::support` module docs,
+///   *resting reach*), except that a cube overhanging a box of half its side keeps rattling
+///   at 0.08–2 m/s at 5 substeps and a tower of three such boxes under a 1000:1 cube topples
+///   at 40 substeps (a held body does not tip). A rigid box 1000× lighter than the slab under it (1 g on 1 kg) is pushed 7 cm and turned
 ///   10°.
 /// * Fast impacts (`impact` module docs): of 448 shots (balls of 0.1 and 0.2 m, boxes of 0.08
 ///   and 0.2 m, 1 kg, at 50–300 m/s onto slabs of 1–4 cells, seven aim points), 12 still fail:
 ///   the 0.2 m box at 200–300 m/s (through the slab or throwing it) and hits within 0.1 m of
-///   the slab's edge. A soft cube at 300 m/s onto a dynamic box on the ground reaches 13 cm
-///   into the box and lifts it at 3.8 m/s.
+///   the slab's edge.
 #[derive(Clone, Debug)]
 pub struct Coupling {
     solver: Solver,

@@ -7,7 +7,7 @@ mod robust_common;
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
-use robust_common::{com, ground, particles, scene, scene_substeps, soft_box};
+use robust_common::{com, ground, particles, scene_substeps, soft_box};
 use tetpbd_rapier::CoupledWorld;
 
 /// What a resting scene measured over 3 s.

@@ -35,14 +35,17 @@
 //!
 //! *Resting reach.* A body resting on its supports does not sit exactly on them at a
 //! substep's start: rapier's path, the offset kept from the previous substep and the support
-//! projections leave it micrometres above or below. The reach is what the body's smooth
-//! acceleration `a_s` (gravity, user force) moves it in one substep, `a_s h²` (27 µm under
-//! `g` at 60 Hz and 10 substeps, 1.7 µm at 40), at least 1 µm: a body that close would land
-//! within the substep anyway. With a fixed 1 µm instead, a 1 kg box under a 1000 kg soft cube
-//! started every other substep 1.2 µm above the ground, was not held there, and took the
-//! cube's impulses with its own 1 kg: it was held and free by turns, the cube rattled at
-//! 0.16–0.5 m/s and the box walked and turned by up to 13 cm and 8° in 3 s (measurements:
-//! `docs/decisions/resting-reach.md`).
+//! projections leave it micrometres above or below, and rapier's own solver lets a stack
+//! move by up to its allowed linear error (its contact slop, 1 mm at its defaults). So a body
+//! rests on its supports while its clearance is within the larger of that slop and what its
+//! smooth acceleration `a_s` (gravity, user force) moves it in one substep, `a_s h²` (27 µm
+//! under `g` at 60 Hz and 10 substeps). With a fixed 1 µm instead, a 1 kg box under a 1000 kg
+//! soft cube started every other substep 1.2 µm above the ground, was not held there, and took
+//! the cube's impulses with its own 1 kg: it was held and free by turns, the cube rattled at
+//! 0.16–0.5 m/s and the box walked and turned by up to 13 cm and 8° in 3 s; on a stack of
+//! light boxes at 20–40 substeps the top box was thrown (measurements and the alternatives:
+//! `docs/decisions/resting-reach.md`). A body lifted off its supports is not held however
+//! close it is: the load must press it into them.
 //!
 //! A body that is not held moves with its generalized inverse mass under every soft impulse, except
 //! that one pressing it into its supports (more than 60° against their mean normal) does not move
