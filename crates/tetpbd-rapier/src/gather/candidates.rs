@@ -95,6 +95,7 @@ impl Frame {
             });
         }
         self.anchor_supported_bodies(input);
+        self.weld_jointed_bodies(input);
         self.gather_joints(input);
         self.stats.candidates = self.contacts.len();
         self.stats.corner_candidates = self.corners.len();

@@ -12,7 +12,9 @@ use std::collections::HashMap;
 
 use hecs::Entity;
 use nalgebra::{Isometry3, Vector3};
-use rapier3d::dynamics::{ImpulseJointSet, MultibodyJointSet, RigidBodyHandle, RigidBodySet};
+use rapier3d::dynamics::{
+    ImpulseJointSet, JointAxesMask, MultibodyJointSet, RigidBodyHandle, RigidBodySet,
+};
 use rapier3d::geometry::{Aabb, ColliderHandle, ColliderSet, NarrowPhase};
 use rapier3d::pipeline::QueryPipeline;
 
@@ -246,6 +248,29 @@ impl Frame {
             }
         }
         self.touching.sort_unstable_by_key(|t| t.0);
+    }
+
+    /// Makes every dynamic body taking part that a joint locks in all six degrees of freedom
+    /// to a fixed or kinematic body *welded*: immovable inside the substeps, its soft reaction
+    /// handed to rapier (`joints` module docs, "Welded bodies").
+    pub(crate) fn weld_jointed_bodies(&mut self, input: &GatherInput<'_, '_>) {
+        for b in 0..self.bodies.len() {
+            if !self.bodies[b].is_dynamic() {
+                continue;
+            }
+            let handle = self.bodies[b].handle;
+            let welded = joints_of(handle, input.impulse_joints, input.multibody_joints).any(
+                |(h1, h2, _, joint)| {
+                    let other = if h1 == handle { h2 } else { h1 };
+                    joint.is_enabled()
+                        && joint.locked_axes.contains(JointAxesMask::LOCKED_FIXED_AXES)
+                        && input.qp.bodies.get(other).is_some_and(|o| !o.is_dynamic())
+                },
+            );
+            if welded {
+                self.bodies[b].weld();
+            }
+        }
     }
 
     /// The joints of the dynamic bodies taking part (`joints` module docs); the other body of

@@ -22,6 +22,18 @@ impl BodyProxy {
         }
     }
 
+    /// Makes a dynamic body *welded* (`joints` module docs): a joint holds it rigidly to a
+    /// fixed or kinematic body, so inside the substeps it follows rapier's path as a
+    /// supported body does, infinitely heavy, its soft reaction summed for rapier's next
+    /// step, and it stops being anchored.
+    pub fn weld(&mut self) {
+        if self.is_dynamic() {
+            self.kind = BodyKind::Supported;
+            self.touched = true;
+            self.support_normal = Vector3::zeros();
+        }
+    }
+
     /// Records an anchored body's clearance `gap` (m) above its supports at its current pose.
     pub fn set_clearance(&mut self, gap: f32) {
         self.clearance = (gap, self.com());
