@@ -129,7 +129,7 @@ impl CouplingSettings {
         if let Some(s) = &self.stacking {
             if s.mass_ratio.is_nan() || s.mass_ratio < 0.0 {
                 return Err(CouplingError::BadSetting {
-                    name: "stacking mass ratio (≥ 0)",
+                    name: "stacking mass ratio",
                     value: s.mass_ratio,
                 });
             }
