@@ -64,7 +64,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let solver = SolverSettings {
         substeps: 10,
-        measure_error: true,
+        diagnostics: tetpbd::DiagnosticSettings {
+            measure_error: true,
+            ..Default::default()
+        },
         ..SolverSettings::default()
     };
     let mut coupling = Coupling::new(solver, CouplingSettings::default())?;

@@ -64,8 +64,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         gravity: Vector3::zeros(),
         substeps,
         damping: 1.0,
-        max_correction_speed,
-        measure_error: true,
+        safety: tetpbd::SafetySettings {
+            max_correction_speed,
+            ..Default::default()
+        },
+        diagnostics: tetpbd::DiagnosticSettings {
+            measure_error: true,
+            ..Default::default()
+        },
         ..Default::default()
     })?;
     println!(

@@ -25,7 +25,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames = cli.frames;
     let solver = SolverSettings {
         substeps: 10,
-        measure_error: true,
+        diagnostics: tetpbd::DiagnosticSettings {
+            measure_error: true,
+            ..Default::default()
+        },
         ..SolverSettings::default()
     };
     let mut scene = CoupledWorld::new(solver, CouplingSettings::default())?;

@@ -26,7 +26,7 @@ pub enum ContactEngine {
     Tetpbd {
         /// `DeformationDamping` rate, 1/s (0 = none).
         damping: f32,
-        /// `CouplingSettings::self_weight_stacking`.
+        /// `StackingSettings::self_weight`.
         self_weight: bool,
     },
     /// rapier's soft body with a cell model and solver (material: [`crate::rapier_material`]).
@@ -130,7 +130,7 @@ struct Ours {
 }
 
 /// tetpbd's side of `sc`: the coupled world (ground, frame [`DT`], `substeps` ×
-/// `iterations`, `self_weight` as `CouplingSettings::self_weight_stacking`) and one soft body
+/// `iterations`, `self_weight` as `StackingSettings::self_weight`) and one soft body
 /// per placement, edges and volumes at compliance 0, with `DeformationDamping` at `damping`
 /// 1/s when it is above 0. Soft–soft contacts are the coupling's
 /// (`CouplingSettings::soft_contacts`, on by default).
@@ -148,7 +148,10 @@ pub fn tetpbd_contact_world(
         ..SolverSettings::default()
     };
     let coupling = CouplingSettings {
-        self_weight_stacking: self_weight,
+        stacking: Some(tetpbd_rapier::StackingSettings {
+            self_weight,
+            ..Default::default()
+        }),
         ..CouplingSettings::default()
     };
     let mut scene = CoupledWorld::new(solver, coupling)?;

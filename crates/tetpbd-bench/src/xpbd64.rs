@@ -8,7 +8,7 @@
 //! and mirrors [`tetpbd::systems`]: prediction with `v ← (v + h g)·max(0, 1 − damping·h)`,
 //! multipliers reset every substep, `iterations` Gauss–Seidel sweeps over the families in
 //! [`SolverSettings::order`], each in the body's stored (colour) order, followed by the spin
-//! removal on a free body ([`SolverSettings::conserve_angular_momentum`]), then
+//! removal on a free body ([`SafetySettings::conserve_angular_momentum`]), then
 //! `v = (x − x_prev)/h` (with the correction-speed safety net's clamp and momentum
 //! restoration when it is set).
 //! Degenerate configurations get the core's fallbacks (edge: rest direction; vertex–face: rest
@@ -130,8 +130,8 @@ impl Xpbd64 {
             gravity: wide(&settings.gravity),
             damping: f64::from(settings.damping),
             order: settings.order,
-            max_correction_speed: settings.max_correction_speed.map(f64::from),
-            conserve_angular_momentum: settings.conserve_angular_momentum,
+            max_correction_speed: settings.safety.max_correction_speed.map(f64::from),
+            conserve_angular_momentum: settings.safety.conserve_angular_momentum,
             before: Vec::new(),
             degenerate: 0,
         })

@@ -98,7 +98,7 @@ use crate::substep::{CoupledHooks, CouplingHook};
 /// immovable support that carries a much heavier dynamic body, the *stacking pass*: its own
 /// constraints once more from the ground up with the supported particles held, and the
 /// heavy body's contacts with the surface frozen (`heavy_loads` module docs,
-/// [`CouplingSettings::stacking_mass_ratio`]). After each substep's velocity update (where
+/// [`crate::StackingSettings::mass_ratio`]). After each substep's velocity update (where
 /// the solver also damps the deformation of bodies with a [`tetpbd::DeformationDamping`]): the
 /// separating velocity a stacking pass gave a heavy body is removed, the per-particle
 /// separating velocity is removed, then restitution acts per (soft body,
@@ -281,8 +281,8 @@ impl Coupling {
                 margin: self.settings.margin,
                 soft_margin: self.settings.soft_contacts.map(|s| s.margin),
                 max_depenetration_speed: self.settings.max_depenetration_speed,
-                stacking_mass_ratio: self.settings.stacking_mass_ratio,
-                self_weight_stacking: self.settings.self_weight_stacking,
+                stacking_mass_ratio: self.settings.stacking_mass_ratio(),
+                self_weight_stacking: self.settings.stacking.is_some_and(|s| s.self_weight),
                 reports: &mut self.reports,
             };
             let soft = match self.settings.soft_contacts {
@@ -290,7 +290,7 @@ impl Coupling {
                     self.soft_contacts.set_settings(s)?;
                     let default = self.settings.default_collider;
                     self.soft_contacts.set_default_collider(default);
-                    let ratio = self.settings.stacking_mass_ratio;
+                    let ratio = self.settings.stacking_mass_ratio();
                     self.soft_contacts.set_carrying_ratio(ratio);
                     Some(&mut self.soft_contacts)
                 }

@@ -13,7 +13,7 @@
 //!   body (infinitely heavy inside the substeps, `rigid::body` module docs), an anchored body
 //!   its own supports hold in the substep (`contacts::support` module docs: a light box on
 //!   the ground under a soft slab carrying a heavy box) — or has pinned particles, and
-//! * carries a dynamic rigid body at least [`crate::CouplingSettings::stacking_mass_ratio`]
+//! * carries a dynamic rigid body at least [`crate::StackingSettings::mass_ratio`]
 //!   times heavier than the particles it touches (the body's generalized mass at the
 //!   contact against the particle's mass, or the triangle's mean particle mass),
 //!
@@ -46,7 +46,7 @@
 //! without such a heavy load) behave exactly as without it. Counted in
 //! [`crate::CouplingStats::stacking_passes`].
 //!
-//! With [`crate::CouplingSettings::self_weight_stacking`] step 2 runs on every soft body
+//! With [`crate::StackingSettings::self_weight`] step 2 runs on every soft body
 //! with roots, loaded or not: a body resting under its own weight then sags by far less
 //! than one iteration per substep leaves (the setting's docs give the figures). Steps 3 and
 //! the velocity pass still run only under a heavy load, and only those count as stacked.
@@ -80,7 +80,7 @@ pub(crate) struct Stacking<'a> {
     pub pinned: &'a mut Vec<bool>,
     /// Mass ratio from which a dynamic body counts as heavy.
     pub ratio: f32,
-    /// `CouplingSettings::self_weight_stacking`: the sweep (step 2) runs without a heavy
+    /// `StackingSettings::self_weight`: the sweep (step 2) runs without a heavy
     /// load too.
     pub self_weight: bool,
     /// The substep (its length, and the solver's family order and kernel for the sweep).

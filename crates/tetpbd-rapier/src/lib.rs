@@ -109,7 +109,7 @@ pub use queries::{
 };
 pub use report::{ContactReport, CouplingStats, SoftFeature};
 pub use scene::CoupledWorld;
-pub use settings::CouplingSettings;
+pub use settings::{CouplingSettings, StackingSettings};
 pub use soft_collider::{SoftCollider, SoftColliderBuilder};
 pub use soft_soft::settings::{SelfCollision, SoftContactSettings, SoftContactStats};
 pub use soft_soft::SoftContacts;

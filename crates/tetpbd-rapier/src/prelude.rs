@@ -29,6 +29,6 @@ pub use crate::queries::{
 };
 pub use crate::report::{ContactReport, CouplingStats, SoftFeature};
 pub use crate::scene::CoupledWorld;
-pub use crate::settings::CouplingSettings;
+pub use crate::settings::{CouplingSettings, StackingSettings};
 pub use crate::soft_collider::{SoftCollider, SoftColliderBuilder};
 pub use tetpbd::prelude::*;

@@ -69,7 +69,7 @@ pub struct CouplingStats {
     /// surface with no previous normal).
     pub degenerate_contacts: u64,
     /// Stacking passes run (one per stacked soft body and iteration; `heavy_loads` module
-    /// docs, [`crate::CouplingSettings::stacking_mass_ratio`]).
+    /// docs, [`crate::StackingSettings::mass_ratio`]).
     pub stacking_passes: u64,
     /// Wall time of the stacking passes and their velocity passes (part of the soft step's
     /// hook time).

@@ -39,9 +39,9 @@ pub(crate) struct CouplingHook<'q, 'a> {
     /// The soft–soft contact margin, m (`None`: soft–soft contacts off).
     pub soft_margin: Option<f32>,
     pub max_depenetration_speed: f32,
-    /// `CouplingSettings::stacking_mass_ratio`.
+    /// `CouplingSettings::stacking_mass_ratio()`.
     pub stacking_mass_ratio: f32,
-    /// `CouplingSettings::self_weight_stacking`.
+    /// `StackingSettings::self_weight` (false when stacking is off).
     pub self_weight_stacking: bool,
     pub reports: &'q mut Vec<ContactReport>,
 }

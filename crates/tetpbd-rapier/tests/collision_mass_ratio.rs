@@ -23,8 +23,8 @@ const CONFIGS: [(&str, Families); 6] = [
 /// A 1000 kg rigid box dropped from 7 mm onto a 1 kg soft slab (0.6 × 0.1 × 0.6 m, one
 /// cell thick) lying on the ground, at the default settings (10 substeps × 1 iteration, no
 /// safety net), under every constraint configuration. One Gauss–Seidel iteration alone
-/// lets the box crush the slab; the coupling's stacking pass (`CouplingSettings::
-/// stacking_mass_ratio`) carries it.
+/// lets the box crush the slab; the coupling's stacking pass (`StackingSettings::
+/// mass_ratio`) carries it.
 #[test]
 fn heavy_box_on_light_slab() {
     for (label, families) in CONFIGS {
@@ -95,13 +95,13 @@ fn heavy_box_on_light_slab() {
     }
 }
 
-/// The same scene with the stacking pass turned off (`stacking_mass_ratio = ∞`): one
+/// The same scene with the stacking pass turned off (`stacking: None`): one
 /// iteration per substep does not carry the box, which reaches the ground. Shows that the
 /// pass, not the scene, holds the box in `heavy_box_on_light_slab`.
 #[test]
 fn without_the_stacking_pass_the_box_sinks() {
     let mut s = scene(10);
-    s.coupling.settings_mut().stacking_mass_ratio = f32::INFINITY;
+    s.coupling.settings_mut().stacking = None;
     ground(&mut s);
     let size = Vector3::new(0.6, 0.1, 0.6);
     let slab = soft_box_with_density(

@@ -1,4 +1,4 @@
-//! `CouplingSettings::self_weight_stacking`: the stacking pass's ground-up sweep on a soft
+//! `StackingSettings::self_weight`: the stacking pass's ground-up sweep on a soft
 //! body resting under its own weight. With one Gauss–Seidel iteration per substep a resting
 //! body sags by a volume error that falls only as `h²`; the sweep must cut it, keep the body
 //! at rest and leave bodies without a support alone.
@@ -22,7 +22,10 @@ struct Rest {
 /// A 1 m cube of 8³ cells dropped 5 cm onto the ground, 10 substeps, 180 frames.
 fn rest(self_weight: bool) -> Rest {
     let mut s = scene(10);
-    s.coupling.settings_mut().self_weight_stacking = self_weight;
+    s.coupling.settings_mut().stacking = Some(tetpbd_rapier::StackingSettings {
+        self_weight,
+        ..Default::default()
+    });
     ground(&mut s);
     let cube = soft_box(
         &mut s,
@@ -81,7 +84,10 @@ fn self_weight_sweep_cuts_the_resting_volume_error() {
 #[test]
 fn self_weight_sweep_leaves_a_falling_body_alone() {
     let mut s = scene(10);
-    s.coupling.settings_mut().self_weight_stacking = true;
+    s.coupling.settings_mut().stacking = Some(tetpbd_rapier::StackingSettings {
+        self_weight: true,
+        ..Default::default()
+    });
     soft_box(
         &mut s,
         Vector3::repeat(1.0),

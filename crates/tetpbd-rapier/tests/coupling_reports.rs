@@ -67,7 +67,10 @@ fn bad_settings_are_rejected_before_anything_moves() {
     ));
     for ratio in [f32::NAN, -1.0] {
         let bad_ratio = CouplingSettings {
-            stacking_mass_ratio: ratio,
+            stacking: Some(tetpbd_rapier::StackingSettings {
+                mass_ratio: ratio,
+                ..Default::default()
+            }),
             ..CouplingSettings::default()
         };
         assert!(matches!(
@@ -78,9 +81,17 @@ fn bad_settings_are_rejected_before_anything_moves() {
             })
         ));
     }
-    // Infinity turns the stacking pass off: a valid setting.
+    // Infinity turns the heavy-load pass off: a valid setting, as is no stacking at all.
+    let never = CouplingSettings {
+        stacking: Some(tetpbd_rapier::StackingSettings {
+            mass_ratio: f32::INFINITY,
+            ..Default::default()
+        }),
+        ..CouplingSettings::default()
+    };
+    assert!(CoupledWorld::new(SolverSettings::default(), never).is_ok());
     let off = CouplingSettings {
-        stacking_mass_ratio: f32::INFINITY,
+        stacking: None,
         ..CouplingSettings::default()
     };
     assert!(CoupledWorld::new(SolverSettings::default(), off).is_ok());

@@ -1,4 +1,4 @@
-//! With `SolverSettings::limit_correction_energy` on, a contact's push counts as external
+//! With `SafetySettings::limit_correction_energy` on, a contact's push counts as external
 //! work: bodies resting on ground shapes come to rest and slide at Coulomb's rate, across
 //! sizes and substep counts.
 
@@ -15,7 +15,10 @@ use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider, SoftColliderBu
 fn limited_scene(substeps: u32) -> CoupledWorld {
     let solver = SolverSettings {
         substeps,
-        limit_correction_energy: true,
+        safety: tetpbd::SafetySettings {
+            limit_correction_energy: true,
+            ..Default::default()
+        },
         ..SolverSettings::default()
     };
     CoupledWorld::new(solver, CouplingSettings::default()).expect("valid settings")

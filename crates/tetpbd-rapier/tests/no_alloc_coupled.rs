@@ -280,12 +280,15 @@ fn soft_pile_steps_without_allocating() {
 }
 
 /// Three soft cubes stacked on rigid ground with the self-weight sweep on
-/// (`CouplingSettings::self_weight_stacking`): the ground-up sweep runs on the bottom cube
+/// (`StackingSettings::self_weight`): the ground-up sweep runs on the bottom cube
 /// in every substep, its levels rebuilt as its ground contacts change.
 #[test]
 fn self_weight_sweep_steps_without_allocating() {
     let mut scene = scene_with(CouplingSettings {
-        self_weight_stacking: true,
+        stacking: Some(tetpbd_rapier::StackingSettings {
+            self_weight: true,
+            ..Default::default()
+        }),
         ..CouplingSettings::default()
     });
     for i in 0..3 {

@@ -2,7 +2,7 @@
 //! energy, volume and momenta per frame, then the final state (per-tetrahedron volume ratios,
 //! edge stretch, surface self-crossings, best rigid fit). `RESTART=1` then zeroes the
 //! velocities and runs 600 more frames (`ITER`, `DAMP` override iterations and damping).
-//! `SPIN=0` turns `SolverSettings::conserve_angular_momentum` off for the whole run,
+//! `SPIN=0` turns `SafetySettings::conserve_angular_momentum` off for the whole run,
 //! `SPIN_RESTART=0|1` sets it for the restart only (e.g. `SPIN=0 SPIN_RESTART=1 RESTART=1
 //! DAMP=0 … nonet long`: tangle without it, then restart with it).
 //!
@@ -93,8 +93,8 @@ fn main() {
     let b = SoftBodyBuilder::new(scene.mesh.clone()).density(1000.0);
     let body = cfg.apply(b, 1.0).build().unwrap();
     let mut settings = scene.settings.clone();
-    settings.measure_error = true;
-    settings.conserve_angular_momentum = std::env::var("SPIN").map_or(true, |v| v != "0");
+    settings.diagnostics.measure_error = true;
+    settings.safety.conserve_angular_momentum = std::env::var("SPIN").map_or(true, |v| v != "0");
     let mut solver = Solver::new(settings).unwrap();
     let (lo, hi) = body.particles.aabb();
     let centre = (lo + hi) / 2.0;
@@ -131,9 +131,9 @@ fn main() {
                 *v = Vector3::zeros();
             }
         }
-        solver.settings.max_correction_speed = None;
+        solver.settings.safety.max_correction_speed = None;
         if let Ok(v) = std::env::var("SPIN_RESTART") {
-            solver.settings.conserve_angular_momentum = v != "0";
+            solver.settings.safety.conserve_angular_momentum = v != "0";
         }
         if let Ok(n) = std::env::var("ITER") {
             solver.settings.iterations = n.parse().unwrap();

@@ -63,7 +63,10 @@ fn scene_net(substeps: u32, iterations: u32, net: Option<f32>) -> Result<Coupled
     let solver = SolverSettings {
         substeps,
         iterations,
-        max_correction_speed: net,
+        safety: tetpbd::SafetySettings {
+            max_correction_speed: net,
+            ..Default::default()
+        },
         ..SolverSettings::default()
     };
     CoupledWorld::new(solver, CouplingSettings::default()).map_err(|e| e.to_string())

@@ -278,7 +278,7 @@ pub fn run_scene_observed(
             return out;
         }
     };
-    solver.settings.measure_error = true;
+    solver.settings.diagnostics.measure_error = true;
     let (lo, hi) = body.particles.aabb();
     let size = (hi - lo).norm().max(1e-9);
     let mass = body.particles.total_mass();

@@ -1,5 +1,5 @@
 //! A soft body stuck in a tangled, self-intersecting equilibrium stays at rest: without the
-//! removal of the corrections' rigid rotation (`SolverSettings::conserve_angular_momentum`)
+//! removal of the corrections' rigid rotation (`SafetySettings::conserve_angular_momentum`)
 //! Gauss–Seidel's second-order torque spins it up (undamped, 22 kJ within 10 s on this 1 m cube).
 
 use hecs::{Entity, World};
@@ -29,7 +29,7 @@ fn tangled() -> (World, Entity, Solver) {
         Start::Mirrored.apply(&mut p, (lo + hi) / 2.0).unwrap();
     }
     let mut settings = case.scene.settings.clone();
-    settings.conserve_angular_momentum = false;
+    settings.safety.conserve_angular_momentum = false;
     // Damped hard so the body settles into the tangle's equilibrium (spinning, which the
     // restart below stops).
     settings.damping = 5.0;
@@ -56,7 +56,7 @@ fn tangled() -> (World, Entity, Solver) {
 /// Kinetic energy (J) and |L| (kg m²/s) after two undamped seconds from rest.
 fn run(conserve: bool) -> (f32, f32) {
     let (mut world, e, mut solver) = tangled();
-    solver.settings.conserve_angular_momentum = conserve;
+    solver.settings.safety.conserve_angular_momentum = conserve;
     let mut peak = 0.0f32;
     for _ in 0..120 {
         solver.step(&mut world).unwrap();

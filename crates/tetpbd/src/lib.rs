@@ -83,7 +83,7 @@ pub use error::{
 pub use ordering::ColourClasses;
 pub use solver::hook::{FrameContext, SubstepContext, SubstepHook};
 pub use solver::non_finite::Restored;
-pub use solver::settings::{ParallelSettings, SolverSettings};
+pub use solver::settings::{DiagnosticSettings, ParallelSettings, SafetySettings, SolverSettings};
 pub use solver::sleeping::{is_sleeping, wake, Touching};
 pub use solver::stats::{ErrorAccumulator, ErrorStats, FamilyStats, StepStats};
 pub use solver::step::Solver;

@@ -23,6 +23,6 @@ pub use crate::body::particles::{ExternalAcceleration, Particles};
 pub use crate::body::placement::Placement;
 pub use crate::body::plasticity::{Plasticity, PlasticitySettings};
 pub use crate::error::{BuildError, PlasticityError, SettingsError, StateError, StepError};
-pub use crate::solver::settings::SolverSettings;
+pub use crate::solver::settings::{SafetySettings, SolverSettings};
 pub use crate::solver::stats::StepStats;
 pub use crate::solver::step::Solver;

@@ -165,7 +165,7 @@ fn solver_rejects_bad_settings() {
         SettingsError::BadDamping { .. }
     ));
     assert!(matches!(
-        bad(&|s| s.max_correction_speed = Some(0.0)),
+        bad(&|s| s.safety.max_correction_speed = Some(0.0)),
         SettingsError::BadCorrectionSpeed { .. }
     ));
     assert_eq!(

@@ -54,8 +54,11 @@ fn run_on(families: Families, start: Start, max_frames: usize, split: CellSplit)
         gravity: Vector3::zeros(),
         substeps: 10,
         damping: 1.0,
-        max_correction_speed: Some(10.0),
-        limit_correction_energy: true,
+        safety: tetpbd::SafetySettings {
+            max_correction_speed: Some(10.0),
+            limit_correction_energy: true,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();

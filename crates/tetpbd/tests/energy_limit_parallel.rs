@@ -26,7 +26,10 @@ fn run_free_mirrored(threads: usize) -> Vec<[u32; 3]> {
             common::deform(&mut world, e, common::Deformation::Mirrored);
             let mut solver = Solver::new(SolverSettings {
                 substeps: 3,
-                limit_correction_energy: true,
+                safety: tetpbd::SafetySettings {
+                    limit_correction_energy: true,
+                    ..Default::default()
+                },
                 ..Default::default()
             })
             .unwrap();

@@ -53,7 +53,10 @@ fn check(families: &str, conserve: bool) -> (f32, f32, f32) {
     let mut solver = Solver::new(SolverSettings {
         gravity: Vector3::zeros(),
         substeps: 20,
-        conserve_angular_momentum: conserve,
+        safety: tetpbd::SafetySettings {
+            conserve_angular_momentum: conserve,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();
@@ -133,8 +136,14 @@ fn collapsed_body_stays_finite_and_reexpands() {
     common::deform_with(&mut world, e, |_, _| Vector3::new(0.1, 0.2, 0.3));
     let mut solver = Solver::new(SolverSettings {
         gravity: Vector3::zeros(),
-        measure_error: true,
-        max_correction_speed: Some(1.0),
+        diagnostics: tetpbd::DiagnosticSettings {
+            measure_error: true,
+            ..Default::default()
+        },
+        safety: tetpbd::SafetySettings {
+            max_correction_speed: Some(1.0),
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();
@@ -193,7 +202,10 @@ fn squashed_spinning_drift(families: &str, conserve: bool) -> f32 {
     };
     let mut solver = Solver::new(SolverSettings {
         gravity: Vector3::zeros(),
-        conserve_angular_momentum: conserve,
+        safety: tetpbd::SafetySettings {
+            conserve_angular_momentum: conserve,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();

@@ -59,7 +59,10 @@ fn inverted_and_crushed_material_bodies_recover() {
                 let settings = SolverSettings {
                     gravity: Vector3::zeros(),
                     substeps,
-                    measure_error: true,
+                    diagnostics: tetpbd::DiagnosticSettings {
+                        measure_error: true,
+                        ..Default::default()
+                    },
                     ..Default::default()
                 };
                 let mut solver = Solver::new(settings).unwrap();

@@ -91,7 +91,10 @@ fn tangled(
     let mut solver = Solver::new(SolverSettings {
         substeps,
         gravity: Vector3::zeros(),
-        limit_correction_energy: true,
+        safety: tetpbd::SafetySettings {
+            limit_correction_energy: true,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();
@@ -156,7 +159,10 @@ fn impact(split: CellSplit, speed: f32, substeps: u32) -> Outcome {
     };
     let mut solver = Solver::new(SolverSettings {
         substeps,
-        limit_correction_energy: true,
+        safety: tetpbd::SafetySettings {
+            limit_correction_energy: true,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();
@@ -317,7 +323,10 @@ fn limited_tangled_body_keeps_its_momentum() {
         let ke0 = world.get::<&Particles>(body).unwrap().kinetic_energy();
         let mut solver = Solver::new(SolverSettings {
             gravity: Vector3::zeros(),
-            limit_correction_energy: true,
+            safety: tetpbd::SafetySettings {
+                limit_correction_energy: true,
+                ..Default::default()
+            },
             ..Default::default()
         })
         .unwrap();
@@ -371,7 +380,10 @@ fn squashed_peak(substeps: u32, limit: bool) -> (f32, u64) {
     let mut solver = Solver::new(SolverSettings {
         substeps,
         gravity: Vector3::zeros(),
-        limit_correction_energy: limit,
+        safety: tetpbd::SafetySettings {
+            limit_correction_energy: limit,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();
@@ -453,7 +465,10 @@ fn hanging_hard_cube_is_held_by_its_pins() {
             let body = b.build().unwrap().spawn(&mut world);
             let mut solver = Solver::new(SolverSettings {
                 substeps,
-                limit_correction_energy: true,
+                safety: tetpbd::SafetySettings {
+                    limit_correction_energy: true,
+                    ..Default::default()
+                },
                 ..Default::default()
             })
             .unwrap();

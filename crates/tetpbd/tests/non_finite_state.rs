@@ -19,7 +19,10 @@ fn cube(world: &mut hecs::World, x: f32) -> hecs::Entity {
 fn solver(substeps: u32) -> Solver {
     Solver::new(SolverSettings {
         substeps,
-        measure_error: true,
+        diagnostics: tetpbd::DiagnosticSettings {
+            measure_error: true,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap()

@@ -61,7 +61,10 @@ fn allocations_in_steps(parallel: ParallelSettings, given: bool) -> u64 {
     let parted = common::hanging_cube_parts(&mut world, 16, 4);
     let mut solver = Solver::new(SolverSettings {
         substeps: 4,
-        max_correction_speed: Some(10.0),
+        safety: tetpbd::SafetySettings {
+            max_correction_speed: Some(10.0),
+            ..Default::default()
+        },
         parallel,
         ..Default::default()
     })

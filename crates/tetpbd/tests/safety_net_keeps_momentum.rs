@@ -1,4 +1,4 @@
-//! The correction-speed safety net (`SolverSettings::max_correction_speed`) never changes a
+//! The correction-speed safety net (`SafetySettings::max_correction_speed`) never changes a
 //! free body's linear or angular momentum: what the per-particle clamp removes is given back
 //! as a rigid velocity change of the whole body. Where the net never acts, the result is
 //! bit-identical to running without it.
@@ -56,8 +56,11 @@ fn released(start: Start, net: f32) -> (f64, f64, u64) {
     let e = deformed(&mut world, start);
     let mut solver = Solver::new(SolverSettings {
         gravity: Vector3::zeros(),
-        max_correction_speed: Some(net),
-        limit_correction_energy: false,
+        safety: tetpbd::SafetySettings {
+            max_correction_speed: Some(net),
+            limit_correction_energy: false,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();
@@ -124,7 +127,10 @@ fn gentle(net: Option<f32>) -> (Vec<[u32; 3]>, u64) {
         }
     }
     let mut solver = Solver::new(SolverSettings {
-        max_correction_speed: net,
+        safety: tetpbd::SafetySettings {
+            max_correction_speed: net,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();
@@ -156,8 +162,11 @@ fn collinear_body_stays_finite() {
     });
     let mut solver = Solver::new(SolverSettings {
         gravity: Vector3::zeros(),
-        max_correction_speed: Some(1.0),
-        limit_correction_energy: false,
+        safety: tetpbd::SafetySettings {
+            max_correction_speed: Some(1.0),
+            limit_correction_energy: false,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();

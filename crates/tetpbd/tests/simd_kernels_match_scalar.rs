@@ -22,7 +22,10 @@ fn run(kernel: Kernel, set: &str, deformed: bool, frames: usize) -> (Vec<Vector3
     }
     let mut solver = Solver::new(SolverSettings {
         kernel,
-        measure_error: true,
+        diagnostics: tetpbd::DiagnosticSettings {
+            measure_error: true,
+            ..Default::default()
+        },
         ..Default::default()
     })
     .unwrap();

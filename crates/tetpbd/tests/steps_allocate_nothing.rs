@@ -73,9 +73,14 @@ fn steps_after_the_first_allocate_nothing() {
     world.insert(e, (forces, grab)).unwrap();
     for measure in [false, true] {
         let mut solver = Solver::new(SolverSettings {
-            measure_error: measure,
-            measure_before: measure,
-            max_correction_speed: Some(10.0),
+            diagnostics: tetpbd::DiagnosticSettings {
+                measure_error: measure,
+                measure_before: measure,
+            },
+            safety: tetpbd::SafetySettings {
+                max_correction_speed: Some(10.0),
+                ..Default::default()
+            },
             ..Default::default()
         })
         .unwrap();

@@ -71,7 +71,10 @@ fn hanging_cube_bits(
     let e = common::hanging_cube_parts(&mut world, cells, parts);
     let mut solver = Solver::new(SolverSettings {
         substeps,
-        max_correction_speed: Some(5.0),
+        safety: tetpbd::SafetySettings {
+            max_correction_speed: Some(5.0),
+            ..Default::default()
+        },
         parallel,
         ..Default::default()
     })
@@ -179,8 +182,11 @@ fn run_free_mirrored(threads: usize) -> Vec<[u32; 3]> {
         common::deform(&mut world, e, common::Deformation::Mirrored);
         let mut solver = Solver::new(SolverSettings {
             substeps: 3,
-            max_correction_speed: Some(5.0),
-            limit_correction_energy: false,
+            safety: tetpbd::SafetySettings {
+                max_correction_speed: Some(5.0),
+                limit_correction_energy: false,
+                ..Default::default()
+            },
             ..Default::default()
         })
         .unwrap();

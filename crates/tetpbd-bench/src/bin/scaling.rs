@@ -25,12 +25,12 @@
 //! few hundredths of a core takes time from the 2-thread column.
 //!
 //! `--error` prints, after the measured frames, the constraint error of the 1-thread body
-//! (one more frame with [`tetpbd::SolverSettings::measure_error`]): how well the sweep
+//! (one more frame with [`tetpbd::DiagnosticSettings::measure_error`]): how well the sweep
 //! order converges, e.g. to compare `--parts 1` with a partitioned order.
 //!
 //! `--set` measures one family set only (default both).
 //!
-//! `--no-energy-limit` turns [`tetpbd::SolverSettings::limit_correction_energy`] off (to
+//! `--no-energy-limit` turns [`tetpbd::SafetySettings::limit_correction_energy`] off (to
 //! measure its cost).
 //!
 //! `--parts P` builds the bodies cut into `P` slabs for the sweep order
@@ -103,7 +103,7 @@ struct Args {
     /// Print the constraint error of the 1-thread body after the measured frames.
     #[arg(long)]
     error: bool,
-    /// `SolverSettings::limit_correction_energy` off (to measure its cost).
+    /// `SafetySettings::limit_correction_energy` off (to measure its cost).
     #[arg(long)]
     no_energy_limit: bool,
     /// `ParallelSettings::keep_helpers_awake` on.
@@ -183,7 +183,10 @@ fn body(
             move_helpers_off_step_core: args().move_helpers_off,
             ..Default::default()
         },
-        limit_correction_energy: !args().no_energy_limit,
+        safety: tetpbd::SafetySettings {
+            limit_correction_energy: !args().no_energy_limit,
+            ..Default::default()
+        },
         ..Default::default()
     })?;
     Ok(Body {
@@ -456,7 +459,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
             if a.error {
-                one.solver.settings.measure_error = true;
+                one.solver.settings.diagnostics.measure_error = true;
                 let s = one.solver.step(&mut one.world)?;
                 let f = |e: Option<tetpbd::ErrorStats>| {
                     e.map_or("-".to_string(), |e| {

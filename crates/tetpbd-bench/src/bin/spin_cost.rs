@@ -1,4 +1,4 @@
-//! Cost of [`tetpbd::SolverSettings::conserve_angular_momentum`]: a free cube (no pinned
+//! Cost of [`tetpbd::SafetySettings::conserve_angular_momentum`]: a free cube (no pinned
 //! particle, so the spin removal runs) of about 1k, 10k and 100k tetrahedra, stepped with
 //! the removal on and off in alternating frames (two copies of the body, so a change of the
 //! machine's load hits both alike). Prints median ms per frame of each, their ratio, and the
@@ -67,7 +67,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let solver = Solver::new(SolverSettings {
                 dt: DT,
                 gravity: Vector3::zeros(),
-                conserve_angular_momentum: conserve,
+                safety: tetpbd::SafetySettings {
+                    conserve_angular_momentum: conserve,
+                    ..Default::default()
+                },
                 ..Default::default()
             })?;
             worlds.push((world, solver, Vec::new(), Vec::new()));

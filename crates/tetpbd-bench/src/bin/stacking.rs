@@ -10,7 +10,7 @@
 //!
 //! Prints, per slab, medians over the measured frames (after 60 frames of settling): ms per
 //! coupled frame, ms of it spent in the stacking passes (`CouplingStats::stacking_time`),
-//! and the same frame with the pass off (`stacking_mass_ratio = ∞`, where the box sinks
+//! and the same frame with the pass off (`stacking: None`, where the box sinks
 //! into the slab), plus the box bottom at the end of each run.
 
 use clap::Parser;
@@ -55,7 +55,10 @@ fn run(
     vertex_face: bool,
 ) -> Result<Run, Box<dyn std::error::Error>> {
     let settings = CouplingSettings {
-        stacking_mass_ratio: ratio,
+        stacking: Some(tetpbd_rapier::StackingSettings {
+            mass_ratio: ratio,
+            ..Default::default()
+        }),
         ..CouplingSettings::default()
     };
     let mut s = CoupledWorld::new(SolverSettings::default(), settings)?;
@@ -122,7 +125,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for cells in [[4, 1, 4], [8, 2, 8], [16, 4, 16], [32, 8, 32]] {
         let on = run(
             cells,
-            CouplingSettings::default().stacking_mass_ratio,
+            CouplingSettings::default().stacking_mass_ratio(),
             frames,
             vertex_face,
         )?;

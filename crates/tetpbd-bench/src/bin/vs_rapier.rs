@@ -9,7 +9,7 @@
 //!
 //! `--pile` runs only scene d); `--tetpbd-only` prints tetpbd's rows at every substep count
 //! and runs no rapier (no comparisons); `--self-weight` runs tetpbd with
-//! `CouplingSettings::self_weight_stacking` on.
+//! `StackingSettings::self_weight` on.
 //!
 //! Prints, per engine and scene: median wall ms per frame over the resting phase (cube: from
 //! 2 s on, pile: from 3 s on), the settled max |v| (largest particle speed over the last 30
@@ -79,7 +79,7 @@ struct Args {
     /// tetpbd's rows at every substep count, no rapier.
     #[arg(long)]
     tetpbd_only: bool,
-    /// tetpbd with `CouplingSettings::self_weight_stacking` on.
+    /// tetpbd with `StackingSettings::self_weight` on.
     #[arg(long)]
     self_weight: bool,
 }

@@ -18,7 +18,7 @@
 //! * the lighter side's body touches an immovable support in this substep (the coupling
 //!   reports it: a fixed or kinematic collider, or a supported rigid body; the heavier
 //!   body may rest on the support beside it too),
-//! * the heavier side is at least [`crate::CouplingSettings::stacking_mass_ratio`] times
+//! * the heavier side is at least [`crate::StackingSettings::mass_ratio`] times
 //!   heavier (the particle's mass against the triangle's mean particle mass), and
 //! * the contact normal, taken from the lighter to the heavier side, points within 60° of
 //!   up (against gravity): the lighter body carries the heavier one's weight.

@@ -15,7 +15,7 @@
 //! cargo run --release -p tetpbd-stability --bin stability -- --coupled "1000 kg on soft"
 //! ```
 //!
-//! `--no-energy-limit` turns `SolverSettings::limit_correction_energy` off in every
+//! `--no-energy-limit` turns `SafetySettings::limit_correction_energy` off in every
 //! uncoupled scene and `--net-everywhere` runs the sweeps under the safety net too (to compare
 //! the options; pass `--out` so the comparison does not overwrite `docs/stability.md`).
 //!
@@ -109,7 +109,7 @@ struct Args {
     /// Skip the long cases.
     #[arg(long)]
     fast: bool,
-    /// `SolverSettings::limit_correction_energy` off in every uncoupled scene.
+    /// `SafetySettings::limit_correction_energy` off in every uncoupled scene.
     #[arg(long)]
     no_energy_limit: bool,
     /// Run the sweeps over grid splits and substep counts under the safety net too.
@@ -214,7 +214,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .filter(|c| (!fast || c.kind == CaseKind::Fast) && wanted(&c.name))
             .filter(|c| net.is_none() || !c.sweep || net_everywhere)
             .map(|mut c| {
-                c.scene.settings.limit_correction_energy &= !no_limit;
+                c.scene.settings.safety.limit_correction_energy &= !no_limit;
                 c
             })
             .collect();

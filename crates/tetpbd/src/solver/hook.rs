@@ -174,7 +174,7 @@ pub trait SubstepHook {
     /// or [`SubstepHook::end_substep`] change their velocities (default `true`). For a hook
     /// that does, the solver measures the kinetic energy its impulses hand the constraint
     /// families (external work in the budget of
-    /// [`crate::SolverSettings::limit_correction_energy`]): one copy of the positions or
+    /// [`crate::SafetySettings::limit_correction_energy`]): one copy of the positions or
     /// velocities and one pass over them per call. A hook that never moves a particle may return `false`
     /// to skip that.
     fn moves_particles(&self) -> bool {

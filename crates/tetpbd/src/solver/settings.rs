@@ -1,5 +1,6 @@
-//! Settings of the solver: time step, substeps, iterations, gravity, damping, family order
-//! and the safety options, with their units and defaults.
+//! Settings of the solver: time step, substeps, iterations, gravity, damping, family order,
+//! and the groups of safety mechanisms, diagnostics and threads, with their units and
+//! defaults.
 
 use nalgebra::Vector3;
 
@@ -35,6 +36,32 @@ pub struct SolverSettings {
     /// The order in which the families are projected in an iteration. Default: volume,
     /// vertex–face, edge — edges last, so lengths are closest to rest at the end.
     pub order: [Family; 3],
+    /// The safety mechanisms that keep a body calm when its constraints cannot all be met
+    /// (tangled or crushed states, impacts). The defaults are what the README's claims and
+    /// the stability matrix measure; change them only to reproduce a measurement.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub safety: SafetySettings,
+    /// Scalar or SIMD projection kernels (default SIMD; they agree to rounding).
+    pub kernel: systems::Kernel,
+    /// What a step measures beyond what it needs (off by default: each costs about a
+    /// sweep).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub diagnostics: DiagnosticSettings,
+    /// How the parallel passes use threads (feature `parallel`; ignored without it). The
+    /// pool they run on is not a setting but a handle: [`Solver::set_thread_pool`](crate::Solver).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub parallel: ParallelSettings,
+}
+
+/// The solver's safety mechanisms (a group of [`SolverSettings`]): what keeps a body calm and
+/// its energy bounded when its constraints cannot all be met. Theory in the
+/// `stabilisation` module docs; the decisions and their measurements in
+/// `docs/decisions/correction-energy.md`, `angular-momentum-removal.md` and
+/// `correction-speed-net-opt-in.md`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+pub struct SafetySettings {
     /// Safety net: the velocity a substep's projections add to a particle is clamped to this
     /// length, m/s (positions keep their full correction). `None` = no clamp. On a body
     /// without pinned particles, the linear and angular momentum the clamps removed are
@@ -69,17 +96,28 @@ pub struct SolverSettings {
     /// hook call that moves them ([`crate::SubstepHook::moves_particles`]). Theory in
     /// `stabilisation::correction_energy` and `stabilisation::hook_work`.
     pub limit_correction_energy: bool,
-    /// Scalar or SIMD projection kernels (default SIMD; they agree to rounding).
-    pub kernel: systems::Kernel,
+}
+
+impl Default for SafetySettings {
+    fn default() -> Self {
+        SafetySettings {
+            max_correction_speed: None,
+            conserve_angular_momentum: true,
+            limit_correction_energy: true,
+        }
+    }
+}
+
+/// What a step measures for the caller (a group of [`SolverSettings`]; all off by default).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+pub struct DiagnosticSettings {
     /// Evaluate every constraint after the step to fill [`crate::FamilyStats::after`] and
     /// [`crate::StepStats::inverted`]. Costs about one extra sweep; off by default.
     pub measure_error: bool,
     /// Also evaluate every constraint before the step ([`crate::FamilyStats::before`]).
     pub measure_before: bool,
-    /// How the parallel passes use threads (feature `parallel`; ignored without it). The
-    /// pool they run on is not a setting but a handle: [`Solver::set_thread_pool`](crate::Solver).
-    #[cfg_attr(feature = "serde", serde(default))]
-    pub parallel: ParallelSettings,
 }
 
 /// How a step uses threads (feature `parallel`; without it every step is serial and these
@@ -130,12 +168,9 @@ impl Default for SolverSettings {
             gravity: Vector3::new(0.0, -9.81, 0.0),
             damping: 0.0,
             order: Family::ALL,
-            max_correction_speed: None,
-            conserve_angular_momentum: true,
-            limit_correction_energy: true,
+            safety: SafetySettings::default(),
             kernel: systems::Kernel::Simd,
-            measure_error: false,
-            measure_before: false,
+            diagnostics: DiagnosticSettings::default(),
             parallel: ParallelSettings::default(),
         }
     }
@@ -161,7 +196,7 @@ impl SolverSettings {
                 value: self.damping,
             });
         }
-        if let Some(v) = self.max_correction_speed {
+        if let Some(v) = self.safety.max_correction_speed {
             if !(v.is_finite() && v > 0.0) {
                 return Err(SettingsError::BadCorrectionSpeed { value: v });
             }

@@ -53,10 +53,10 @@ pub struct FamilyStats {
     /// Projections skipped (or given the documented fallback direction) because the
     /// configuration was degenerate.
     pub degenerate: u64,
-    /// `|C|` at the end of the step (when [`crate::SolverSettings::measure_error`] is on).
+    /// `|C|` at the end of the step (when [`crate::DiagnosticSettings::measure_error`] is on).
     pub after: Option<ErrorStats>,
     /// `|C|` at the start of the step, before prediction (when
-    /// [`crate::SolverSettings::measure_before`] is on).
+    /// [`crate::DiagnosticSettings::measure_before`] is on).
     pub before: Option<ErrorStats>,
     /// Wall time spent in the family's system.
     pub time: Duration,
@@ -101,20 +101,20 @@ pub struct StepStats {
     /// [`crate::StepError::NonFiniteState`].
     pub non_finite_restored: u64,
     /// Particle velocity updates clamped by
-    /// [`crate::SolverSettings::max_correction_speed`] (summed over substeps; the momentum
+    /// [`crate::SafetySettings::max_correction_speed`] (summed over substeps; the momentum
     /// restoration that follows a body's clamps is not counted separately).
     pub velocity_clamps: u64,
     /// Body iterations in which the families' corrections would have added more kinetic
     /// energy than their compliant constraints released, and were limited
-    /// ([`crate::SolverSettings::limit_correction_energy`]).
+    /// ([`crate::SafetySettings::limit_correction_energy`]).
     pub energy_limited: u64,
     /// Time in prediction (gravity, damping, integration).
     pub predict_time: Duration,
     /// Time in the velocity update.
     pub velocity_time: Duration,
     /// Time removing the rigid rotation of the families' corrections
-    /// ([`crate::SolverSettings::conserve_angular_momentum`]) and limiting their energy
-    /// ([`crate::SolverSettings::limit_correction_energy`]), including the copy back from
+    /// ([`crate::SafetySettings::conserve_angular_momentum`]) and limiting their energy
+    /// ([`crate::SafetySettings::limit_correction_energy`]), including the copy back from
     /// the working copy that it takes over (then not in [`StepStats::copy_time`]).
     pub spin_time: Duration,
     /// Time copying the particles into the projections' working copy and back, once per

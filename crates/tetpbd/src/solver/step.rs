@@ -224,7 +224,7 @@ impl Solver {
         sleep.touching.clear();
         stats.bodies_woken = sleeping::wake_written(world, &mut sleep.entities);
         count_constraints(world, &mut stats);
-        if s.measure_before {
+        if s.diagnostics.measure_before {
             let m = systems::measure(world);
             stats.edge.before = Some(m.edge);
             stats.vertex_face.before = Some(m.vertex_face);
@@ -251,7 +251,7 @@ impl Solver {
         let slept = sleeping::fall_asleep(world, frame.dt(), &sleep.touching, &mut sleep.islands);
         stats.bodies_fell_asleep = slept.fell_asleep;
         stats.bodies_asleep_after = slept.asleep;
-        if s.measure_error {
+        if s.diagnostics.measure_error {
             let t = Instant::now();
             let m = systems::measure(world);
             stats.edge.after = Some(m.edge);
@@ -299,7 +299,8 @@ impl Solver {
             .into_iter()
             .next()
             .is_some();
-        let measure = (s.limit_correction_energy && (grabs || hook.moves_particles())).then_some(h);
+        let measure =
+            (s.safety.limit_correction_energy && (grabs || hook.moves_particles())).then_some(h);
         let t = Instant::now();
         measured(world, measure, Changed::Positions, |w| {
             hook.begin_substep(w, frame.substep(index, 0))
@@ -316,7 +317,7 @@ impl Solver {
             *hook_time += t.elapsed();
         }
         let t = Instant::now();
-        let u = systems::update_velocities(world, h, s.max_correction_speed);
+        let u = systems::update_velocities(world, h, s.safety.max_correction_speed);
         stats.non_finite_resets += u.non_finite_resets;
         stats.velocity_clamps += u.clamped;
         deformation_damping::damp_deformation(world, h);
@@ -356,8 +357,11 @@ impl Solver {
             f.degenerate += c.degenerate;
         }
         let t = Instant::now();
-        if s.conserve_angular_momentum || s.limit_correction_energy {
-            let (spin, limit) = (s.conserve_angular_momentum, s.limit_correction_energy);
+        if s.safety.conserve_angular_momentum || s.safety.limit_correction_energy {
+            let (spin, limit) = (
+                s.safety.conserve_angular_momentum,
+                s.safety.limit_correction_energy,
+            );
             stats.energy_limited += correction_energy::store_bodies(world, h, spin, limit);
             stats.spin_time += t.elapsed();
         } else {

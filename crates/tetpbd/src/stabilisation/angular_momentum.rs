@@ -1,5 +1,5 @@
 //! Removing the spin Gauss–Seidel creates
-//! ([`crate::SolverSettings::conserve_angular_momentum`]).
+//! ([`crate::SafetySettings::conserve_angular_momentum`]).
 //!
 //! A body's internal constraints exert no net force and no net torque. Each projection's
 //! correction `Δᵢ = wᵢ∇ᵢC Δλ` is free of both *about the positions it was computed at*

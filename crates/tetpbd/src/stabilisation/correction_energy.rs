@@ -1,5 +1,5 @@
 //! Keeping the families' corrections from adding kinetic energy
-//! ([`crate::SolverSettings::limit_correction_energy`]).
+//! ([`crate::SafetySettings::limit_correction_energy`]).
 //!
 //! A substep turns every position correction into velocity, `vᵢ = (xᵢ − x̄ᵢ)/h`. For a
 //! violation the substep's own motion created, that is the constraint's reaction and it only

@@ -2,13 +2,13 @@
 //!
 //! * [`angular_momentum`] — removing the rigid rotation the projections' corrections carry,
 //!   so a free body's internal constraints conserve its angular momentum
-//!   ([`crate::SolverSettings::conserve_angular_momentum`], on by default);
+//!   ([`crate::SafetySettings::conserve_angular_momentum`], on by default);
 //! * [`correction_energy`] — keeping the families' corrections from adding more kinetic
 //!   energy than their compliant constraints release
-//!   ([`crate::SolverSettings::limit_correction_energy`], on by default), counting what a
+//!   ([`crate::SafetySettings::limit_correction_energy`], on by default), counting what a
 //!   hook's position corrections hand them as external work ([`hook_work`]);
 //! * [`momentum_restoration`] — giving back, as a rigid velocity change, the momentum the
-//!   correction-speed safety net ([`crate::SolverSettings::max_correction_speed`]) clamped;
+//!   correction-speed safety net ([`crate::SafetySettings::max_correction_speed`]) clamped;
 //! * [`ground_up`] — one more sweep ordered from a body's supports outwards, for heavy loads
 //!   on light bodies (its level order in [`ground_up_levels`]), offered as one call by
 //!   [`ground_up_sweep`] ([`crate::GroundUpSweep`]) to a hook such as a coupling's;

@@ -1,5 +1,5 @@
 //! The momentum restoration of the correction-speed safety net
-//! ([`crate::SolverSettings::max_correction_speed`]).
+//! ([`crate::SafetySettings::max_correction_speed`]).
 //!
 //! The per-particle clamp of [`crate::solver::systems::update_velocities`] removes a velocity
 //! `δvᵢ = v_clampedᵢ − v_unclampedᵢ` from each clamped particle, and with it the linear
@@ -19,7 +19,7 @@
 //! angular momentum.
 //!
 //! Limit: giving the angular part back assumes the projections create no spin of their own
-//! ([`crate::SolverSettings::conserve_angular_momentum`], on by default). With that switched
+//! ([`crate::SafetySettings::conserve_angular_momentum`], on by default). With that switched
 //! off, a snap-back violent enough to be clamped spins the body up through the projections
 //! themselves, what the clamp removes is mostly that spurious spin, and giving it back makes
 //! recovery from tangled states worse.

@@ -293,7 +293,7 @@ impl Sim for Ours {
         let (solver, world) = (&mut self.solver, &mut self.world);
         let mut stats = StepStats::default();
         let (ms, cpu_ms) = timed(|| stats = solver.step(world).expect("settings validated"));
-        // The same evaluation `SolverSettings::measure_error` runs, outside the timed step.
+        // The same evaluation `DiagnosticSettings::measure_error` runs, outside the timed step.
         self.measured = systems::measure(&mut self.world);
         self.last = stats;
         let s = &self.last;
