@@ -57,9 +57,10 @@ fn split_label(split: CellSplit) -> &'static str {
     }
 }
 
-/// A 0.5 m cube of 4³ cells, its bottom 5 cm above the ground, thrown down at `speed`
-/// (m/s), gravity on, 2 s.
-fn impact(split: CellSplit, speed: f32, substeps: u32) -> Scene {
+/// The impact rows' scene: a 0.5 m cube of 4³ cells (grid `split`), its bottom 5 cm above
+/// immovable ground ([`crate::Ground`]), thrown down at `speed` (m/s), gravity on, default
+/// settings with `substeps` substeps, 2 s.
+pub fn impact(split: CellSplit, speed: f32, substeps: u32) -> Scene {
     let mut mesh = box_grid(Vector3::repeat(0.5), [4; 3], split).unwrap_or_default();
     for v in &mut mesh.vertices {
         v.y += 0.3;
@@ -125,7 +126,7 @@ fn single_tet(apex_height: f32) -> TetMesh {
 }
 
 /// Every case, in report order. `safety_net` sets
-/// [`tetpbd::SafetySettings::max_correction_speed`] on every scene.
+/// [`tetpbd::SolverSettings::max_correction_speed`] on every scene.
 pub fn all_cases(safety_net: Option<f32>) -> Vec<Case> {
     let mut cases = Vec::new();
     let mut add_case = |group, name: String, description, kind, sweep, mut scene: Scene| {

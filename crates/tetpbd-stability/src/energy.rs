@@ -94,3 +94,29 @@ pub fn motion(world: &World, e: Entity, g: Vector3<f32>) -> f64 {
         .sum();
     kinetic + potential
 }
+
+/// Kinetic energy of body `e`'s motion relative to its best-fit rigid motion
+/// ([`Particles::rigid_fit`]: centre-of-mass translation plus rotation), J: its internal,
+/// vibrational kinetic energy `Σ ½ mᵢ |vᵢ − v_c − ω × (xᵢ − c)|²` over the free particles.
+/// A body flying or rolling as a whole has none; one that jiggles, spins itself apart or is
+/// crushed keeps it. The whole kinetic energy if the fit is not defined.
+pub fn internal_kinetic(p: &Particles) -> f64 {
+    let Some(fit) = p.rigid_fit() else {
+        return f64::from(p.kinetic_energy());
+    };
+    let (c, vc, omega) = (
+        fit.centre.cast::<f64>(),
+        fit.velocity.cast::<f64>(),
+        fit.angular_velocity.cast::<f64>(),
+    );
+    p.positions()
+        .iter()
+        .zip(p.velocities())
+        .zip(p.masses().iter().zip(p.inv_masses()))
+        .filter(|(_, (_, &inv_mass))| inv_mass > 0.0)
+        .map(|((x, v), (&m, _))| {
+            let rigid = vc + omega.cross(&(x.cast::<f64>() - c));
+            0.5 * f64::from(m) * (v.cast::<f64>() - rigid).norm_squared()
+        })
+        .sum()
+}

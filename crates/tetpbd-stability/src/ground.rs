@@ -6,11 +6,25 @@
 //! Müller et al. 2020, with restitution 0). It only ever removes energy. The coupled table
 //! runs rapier colliders through `tetpbd-rapier`; this plane keeps the impact rows
 //! independent of the coupling so every constraint configuration is measured the same way.
+//!
+//! It also records the largest internal kinetic energy of a body at the end of any substep
+//! ([`crate::energy::internal_kinetic`]): an impact's vibration lasts a few substeps, well
+//! inside the frame it happens in, where a frame-by-frame sample would miss it.
 
 use tetpbd::{hecs, Particles, SubstepHook};
 
 /// The plane y = 0 (see the module docs).
-pub struct Ground;
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Ground {
+    peak_internal: f64,
+}
+
+impl Ground {
+    /// The largest internal kinetic energy of a body at the end of a substep so far, J.
+    pub fn peak_internal(&self) -> f64 {
+        self.peak_internal
+    }
+}
 
 impl SubstepHook for Ground {
     fn project(&mut self, world: &mut hecs::World, _substep: tetpbd::SubstepContext) {
@@ -28,6 +42,8 @@ impl SubstepHook for Ground {
                     p.velocities_mut()[i].y = 0.0;
                 }
             }
+            let internal = crate::energy::internal_kinetic(p);
+            self.peak_internal = self.peak_internal.max(internal);
         }
     }
 }

@@ -18,7 +18,7 @@ mod ground;
 mod report;
 mod run;
 
-pub use cases::{all_cases, Case, CaseKind, SWEEP_SUBSTEPS};
+pub use cases::{all_cases, impact, Case, CaseKind, SWEEP_SUBSTEPS};
 pub use config::{Config, ConstraintSet};
 pub use coupled::{coupled_cases, CoupledCase, CoupledOutcome};
 pub use coupled_rapier::rapier_comparison;
