@@ -32,6 +32,8 @@ pub(crate) struct MaterialStep {
     pub alpha_tilde_volume: [f32; 2],
     /// `γ = 1 + μ/λ'`.
     pub rest_offset: f32,
+    /// The collapse threshold `τ` ([`constraints::neo_hookean_collapse_threshold`]).
+    pub collapse: f32,
     /// `β/h`, the XPBD damping factor.
     pub damping: f32,
     /// `h²`, s².
@@ -47,6 +49,7 @@ impl MaterialStep {
         MaterialStep {
             alpha_tilde_volume: [1.0 / (mu * h2), 1.0 / (lp * h2)],
             rest_offset: constraints::neo_hookean_rest_offset(mu, lp),
+            collapse: constraints::neo_hookean_collapse_threshold(mu, lp),
             damping: material.damping() / h,
             h2,
         }
@@ -81,10 +84,14 @@ pub(crate) fn project_tet<A: ParticleAccess>(
         return TetOutcome::Skipped;
     }
     let p = xw.map(|(x, _)| x);
-    let Some(d) = constraints::neo_hookean_deviatoric(&p, dm_inv) else {
-        return TetOutcome::Degenerate;
-    };
-    let y = constraints::neo_hookean_hydrostatic(&p, dm_inv, k.rest_offset);
+    // All four points at one place: `C_D = 0` with no direction, and no force either
+    // (`C_D ∇C_D = F Dm⁻ᵀ` vanishes); the hydrostatic constraint's recovery direction
+    // moves the points apart.
+    let d = constraints::neo_hookean_deviatoric(&p, dm_inv).unwrap_or(Evaluated {
+        c: 0.0,
+        grad: [Vector3::zeros(); 4],
+    });
+    let y = constraints::neo_hookean_hydrostatic_recovering(&p, dm_inv, k.rest_offset, k.collapse);
     let v0 = rest_volume.abs();
     let at = k.alpha_tilde_volume.map(|a| a / v0);
     let rate = if k.damping > 0.0 {

@@ -155,11 +155,14 @@ pub(crate) fn tets<L: Lane, A: ParticleAccess>(
     let f = times(e, &m);
     let c_d = ddot(&f, &f).vsqrt();
     let tiny = L::splat(f32::EPSILON * f32::EPSILON);
-    let ok = c_d.vgt(tiny);
+    let cof_f = cofactor(&f);
+    // A lane collapsed towards a point or a line (the recovery direction's region,
+    // `‖cof F‖²_F < 3τ²`) or with all points at one place goes to the scalar kernel.
+    let weak = L::splat(3.0 * k.collapse * k.collapse);
+    let ok = c_d.vgt(tiny) & ddot(&cof_f, &cof_f).vge(weak);
     if free.vbits() & !ok.vbits() != 0 {
         return elsewhere::<L, A>(bd, at, prev, run, k);
     }
-    let cof_f = cofactor(&f);
     let c_h = f[0].dot(cof_f[0]) - L::splat(k.rest_offset);
     let inv_c = ok.vsel(L::ONE / c_d, L::ZERO);
     let g_d = gradients(
