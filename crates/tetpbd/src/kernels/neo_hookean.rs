@@ -8,7 +8,9 @@
 //! ([`constraints::neo_hookean_update`]), the move bounded to `√3/‖Dm⁻¹‖_F` (about one
 //! rest edge) so that a tetrahedron far from rest (inverted, crushed) recovers over a few
 //! projections instead of overshooting, and the elastic energy released since the substep
-//! start, for the energy limit.
+//! start, for the energy limit. A tetrahedron crushed towards a point or a line is projected
+//! along the hydrostatic constraint's recovery direction
+//! ([`constraints::neo_hookean_hydrostatic_recovering`]) and counted as degenerate.
 
 use nalgebra::{Matrix3, Vector3};
 use wide::f32x4;
@@ -56,9 +58,12 @@ impl MaterialStep {
     }
 }
 
-/// What one projection did: applied (with the energy it released, J) or degenerate.
+/// What one projection did: applied (with the energy it released, J), applied along the
+/// recovery direction of a collapsed tetrahedron (likewise; counted as degenerate), or
+/// degenerate (nothing done).
 pub(crate) enum TetOutcome {
     Applied(f32),
+    Recovered(f32),
     Degenerate,
     Skipped,
 }
@@ -128,7 +133,12 @@ pub(crate) fn project_tet<A: ParticleAccess>(
     let df_back = ds(&back) * dm_inv;
     let to_start = energy_change(&f, &df_back, y.c, at, k.h2);
     let projected = energy_change(&f, &(ds(&dx) * dm_inv), y.c, at, k.h2);
-    TetOutcome::Applied(to_start - projected)
+    let released = to_start - projected;
+    if constraints::recovery_weight(&constraints::cofactor(&f), k.collapse) > 0.0 {
+        TetOutcome::Recovered(released)
+    } else {
+        TetOutcome::Applied(released)
+    }
 }
 
 /// `U(F + dF) − U(F)` (J) of one tetrahedron's constraints, `U = C_D²/(2α_D) + C_H²/(2α_H)`,
