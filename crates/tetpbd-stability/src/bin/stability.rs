@@ -20,8 +20,9 @@
 //! the options; pass `--out` so the comparison does not overwrite `docs/stability.md`).
 //!
 //! `--case TEXT` keeps only the cases whose name contains `TEXT` (repeatable; coupled cases
-//! included), `--no-coupled` skips the coupled table. Pass `--out` with a filter so the partial
-//! matrix does not overwrite `docs/stability.md`.
+//! included), `--no-coupled` skips the coupled table. `--config TEXT` keeps only the
+//! columns whose label contains `TEXT` (repeatable; e.g. `--config material`). Pass `--out`
+//! with a filter so the partial matrix does not overwrite `docs/stability.md`.
 
 use std::fmt::Write as _;
 use std::process::Command;
@@ -121,6 +122,9 @@ struct Args {
     /// Only the cases whose name contains this text (repeatable).
     #[arg(long = "case", value_name = "TEXT")]
     cases: Vec<String>,
+    /// Only the configurations (columns) whose label contains this text (repeatable).
+    #[arg(long = "config", value_name = "TEXT")]
+    configs: Vec<String>,
     /// Run only the coupled cases whose name contains TEXT ("" for all) and print them,
     /// without writing the report.
     #[arg(long, value_name = "TEXT", num_args = 0..=1, default_missing_value = "")]
@@ -136,11 +140,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         net_everywhere,
         no_coupled,
         cases: filters,
+        configs: column_filters,
         coupled,
     } = args;
     let wanted =
         |name: &str| filters.is_empty() || filters.iter().any(|f| name.contains(f.as_str()));
-    let configs = Config::all();
+    let configs: Vec<Config> = Config::all()
+        .into_iter()
+        .filter(|c| {
+            column_filters.is_empty()
+                || column_filters
+                    .iter()
+                    .any(|f| c.label().contains(f.as_str()))
+        })
+        .collect();
     if let Some(filter) = coupled {
         coupled_only(&filter, &Config::families());
         return Ok(());

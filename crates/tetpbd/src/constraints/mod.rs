@@ -31,7 +31,9 @@
 //! * [`volume()`] — signed volume (`volume.rs`);
 //! * [`neo_hookean_deviatoric`] and [`neo_hookean_hydrostatic`] — the stable Neo-Hookean
 //!   material's two constraints per tetrahedron, solved together by
-//!   [`neo_hookean_update`] (`neo_hookean.rs`);
+//!   [`neo_hookean_update`] (`neo_hookean.rs`), and
+//!   [`neo_hookean_hydrostatic_recovering`], the hydrostatic one with the recovery direction
+//!   of a collapsed tetrahedron that the solver runs (`neo_hookean_recovery.rs`);
 //! * [`grab()`] — a material point held to a target with a bounded force (`grab.rs`);
 //! * [`xpbd_delta_lambda`], [`bounded_step`] and [`apply()`] — the XPBD update (`xpbd.rs`).
 
@@ -40,6 +42,7 @@ use nalgebra::{RealField, Vector3};
 mod edge;
 mod grab;
 mod neo_hookean;
+mod neo_hookean_recovery;
 mod vertex_face;
 mod vertex_face_bounded;
 mod volume;
@@ -51,6 +54,9 @@ pub use neo_hookean::{
     cofactor, deformation_gradient, neo_hookean_deviatoric, neo_hookean_energy_density,
     neo_hookean_hydrostatic, neo_hookean_rest_offset, neo_hookean_stress, neo_hookean_update,
     rest_shape_inverse, NeoHookeanUpdate,
+};
+pub use neo_hookean_recovery::{
+    neo_hookean_collapse_threshold, neo_hookean_hydrostatic_recovering, recovery_weight,
 };
 pub use vertex_face::{
     signed_height, vertex_face, vertex_face_step_bound, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER,

@@ -69,7 +69,7 @@ pub fn cofactor<T: RealField + Copy>(f: &Matrix3<T>) -> Matrix3<T> {
 /// The particle gradients of a constraint from `∂C/∂F`: `∇xᵢ C` = column `i − 1` of
 /// `(∂C/∂F) Dm⁻ᵀ`, `∇x0 C = −(∇x1 C + ∇x2 C + ∇x3 C)`.
 #[inline]
-fn particle_gradients<T: RealField + Copy>(
+pub(super) fn particle_gradients<T: RealField + Copy>(
     dc_df: &Matrix3<T>,
     dm_inv: &Matrix3<T>,
 ) -> [Vector3<T>; 4] {

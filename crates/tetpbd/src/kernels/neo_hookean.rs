@@ -8,7 +8,9 @@
 //! ([`constraints::neo_hookean_update`]), the move bounded to `√3/‖Dm⁻¹‖_F` (about one
 //! rest edge) so that a tetrahedron far from rest (inverted, crushed) recovers over a few
 //! projections instead of overshooting, and the elastic energy released since the substep
-//! start, for the energy limit.
+//! start, for the energy limit. A tetrahedron crushed towards a point or a line is projected
+//! along the hydrostatic constraint's recovery direction
+//! ([`constraints::neo_hookean_hydrostatic_recovering`]) and counted as degenerate.
 
 use nalgebra::{Matrix3, Vector3};
 use wide::f32x4;
@@ -32,6 +34,8 @@ pub(crate) struct MaterialStep {
     pub alpha_tilde_volume: [f32; 2],
     /// `γ = 1 + μ/λ'`.
     pub rest_offset: f32,
+    /// The collapse threshold `τ` ([`constraints::neo_hookean_collapse_threshold`]).
+    pub collapse: f32,
     /// `β/h`, the XPBD damping factor.
     pub damping: f32,
     /// `h²`, s².
@@ -47,15 +51,19 @@ impl MaterialStep {
         MaterialStep {
             alpha_tilde_volume: [1.0 / (mu * h2), 1.0 / (lp * h2)],
             rest_offset: constraints::neo_hookean_rest_offset(mu, lp),
+            collapse: constraints::neo_hookean_collapse_threshold(mu, lp),
             damping: material.damping() / h,
             h2,
         }
     }
 }
 
-/// What one projection did: applied (with the energy it released, J) or degenerate.
+/// What one projection did: applied (with the energy it released, J), applied along the
+/// recovery direction of a collapsed tetrahedron (likewise; counted as degenerate), or
+/// degenerate (nothing done).
 pub(crate) enum TetOutcome {
     Applied(f32),
+    Recovered(f32),
     Degenerate,
     Skipped,
 }
@@ -81,10 +89,14 @@ pub(crate) fn project_tet<A: ParticleAccess>(
         return TetOutcome::Skipped;
     }
     let p = xw.map(|(x, _)| x);
-    let Some(d) = constraints::neo_hookean_deviatoric(&p, dm_inv) else {
-        return TetOutcome::Degenerate;
-    };
-    let y = constraints::neo_hookean_hydrostatic(&p, dm_inv, k.rest_offset);
+    // All four points at one place: `C_D = 0` with no direction, and no force either
+    // (`C_D ∇C_D = F Dm⁻ᵀ` vanishes); the hydrostatic constraint's recovery direction
+    // moves the points apart.
+    let d = constraints::neo_hookean_deviatoric(&p, dm_inv).unwrap_or(Evaluated {
+        c: 0.0,
+        grad: [Vector3::zeros(); 4],
+    });
+    let y = constraints::neo_hookean_hydrostatic_recovering(&p, dm_inv, k.rest_offset, k.collapse);
     let v0 = rest_volume.abs();
     let at = k.alpha_tilde_volume.map(|a| a / v0);
     let rate = if k.damping > 0.0 {
@@ -121,7 +133,12 @@ pub(crate) fn project_tet<A: ParticleAccess>(
     let df_back = ds(&back) * dm_inv;
     let to_start = energy_change(&f, &df_back, y.c, at, k.h2);
     let projected = energy_change(&f, &(ds(&dx) * dm_inv), y.c, at, k.h2);
-    TetOutcome::Applied(to_start - projected)
+    let released = to_start - projected;
+    if constraints::recovery_weight(&constraints::cofactor(&f), k.collapse) > 0.0 {
+        TetOutcome::Recovered(released)
+    } else {
+        TetOutcome::Applied(released)
+    }
 }
 
 /// `U(F + dF) − U(F)` (J) of one tetrahedron's constraints, `U = C_D²/(2α_D) + C_H²/(2α_H)`,

@@ -155,11 +155,14 @@ pub(crate) fn tets<L: Lane, A: ParticleAccess>(
     let f = times(e, &m);
     let c_d = ddot(&f, &f).vsqrt();
     let tiny = L::splat(f32::EPSILON * f32::EPSILON);
-    let ok = c_d.vgt(tiny);
+    let cof_f = cofactor(&f);
+    // A lane collapsed towards a point or a line (the recovery direction's region,
+    // `‖cof F‖²_F < 3τ²`) or with all points at one place goes to the scalar kernel.
+    let weak = L::splat(3.0 * k.collapse * k.collapse);
+    let ok = c_d.vgt(tiny) & ddot(&cof_f, &cof_f).vge(weak);
     if free.vbits() & !ok.vbits() != 0 {
         return elsewhere::<L, A>(bd, at, prev, run, k);
     }
-    let cof_f = cofactor(&f);
     let c_h = f[0].dot(cof_f[0]) - L::splat(k.rest_offset);
     let inv_c = ok.vsel(L::ONE / c_d, L::ZERO);
     let g_d = gradients(
@@ -345,6 +348,10 @@ pub(crate) fn one(released: &mut f32, o: TetOutcome) -> ProjectionCount {
             c.applied = 1;
             *released = e;
         }
+        TetOutcome::Recovered(e) => {
+            c.degenerate = 1;
+            *released = e;
+        }
         TetOutcome::Degenerate => c.degenerate = 1,
         TetOutcome::Skipped => {}
     }
@@ -367,7 +374,7 @@ mod tests {
     /// with all four pinned: skipped lanes), the rest sheared and squashed from
     /// its rest shape (kept as the substep start), and every 23rd particle pushed through
     /// the body by 1.5 cells (inverted tetrahedra, the move bound), and one tetrahedron collapsed
-    /// to a point (the scalar fallback).
+    /// to a point (the scalar kernel's recovery direction, counted as degenerate).
     fn deformed() -> (SoftBody, Vec<Vector3<f32>>) {
         let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [5; 3], CellSplit::Six).unwrap();
         let high = mesh.vertices.iter().fold(f32::MIN, |m, x| m.max(x.y)) - 0.3;
@@ -389,8 +396,8 @@ mod tests {
                 x.y -= 0.3;
             }
         }
-        // One free tetrahedron of the first class collapsed to a point: degenerate in the
-        // first sweep, its chunk on the scalar kernel.
+        // One free tetrahedron of the first class collapsed to a point: projected along the
+        // recovery direction (counted as degenerate), its chunk on the scalar kernel.
         let p = &mut body.particles;
         let free = |t: &&[u32; 4]| t.iter().all(|&i| p.inv_masses[i as usize] > 0.0);
         let t = body.tetrahedra.indices.iter().find(free).unwrap();

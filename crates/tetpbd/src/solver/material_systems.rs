@@ -22,7 +22,8 @@ pub fn project_neo_hookean(world: &mut World, h: f32) -> ProjectionCount {
 /// One Gauss–Seidel sweep over every awake body's [`NeoHookeanMaterial`], tetrahedra in
 /// solver (colour) order: the two constraints of each tetrahedron projected together
 /// ([`crate::constraints::neo_hookean_update`]), with the material's damping. A tetrahedron
-/// collapsed to a point (no deviatoric direction) is skipped and counted as degenerate.
+/// collapsed towards a point or a line is moved apart along the hydrostatic constraint's
+/// recovery direction ([`crate::constraints::neo_hookean_hydrostatic_recovering`]).
 ///
 /// [`Kernel::Simd`] projects four or eight tetrahedra of a colour class at once and agrees
 /// with [`Kernel::Scalar`] to rounding. With the `parallel` feature, the tetrahedra of one

@@ -206,7 +206,7 @@ pub(crate) fn elastic_release(
 /// is set. Returns the number of bodies the limit acted on.
 pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: bool) -> u64 {
     let mut limited = 0;
-    for (p, e, t, vf, vol, m) in world
+    for (p, e, t, vf, vol, m, a) in world
         .query_mut::<(
             &mut crate::Particles,
             Option<&EdgeConstraints>,
@@ -214,6 +214,7 @@ pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: b
             Option<&VertexFaceConstraints>,
             Option<&VolumeConstraints>,
             Option<&crate::NeoHookeanMaterial>,
+            Option<&mut crate::body::activation::Activation>,
         )>()
         .without::<&crate::Asleep>()
     {
@@ -238,6 +239,11 @@ pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: b
         };
         if crate::stabilisation::angular_momentum::store_measured(p, h, spin, budget) {
             limited += 1;
+            // Corrections held back from the velocities still moved the positions: the
+            // body is not at rest, whatever its particles' speeds say.
+            if let Some(a) = a {
+                a.restart();
+            }
         }
     }
     limited
