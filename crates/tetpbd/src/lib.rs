@@ -37,12 +37,13 @@
 //!
 //! ```
 //! use nalgebra::Vector3;
-//! use tetpbd::{generators, Solver, SolverSettings, SoftBodyBuilder};
+//! use tetpbd::{generators, DiagnosticSettings, Solver, SolverSettings, SoftBodyBuilder};
 //!
 //! let mut world = hecs::World::new();
 //! let mesh = generators::box_grid(Vector3::new(1.0, 1.0, 1.0), [3, 3, 3], generators::CellSplit::Six)?;
 //! SoftBodyBuilder::new(mesh).density(1000.0).edges(0.0).volume(0.0).build()?.spawn(&mut world);
-//! let mut solver = Solver::new(SolverSettings { measure_error: true, ..Default::default() })?;
+//! let diagnostics = DiagnosticSettings { measure_error: true, ..Default::default() };
+//! let mut solver = Solver::new(SolverSettings { diagnostics, ..Default::default() })?;
 //! let stats = solver.step(&mut world)?;
 //! assert_eq!(stats.inverted, Some(0));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
