@@ -126,7 +126,7 @@ fn single_tet(apex_height: f32) -> TetMesh {
 }
 
 /// Every case, in report order. `safety_net` sets
-/// [`tetpbd::SolverSettings::max_correction_speed`] on every scene.
+/// [`tetpbd::SafetySettings::max_correction_speed`] on every scene.
 pub fn all_cases(safety_net: Option<f32>) -> Vec<Case> {
     let mut cases = Vec::new();
     let mut add_case = |group, name: String, description, kind, sweep, mut scene: Scene| {
