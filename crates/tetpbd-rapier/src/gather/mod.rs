@@ -251,24 +251,53 @@ impl Frame {
     }
 
     /// Makes every dynamic body taking part that a joint locks in all six degrees of freedom
-    /// to a fixed or kinematic body *welded*: immovable inside the substeps, its soft reaction
-    /// handed to rapier (`joints` module docs, "Welded bodies").
+    /// to a fixed or kinematic body *welded* (immovable inside the substeps, its soft
+    /// reaction handed to rapier), and one whose joint to such a body locks its rotation and
+    /// some of its translation *sliding* along the free axes (`joints` module docs, "Welded
+    /// and sliding bodies").
     pub(crate) fn weld_jointed_bodies(&mut self, input: &GatherInput<'_, '_>) {
         for b in 0..self.bodies.len() {
             if !self.bodies[b].is_dynamic() {
                 continue;
             }
             let handle = self.bodies[b].handle;
-            let welded = joints_of(handle, input.impulse_joints, input.multibody_joints).any(
-                |(h1, h2, _, joint)| {
-                    let other = if h1 == handle { h2 } else { h1 };
-                    joint.is_enabled()
-                        && joint.locked_axes.contains(JointAxesMask::LOCKED_FIXED_AXES)
-                        && input.qp.bodies.get(other).is_some_and(|o| !o.is_dynamic())
-                },
-            );
+            let mut welded = false;
+            let mut slide: Option<Vec<Vector3<f32>>> = None;
+            for (h1, h2, _, joint) in
+                joints_of(handle, input.impulse_joints, input.multibody_joints)
+            {
+                let other = if h1 == handle { h2 } else { h1 };
+                let immovable = input.qp.bodies.get(other).is_some_and(|o| !o.is_dynamic());
+                let m = joint.locked_axes;
+                if !joint.is_enabled() || !immovable || !m.contains(JointAxesMask::ANG_AXES) {
+                    continue;
+                }
+                if m.contains(JointAxesMask::LOCKED_FIXED_AXES) {
+                    welded = true;
+                    break;
+                }
+                let Some(b1) = input.qp.bodies.get(h1) else {
+                    continue;
+                };
+                let frame = pose_to_na(b1.position()) * pose_to_na(&joint.local_frame1);
+                let free: Vec<_> = [
+                    JointAxesMask::LIN_X,
+                    JointAxesMask::LIN_Y,
+                    JointAxesMask::LIN_Z,
+                ]
+                .iter()
+                .enumerate()
+                .filter(|(_, &axis)| !m.contains(axis))
+                .map(|(k, _)| frame.rotation * Vector3::ith(k, 1.0))
+                .collect();
+                // Two such joints: the body can only move along what both leave free; keep
+                // the first and let the second's projection hold the rest.
+                slide.get_or_insert(free);
+            }
             if welded {
                 self.bodies[b].weld();
+            } else if let Some(free) = slide {
+                self.bodies[b].slide(&free);
             }
         }
     }

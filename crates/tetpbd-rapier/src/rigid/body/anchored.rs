@@ -34,6 +34,20 @@ impl BodyProxy {
         }
     }
 
+    /// Restricts a dynamic body that a joint holds to an immovable body without letting it
+    /// turn to sliding along the unit world directions `free` (`joints` module docs, "Welded
+    /// and sliding bodies"): soft impulses move it only along them and never turn it.
+    pub fn slide(&mut self, free: &[Vector3<f32>]) {
+        if self.kind != BodyKind::Dynamic {
+            return;
+        }
+        let project = free
+            .iter()
+            .fold(nalgebra::Matrix3::zeros(), |m, a| m + a * a.transpose());
+        self.inv_mass = project * self.inv_mass * project;
+        self.inv_inertia = nalgebra::Matrix3::zeros();
+    }
+
     /// Records an anchored body's clearance `gap` (m) above its supports at its current pose.
     pub fn set_clearance(&mut self, gap: f32) {
         self.clearance = (gap, self.com());

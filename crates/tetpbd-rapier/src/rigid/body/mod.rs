@@ -76,7 +76,7 @@ pub(crate) struct BodyProxy {
     w_end: Vector3<f32>,
     dt: f32,
     h: f32,
-    inv_mass: Vector3<f32>,
+    inv_mass: Matrix3<f32>,
     inv_inertia: Matrix3<f32>,
     dx: Vector3<f32>,
     dq: UnitQuaternion<f32>,
@@ -139,17 +139,17 @@ impl BodyKind {
     }
 }
 
-/// Effective inverse mass (per axis, 1/kg) and world inverse inertia (1/(kg·m²)) of a
-/// dynamic body; zero for the others.
-fn inverse_mass(body: &RigidBody) -> (Vector3<f32>, Matrix3<f32>) {
+/// Effective inverse mass (world, 1/kg) and world inverse inertia (1/(kg·m²)) of a dynamic
+/// body; zero for the others.
+fn inverse_mass(body: &RigidBody) -> (Matrix3<f32>, Matrix3<f32>) {
     if body.is_dynamic() {
         let mp = body.mass_properties();
         (
-            to_na(mp.effective_inv_mass),
+            Matrix3::from_diagonal(&to_na(mp.effective_inv_mass)),
             inertia_to_na(&mp.effective_world_inv_inertia),
         )
     } else {
-        (Vector3::zeros(), Matrix3::zeros())
+        (Matrix3::zeros(), Matrix3::zeros())
     }
 }
 
@@ -356,7 +356,7 @@ impl BodyProxy {
             return 0.0;
         }
         let rn = (q - self.com()).cross(n);
-        n.dot(&self.inv_mass.component_mul(n)) + rn.dot(&(self.inv_inertia * rn))
+        n.dot(&(self.inv_mass * n)) + rn.dot(&(self.inv_inertia * rn))
     }
 
     /// Generalized inverse mass `aᵀ I⁻¹ a` of a rotation about the unit axis `a` (world),
@@ -391,7 +391,7 @@ impl BodyProxy {
             if !self.moves(p) {
                 return;
             }
-            let sink = -self.support_normal.dot(&self.inv_mass.component_mul(p));
+            let sink = -self.support_normal.dot(&(self.inv_mass * p));
             let room = self.clearance();
             if self.presses(p) && sink > room {
                 self.apply_support_impulse(&(p * (room / sink)), q);
@@ -414,7 +414,7 @@ impl BodyProxy {
             return;
         }
         let dtheta = self.inv_inertia * (q - self.com()).cross(p);
-        self.dx += self.inv_mass.component_mul(p);
+        self.dx += self.inv_mass * p;
         let dq = Quaternion::from_parts(0.0, dtheta) * self.dq.into_inner() * 0.5;
         self.dq = UnitQuaternion::new_normalize(self.dq.into_inner() + dq);
         self.touched = true;
@@ -465,7 +465,7 @@ impl BodyProxy {
         if self.kind != BodyKind::Dynamic {
             return;
         }
-        self.dv += self.inv_mass.component_mul(j);
+        self.dv += self.inv_mass * j;
         self.dw += self.inv_inertia * (q - self.com()).cross(j);
         self.touched = true;
     }
