@@ -7,7 +7,7 @@ use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{
     ColliderBuilder, FixedJointBuilder, GenericJoint, PrismaticJointBuilder, RevoluteJointBuilder,
-    RigidBodyBuilder, SphericalJointBuilder,
+    RigidBodyBuilder, RigidBodyHandle, SphericalJointBuilder,
 };
 use robust_common::{scene, scene_substeps};
 use tetpbd::generators::{self, CellSplit};
@@ -60,18 +60,9 @@ fn joints() -> Vec<(&'static str, GenericJoint, [bool; 3])> {
     ]
 }
 
-/// A 2 kg box of 0.2 m hanging 0.2 m below a fixed anchor at (0, 1, 0) on `joint` (impulse
-/// or multibody), with a soft beam of `beam_mass` kg (0.6 m along x, 6 × 1 × 1 cells)
-/// attached by its root face to the box's +x side. Returns the anchor drift (m) after each
-/// second.
-fn hang(
-    joint: GenericJoint,
-    counted: [bool; 3],
-    beam_mass: f32,
-    multibody: bool,
-    seconds: usize,
-) -> Vec<f32> {
-    let mut s: CoupledWorld = scene();
+/// A 2 kg box of 0.2 m, its centre at (0, 0.8, 0), on `joint` (impulse or multibody) from a
+/// fixed body at (0, 1, 0).
+fn hanging_box(s: &mut CoupledWorld, joint: GenericJoint, multibody: bool) -> RigidBodyHandle {
     let anchor = s
         .physics
         .bodies
@@ -85,6 +76,22 @@ fn hang(
     } else {
         s.physics.impulse_joints.insert(anchor, bx, joint, true);
     }
+    bx
+}
+
+/// A 2 kg box of 0.2 m hanging 0.2 m below a fixed anchor at (0, 1, 0) on `joint` (impulse
+/// or multibody), with a soft beam of `beam_mass` kg (0.6 m along x, 6 × 1 × 1 cells)
+/// attached by its root face to the box's +x side. Returns the anchor drift (m) after each
+/// second.
+fn hang(
+    joint: GenericJoint,
+    counted: [bool; 3],
+    beam_mass: f32,
+    multibody: bool,
+    seconds: usize,
+) -> Vec<f32> {
+    let mut s: CoupledWorld = scene();
+    let bx = hanging_box(&mut s, joint, multibody);
     let mesh = generators::beam(0.6, 0.1, 6, 1, CellSplit::Six).expect("mesh");
     let roots = generators::beam_root(&mesh);
     let body = SoftBodyBuilder::new(mesh)
@@ -176,19 +183,7 @@ fn cube_on_welded_box(
     frames: usize,
 ) -> (f32, f32, f32) {
     let mut s: CoupledWorld = scene_substeps(substeps);
-    let anchor = s
-        .physics
-        .bodies
-        .insert(RigidBodyBuilder::fixed().translation(Vector::new(0.0, 1.0, 0.0)));
-    let (bx, _) = s.physics.insert(
-        RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 0.8, 0.0)),
-        ColliderBuilder::cuboid(0.1, 0.1, 0.1).mass(2.0),
-    );
-    if multibody {
-        s.physics.multibody_joints.insert(anchor, bx, joint, true);
-    } else {
-        s.physics.impulse_joints.insert(anchor, bx, joint, true);
-    }
+    let bx = hanging_box(&mut s, joint, multibody);
     let mesh = generators::box_grid(Vector3::repeat(0.2), [3; 3], CellSplit::Six).expect("mesh");
     let b = SoftBodyBuilder::new(mesh)
         .density(2.0 * ratio / 0.008)

@@ -11,7 +11,7 @@ mod corners;
 use std::collections::HashMap;
 
 use hecs::Entity;
-use nalgebra::{Isometry3, Vector3};
+use nalgebra::{Isometry3, Matrix3, Vector3};
 use rapier3d::dynamics::{
     ImpulseJointSet, JointAxesMask, MultibodyJointSet, RigidBodyHandle, RigidBodySet,
 };
@@ -262,7 +262,7 @@ impl Frame {
             }
             let handle = self.bodies[b].handle;
             let mut welded = false;
-            let mut slide: Option<Vec<Vector3<f32>>> = None;
+            let mut slide: Option<Matrix3<f32>> = None;
             for (h1, h2, _, joint) in
                 joints_of(handle, input.impulse_joints, input.multibody_joints)
             {
@@ -280,16 +280,19 @@ impl Frame {
                     continue;
                 };
                 let frame = pose_to_na(b1.position()) * pose_to_na(&joint.local_frame1);
-                let free: Vec<_> = [
+                // The projector onto the joint's free translations (first frame's axes).
+                let lin = [
                     JointAxesMask::LIN_X,
                     JointAxesMask::LIN_Y,
                     JointAxesMask::LIN_Z,
-                ]
-                .iter()
-                .enumerate()
-                .filter(|(_, &axis)| !m.contains(axis))
-                .map(|(k, _)| frame.rotation * Vector3::ith(k, 1.0))
-                .collect();
+                ];
+                let free =
+                    (0..3)
+                        .filter(|&k| !m.contains(lin[k]))
+                        .fold(Matrix3::zeros(), |p, k| {
+                            let a = frame.rotation * Vector3::ith(k, 1.0);
+                            p + a * a.transpose()
+                        });
                 // Two such joints: the body can only move along what both leave free; keep
                 // the first and let the second's projection hold the rest.
                 slide.get_or_insert(free);

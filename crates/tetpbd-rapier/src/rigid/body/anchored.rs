@@ -35,15 +35,13 @@ impl BodyProxy {
     }
 
     /// Restricts a dynamic body that a joint holds to an immovable body without letting it
-    /// turn to sliding along the unit world directions `free` (`joints` module docs, "Welded
-    /// and sliding bodies"): soft impulses move it only along them and never turn it.
-    pub fn slide(&mut self, free: &[Vector3<f32>]) {
+    /// turn to sliding along the joint's free translations, `project` the orthogonal
+    /// projector onto them (world; `joints` module docs, "Welded and sliding bodies"): soft
+    /// impulses move it only along them and never turn it.
+    pub fn slide(&mut self, project: &nalgebra::Matrix3<f32>) {
         if self.kind != BodyKind::Dynamic {
             return;
         }
-        let project = free
-            .iter()
-            .fold(nalgebra::Matrix3::zeros(), |m, a| m + a * a.transpose());
         self.inv_mass = project * self.inv_mass * project;
         self.inv_inertia = nalgebra::Matrix3::zeros();
     }
