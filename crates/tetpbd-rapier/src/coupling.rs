@@ -148,7 +148,7 @@ use crate::substep::{CoupledHooks, CouplingHook};
 ///   at 0.08–2 m/s at 5 substeps and a tower of three such boxes under a 1000:1 cube topples
 ///   at 40 substeps (a held body does not tip). A rigid box 1000× lighter than the slab under it (1 g on 1 kg) is pushed 7 cm and turned
 ///   10°.
-/// * Fast impacts (`impact` module docs): of 448 shots (balls of 0.1 and 0.2 m, boxes of 0.08
+/// * Fast impacts ([`tetpbd::ImpactReach`]): of 448 shots (balls of 0.1 and 0.2 m, boxes of 0.08
 ///   and 0.2 m, 1 kg, at 50–300 m/s onto slabs of 1–4 cells, seven aim points), 12 still fail:
 ///   the 0.2 m box at 200–300 m/s (through the slab or throwing it) and hits within 0.1 m of
 ///   the slab's edge.

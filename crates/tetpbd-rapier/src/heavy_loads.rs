@@ -63,10 +63,10 @@ use tetpbd::{GroundUpSweep, Particles, SubstepContext, Surface};
 use crate::contacts::corner::{project_corners, CornerContact, CornerPass};
 use crate::contacts::particle::project_contacts;
 use crate::contacts::particle::ParticleContact;
-use crate::impact::Impact;
 use crate::rigid::body::{BodyKind, BodyProxy};
 use crate::rigid::collider::ColliderProxy;
 use nalgebra::Vector3;
+use tetpbd::ImpactReach;
 
 /// What the pass borrows besides one soft body's contacts.
 pub(crate) struct Stacking<'a> {
@@ -282,7 +282,7 @@ fn project_on_frozen_surface(
                 s.colliders,
                 s.set,
                 s.max_push,
-                &mut Impact::new(f32::INFINITY),
+                &mut ImpactReach::new(f32::INFINITY),
             );
         }
         i = end;
@@ -301,7 +301,7 @@ fn project_on_frozen_surface(
                 s.set,
                 CornerPass::Frozen,
                 s.max_push,
-                &mut Impact::new(f32::INFINITY),
+                &mut ImpactReach::new(f32::INFINITY),
             );
         }
         i = end;

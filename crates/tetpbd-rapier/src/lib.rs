@@ -79,7 +79,6 @@ mod depenetration;
 mod error;
 mod gather;
 mod heavy_loads;
-mod impact;
 mod joints;
 mod mesh_side;
 mod pieces;

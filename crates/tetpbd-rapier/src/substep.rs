@@ -18,7 +18,6 @@ use crate::contacts::support::{
 use crate::depenetration::{cap_depenetration, settle_substeps};
 use crate::gather::{Frame, GatherInput};
 use crate::heavy_loads::{immovable, stacked_velocity_pass, stacking_pass, Stacking};
-use crate::impact::Impact;
 use crate::joints::project_joints;
 use crate::report::{ContactReport, SoftFeature};
 use crate::response::restitution::restitution_pass;
@@ -26,6 +25,7 @@ use crate::response::rolling::rolling_pass;
 use crate::rigid::shape_query::surface_point;
 use crate::soft_collider::SoftCollider;
 use crate::soft_soft::SoftContacts;
+use tetpbd::ImpactReach;
 
 /// Borrows the frame state and rapier's query pipeline for one soft step.
 pub(crate) struct CouplingHook<'q, 'a> {
@@ -181,7 +181,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             else {
                 continue;
             };
-            let mut impact = Impact::new(s.reach);
+            let mut impact = ImpactReach::new(s.reach);
             project_corners(
                 &mut corners[s.corners.clone()],
                 &contacts[s.contacts.clone()],

@@ -1,9 +1,11 @@
 //! The immovable ground of the impact cases: the plane y = 0, restitution 0.
 //!
 //! A [`SubstepHook`] that runs after the families every substep: a particle below the plane
-//! is put back on it (a position constraint, as a coupling's contacts are), and a particle
-//! on it leaves the substep with no normal velocity (the velocity pass of an XPBD contact,
-//! Müller et al. 2020, with restitution 0). It only ever removes energy. The coupled table
+//! is put back on it (a position constraint, as a coupling's contacts are), the depth beyond
+//! the body's local reach taken by the whole body ([`ImpactReach`], as the rapier coupling's
+//! contacts do), and a particle on it leaves the substep with no normal velocity (the
+//! velocity pass of an XPBD contact, Müller et al. 2020, with restitution 0). It only ever
+//! removes energy. The coupled table
 //! runs rapier colliders through `tetpbd-rapier`; this plane keeps the impact rows
 //! independent of the coupling so every constraint configuration is measured the same way.
 //!
@@ -11,7 +13,8 @@
 //! ([`crate::energy::internal_kinetic`]): an impact's vibration lasts a few substeps, well
 //! inside the frame it happens in, where a frame-by-frame sample would miss it.
 
-use tetpbd::{hecs, Particles, SubstepHook};
+use tetpbd::nalgebra::Vector3;
+use tetpbd::{hecs, ImpactReach, Particles, SubstepHook, Surface};
 
 /// The plane y = 0 (see the module docs).
 #[derive(Clone, Copy, Debug, Default)]
@@ -28,9 +31,12 @@ impl Ground {
 
 impl SubstepHook for Ground {
     fn project(&mut self, world: &mut hecs::World, _substep: tetpbd::SubstepContext) {
-        for p in world.query_mut::<&mut Particles>() {
-            for x in p.positions_mut() {
-                x.y = x.y.max(0.0);
+        for (p, surface) in world.query_mut::<(&mut Particles, Option<&Surface>)>() {
+            let mut impact =
+                surface.map_or(ImpactReach::new(f32::INFINITY), |s| ImpactReach::of(p, s));
+            for i in 0..p.len() {
+                let depth = -p.positions()[i].y;
+                impact.push_out(p, i, depth, &Vector3::y());
             }
         }
     }

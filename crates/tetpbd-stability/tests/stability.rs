@@ -49,8 +49,7 @@ fn every_fast_case_stays_finite_with_safety_net() {
 
 /// Cells that fail at default settings, each listed in the report (`docs/stability.md`) and
 /// its findings: (case name, configuration label). Slivers next to pins invert; released
-/// soft vertex–face + edges can settle tangled; an impact at 300 m/s crushes the vertex–face
-/// configurations and soft bodies on the five-tetrahedra grid; a body collapsed to a point on
+/// soft vertex–face + edges can settle tangled; a body collapsed to a point on
 /// the five-tetrahedra 3³ grid stays collapsed under edges + volume; a hard vertex–face cube
 /// hanging at 20 substeps gains 1e-3 of `M g L`.
 const KNOWN_LIMITS: &[(&str, &str)] = &[
@@ -73,23 +72,6 @@ const KNOWN_LIMITS: &[(&str, &str)] = &[
         "collapsed to a point, 5 tets/cell, 10 substeps",
         "vertex-face+edges, soft",
     ),
-    ("300 m/s, 6 tets/cell, 10 substeps", "vertex-face, α=0"),
-    ("300 m/s, 6 tets/cell, 10 substeps", "vertex-face, soft"),
-    (
-        "300 m/s, 6 tets/cell, 10 substeps",
-        "vertex-face+edges, α=0",
-    ),
-    (
-        "300 m/s, 6 tets/cell, 10 substeps",
-        "vertex-face+edges, soft",
-    ),
-    ("300 m/s, 5 tets/cell, 10 substeps", "edges+volume, soft"),
-    ("300 m/s, 5 tets/cell, 10 substeps", "vertex-face, soft"),
-    // Vertex–face alone cannot hold a shape crushed at 300 m/s (four heights fix four of six
-    // shape degrees of freedom); the ground's impulses are external work in the energy
-    // limit's budget, and part of the crush comes back as particle speed (354 m/s, the body's
-    // centre rebounds at 36 m/s).
-    ("300 m/s, 5 tets/cell, 10 substeps", "vertex-face, α=0"),
 ];
 
 fn known_limit(case: &tetpbd_stability::Case, config: &Config) -> bool {

@@ -68,6 +68,7 @@ pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeC
 pub use body::forces::{applied_acceleration, UserForces};
 pub use body::generators;
 pub use body::grab::Grab;
+pub use body::impact_reach::{local_reach, ImpactReach, LOCAL_REACH};
 pub use body::impulses::PointImpulse;
 pub use body::material::{Material, MaterialError};
 pub use body::material_point::MaterialPoint;

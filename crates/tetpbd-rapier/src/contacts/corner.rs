@@ -39,7 +39,7 @@
 //! had at the substep start, less `max_depenetration_speed · h`, is tolerated and shrinks by
 //! that much every substep, so it is pushed out at the depenetration speed. (A draped soft
 //! body whose bottom triangle slid over a box corner 15 cm inside it otherwise took the
-//! whole depth at once, most of it as the whole body's motion (`impact` module docs), and
+//! whole depth at once, most of it as the whole body's motion ([`tetpbd::ImpactReach`]), and
 //! jumped off the box at 5 m/s.)
 //!
 //! A support point over a triangle with a vertex that *holds* the collider is skipped in the
@@ -78,10 +78,10 @@ use tetpbd::{Particles, Surface};
 
 use crate::contacts::particle::ParticleContact;
 use crate::convert::{to_glam, to_na};
-use crate::impact::Impact;
 use crate::response::friction::{positional_friction, ContactStencil, Coulomb};
 use crate::rigid::body::{BodyKind, BodyProxy};
 use crate::rigid::collider::ColliderProxy;
+use tetpbd::ImpactReach;
 
 /// Cosine of the largest angle between a vertex's particle contact normal and its triangle's
 /// normal at which the particle contact still holds the collider against the triangle, so
@@ -150,7 +150,7 @@ pub(crate) fn project_corners(
     set: &ColliderSet,
     pass: CornerPass,
     max_push: f32,
-    impact: &mut Impact,
+    impact: &mut ImpactReach,
 ) {
     if pass == CornerPass::Crossing {
         // Only the runs of moving colliders.
@@ -200,7 +200,7 @@ fn sweep_corners(
     colliders: &[ColliderProxy],
     set: &ColliderSet,
     (pass, max_push): (CornerPass, f32),
-    impact: &mut Impact,
+    impact: &mut ImpactReach,
 ) {
     let crossing_only = pass == CornerPass::Crossing;
     for k in corners {
@@ -389,13 +389,13 @@ fn push_out(
     bodies: &mut [BodyProxy],
     body: Option<usize>,
     hit: &Hit,
-    impact: &mut Impact,
+    impact: &mut ImpactReach,
 ) {
     let Hit { v, n, beta, .. } = *hit;
     let mut c_val = hit.c_val;
     let w = idx.map(|i| p.inv_masses()[i]);
     let w_body = body.map_or(0.0, |bi| bodies[bi].inv_mass_pushed(&v, &n));
-    // Deeper than the surface takes locally: the rest meets the whole soft body (`impact`
+    // Deeper than the surface takes locally: the rest meets the whole soft body (`tetpbd::ImpactReach`
     // module docs).
     if let Some((dl, excess)) = impact.take_excess(p, c_val, w_body, &(-n)) {
         if let Some(bi) = body {

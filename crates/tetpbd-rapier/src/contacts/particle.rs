@@ -39,11 +39,11 @@ use rapier3d::geometry::ColliderSet;
 use tetpbd::Particles;
 
 use crate::ccd::swept_entry;
-use crate::impact::Impact;
 use crate::response::friction::{positional_friction, ContactStencil, Coulomb};
 use crate::rigid::body::{BodyKind, BodyProxy};
 use crate::rigid::collider::ColliderProxy;
 use crate::rigid::shape_query::{surface_point, InsideRule};
+use tetpbd::ImpactReach;
 
 /// A surface particle near a collider: an XPBD inequality contact re-evaluated every
 /// iteration of every substep.
@@ -87,7 +87,7 @@ pub(crate) fn project_contacts(
     colliders: &[ColliderProxy],
     set: &ColliderSet,
     max_push: f32,
-    impact: &mut Impact,
+    impact: &mut ImpactReach,
 ) -> u64 {
     let mut degenerate = 0;
     for c in contacts {
@@ -150,7 +150,7 @@ pub(crate) fn project_contacts(
             continue;
         }
         // An impact deeper than the surface can take locally within the substep meets the
-        // whole soft body (`impact` module docs).
+        // whole soft body ([`tetpbd::ImpactReach`]).
         let w_b = cp.body.map_or(0.0, |b| bodies[b].inv_mass_pushed(&q, &-n));
         if let Some((dl, excess)) = impact.take_excess(p, c_val, w_b, &n) {
             if let Some(b) = cp.body {

@@ -91,7 +91,7 @@ impl Frame {
                 corners: k0..self.corners.len(),
                 attachments: a0..self.attachments.len(),
                 stacked: false,
-                reach: crate::impact::local_reach(p, surface),
+                reach: tetpbd::local_reach(p, surface),
             });
         }
         self.anchor_supported_bodies(input);

@@ -44,7 +44,7 @@ pub(crate) struct SoftEntry {
     /// Whether the stacking pass ran on the body in the current substep.
     pub stacked: bool,
     /// How deep an impact its surface takes locally within a substep, m
-    /// (`impact` module docs).
+    /// ([`tetpbd::ImpactReach`]).
     pub reach: f32,
 }
 

@@ -16,6 +16,7 @@ pub(crate) mod families;
 pub(crate) mod forces;
 pub mod generators;
 pub(crate) mod grab;
+pub(crate) mod impact_reach;
 pub(crate) mod impulses;
 pub(crate) mod material;
 pub(crate) mod material_point;
