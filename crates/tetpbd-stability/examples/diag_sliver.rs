@@ -20,7 +20,8 @@ struct Cli {
     #[arg(default_value = "slivers")]
     case: String,
     /// The configuration: a column label's prefix (`vertex-face`, `vertex-face+edges`,
-    /// `edges+volume`), optionally followed by `,soft`.
+    /// `edges+volume`), or `material` (rubber), optionally followed by `,soft` (for the
+    /// material: soft tissue).
     #[arg(default_value = "vertex-face", value_parser = parse_config)]
     config: Config,
     /// `net` turns the 10 m/s safety net on (default: off).
@@ -45,9 +46,10 @@ fn parse_config(text: &str) -> Result<Config, String> {
         "edges+volume" => ConstraintSet::EdgesVolume,
         "vertex-face+edges" => ConstraintSet::VertexFaceEdges,
         "vertex-face" => ConstraintSet::VertexFace,
+        "material" => ConstraintSet::Material,
         other => {
             return Err(format!(
-                "`{other}`: one of vertex-face, vertex-face+edges, edges+volume"
+                "`{other}`: one of vertex-face, vertex-face+edges, edges+volume, material"
             ))
         }
     };

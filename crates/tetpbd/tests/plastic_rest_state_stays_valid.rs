@@ -12,7 +12,7 @@ use nalgebra::{Matrix3, Vector3};
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{
     BuildError, EdgeConstraints, Particles, Plasticity, PlasticityError, PlasticitySettings,
-    SoftBodyBuilder, Solver, Tetrahedra, VertexFaceConstraints,
+    SoftBodyBuilder, Tetrahedra, VertexFaceConstraints,
 };
 
 /// Held in random stretches, shears and squashes, frame after frame: volume-preserving flow
@@ -264,7 +264,7 @@ fn flowing_body_restored_from_a_snapshot_continues_bit_identically() {
     let json = serde_json::to_string(&saved).unwrap();
     let mut fresh = World::new();
     let e2 = fresh.spawn(serde_json::from_str::<Saved>(&json).unwrap());
-    let mut solver2 = Solver::new(solver.settings.clone()).unwrap();
+    let mut solver2 = tetpbd::Solver::new(solver.settings.clone()).unwrap();
     for _ in 0..20 {
         solver.step(&mut world).unwrap();
         solver2.step(&mut fresh).unwrap();

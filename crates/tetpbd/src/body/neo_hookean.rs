@@ -124,26 +124,26 @@ impl NeoHookeanMaterial {
     }
 
     /// The longest substep (s) at which this material is stable on this body:
-    /// `0.1 L / c`, with `c = √(μ/ρ)` the shear wave speed (`ρ` the body's mean density, from
-    /// `particles`' masses and the rest volumes) and `L = (6√2 V)^⅓` the edge of a regular
-    /// tetrahedron of the smallest rest volume `V`.
+    /// `0.1 L/c`, with `c = √(μ/ρ)` the shear wave speed (`ρ` the body's mean density, from
+    /// `particles`' masses and the rest volumes) and `L = √(3/2) a` the edge of the regular
+    /// tetrahedron whose altitude `a` is the smallest rest altitude of the body's tetrahedra
+    /// (`3V/A` of the largest face: the thinnest direction a wave crosses).
     ///
     /// Why there is a bound: the two constraints are isotropic invariants of `F`, whose
     /// gradients at rest are both along the volume change, so the material's shear stiffness
     /// lives entirely in their curvature times their (non-zero) rest multipliers, and XPBD
     /// integrates that part explicitly. Shear waves then need the explicit (CFL) condition
-    /// `h ≲ 0.3 L / c`; past it a body at rest starts to vibrate by itself. Choose
-    /// `substeps ≥ dt / max_stable_substep` (`SolverSettings::substeps`).
+    /// `h ≲ 0.3 L / c`; past it a body at rest starts to vibrate by itself. The wave crosses a
+    /// sliver in its thin direction, so `L` comes from the smallest altitude, not the smallest
+    /// volume (a 1 m × 1 mm × 1 m sliver has the volume of a regular tetrahedron of 5 cm edge).
+    /// Choose `substeps ≥ dt / max_stable_substep` (`SolverSettings::substeps`).
     pub fn max_stable_substep(&self, tets: &Tetrahedra, particles: &crate::Particles) -> f32 {
         let volume: f64 = tets.rest_volumes.iter().map(|v| f64::from(v.abs())).sum();
         let mass: f64 = particles.masses().iter().map(|&m| f64::from(m)).sum();
-        let smallest = tets
-            .rest_volumes
-            .iter()
-            .fold(f32::INFINITY, |m, v| m.min(v.abs()));
+        let altitude = smallest_rest_altitude(tets, particles.rest_positions());
         let (mu, _) = self.material.lame();
         let c = (f64::from(mu) * volume / mass).sqrt();
-        let l = (6.0 * std::f64::consts::SQRT_2 * f64::from(smallest)).cbrt();
+        let l = 1.5f64.sqrt() * altitude;
         (0.1 * l / c) as f32
     }
 
@@ -163,4 +163,26 @@ impl NeoHookeanMaterial {
             })
             .sum()
     }
+}
+
+/// The smallest altitude `3|V|/A_max` of the tetrahedra of `tets` at the rest positions
+/// `rest`, m (f64; `f64::INFINITY` for no tetrahedron or indices past `rest`).
+fn smallest_rest_altitude(tets: &Tetrahedra, rest: &[nalgebra::Vector3<f32>]) -> f64 {
+    const FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+    let mut smallest = f64::INFINITY;
+    for (t, v0) in tets.indices.iter().zip(&tets.rest_volumes) {
+        let corners = t.map(|i| rest.get(i as usize).map(|v| v.cast::<f64>()));
+        let [Some(a), Some(b), Some(c), Some(d)] = corners else {
+            continue;
+        };
+        let x = [a, b, c, d];
+        let largest_face = FACES
+            .iter()
+            .map(|f| 0.5 * (x[f[1]] - x[f[0]]).cross(&(x[f[2]] - x[f[0]])).norm())
+            .fold(0.0f64, f64::max);
+        if largest_face > 0.0 {
+            smallest = smallest.min(3.0 * f64::from(v0.abs()) / largest_face);
+        }
+    }
+    smallest
 }
