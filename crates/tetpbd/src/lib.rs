@@ -64,11 +64,13 @@ mod stabilisation;
 pub use body::activation::{Activation, Asleep};
 pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
 pub use body::cutting::{cut, Blade};
+pub use body::elastic_energy::ElasticFamilies;
 pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};
 pub use body::forces::{applied_acceleration, UserForces};
 pub use body::generators;
 pub use body::grab::Grab;
 pub use body::impact_reach::{local_reach, ImpactReach, LOCAL_REACH};
+pub use body::impact_speed;
 pub use body::impulses::PointImpulse;
 pub use body::material::{Material, MaterialError};
 pub use body::material_point::MaterialPoint;
@@ -93,6 +95,7 @@ pub use solver::systems;
 pub use stabilisation::deformation_damping::DeformationDamping;
 pub use stabilisation::ground_up_sweep::GroundUpSweep;
 pub use stabilisation::rigid_fit::RigidFit;
+pub use stabilisation::untangle::Untangle;
 
 /// The constraint math under its former name; the same module as [`constraints`].
 #[doc(hidden)]

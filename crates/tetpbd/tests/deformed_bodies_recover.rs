@@ -1,5 +1,6 @@
 //! Inverted, flattened and scrambled bodies recover; edges alone do not un-invert (the
-//! seed's motivation for the vertex–face and signed volume constraints).
+//! seed's motivation for the vertex–face and signed volume constraints) unless the
+//! untangling ([`tetpbd::Untangle`]) pulls the calm, inverted body back.
 //!
 //! A limit: the four vertex–face constraints alone fix only four of a tetrahedron's six
 //! shape degrees of freedom. Released from a mirrored or scrambled start without the safety
@@ -40,6 +41,17 @@ fn run(families: Families, start: Start, max_frames: usize) -> Outcome {
 }
 
 fn run_on(families: Families, start: Start, max_frames: usize, split: CellSplit) -> Outcome {
+    run_with(families, start, max_frames, split, true)
+}
+
+/// `untangle`: whether the body keeps its [`tetpbd::Untangle`] on (the default).
+fn run_with(
+    families: Families,
+    start: Start,
+    max_frames: usize,
+    split: CellSplit,
+    untangle: bool,
+) -> Outcome {
     let mut world = World::new();
     let b = SoftBodyBuilder::new(common::cube(3, split)).density(1000.0);
     let b = match families {
@@ -49,6 +61,7 @@ fn run_on(families: Families, start: Start, max_frames: usize, split: CellSplit)
         Families::EdgesOnly => b.edges(0.0),
     };
     let e: Entity = b.build().unwrap().spawn(&mut world);
+    world.get::<&mut tetpbd::Untangle>(e).unwrap().disabled = !untangle;
     common::deform(&mut world, e, start);
     let mut solver = Solver::new(SolverSettings {
         gravity: Vector3::zeros(),
@@ -135,9 +148,17 @@ fn edges_and_volume_recover_every_start() {
     }
 }
 
+/// The constraints alone: edge lengths are satisfied by the mirror image, so without the
+/// untangling a mirrored body of edges stays inverted.
 #[test]
-fn edges_alone_leave_a_mirrored_body_inverted() {
-    let r = run(Families::EdgesOnly, Start::Mirrored, 120);
+fn edges_alone_leave_a_mirrored_body_inverted_without_the_untangling() {
+    let r = run_with(
+        Families::EdgesOnly,
+        Start::Mirrored,
+        120,
+        CellSplit::Five,
+        false,
+    );
     assert!(r.uninverted.is_none());
     assert_eq!(
         r.final_inverted,
@@ -145,4 +166,12 @@ fn edges_alone_leave_a_mirrored_body_inverted() {
         "edge lengths are satisfied by the mirror image"
     );
     assert!((r.final_volume_ratio + 1.0).abs() < 0.01, "{r:?}");
+}
+
+/// At default settings the untangling catches the calm, inverted body and pulls it back to
+/// its best-fit rest shape.
+#[test]
+fn untangling_recovers_a_mirrored_body_of_edges_alone() {
+    let r = run(Families::EdgesOnly, Start::Mirrored, 120);
+    assert!(r.recovered.is_some() && r.final_inverted == 0, "{r:?}");
 }

@@ -151,7 +151,7 @@ fn net_that_never_acts_changes_nothing() {
 }
 
 /// Every particle on one line with the net on (an inertia tensor of rank 2): nothing turns
-/// non-finite and the momenta stay zero.
+/// non-finite and the momenta stay zero (to f32 rounding of the largest momentum of the run).
 #[test]
 fn collinear_body_stays_finite() {
     let mut world = World::new();
@@ -171,6 +171,7 @@ fn collinear_body_stays_finite() {
     })
     .unwrap();
     let mut clamps = 0;
+    let (mut sp_max, mut sl_max) = (0.0f64, 0.0f64);
     for _ in 0..30 {
         let s = solver.step(&mut world).unwrap();
         assert_eq!(s.non_finite_resets, 0);
@@ -182,8 +183,11 @@ fn collinear_body_stays_finite() {
             .chain(p.velocities())
             .all(|v| v.iter().all(|c| c.is_finite())));
         let (lin, ang, sp, sl) = momenta(&p);
-        assert!(lin.norm() <= 1e-5 * sp, "linear momentum {lin:?}");
-        assert!(ang.norm() <= 1e-5 * sl, "angular momentum {ang:?}");
+        // Relative to the largest of the run, as `released` takes them: the body leaves the
+        // line (the volume constraints' recovery direction) and comes to rest.
+        (sp_max, sl_max) = (sp_max.max(sp), sl_max.max(sl));
+        assert!(lin.norm() <= 1e-5 * sp_max, "linear momentum {lin:?}");
+        assert!(ang.norm() <= 1e-5 * sl_max, "angular momentum {ang:?}");
     }
     assert!(clamps > 0, "the net acts");
 }

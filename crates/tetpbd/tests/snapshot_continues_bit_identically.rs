@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use tetpbd::generators::{ball, CellSplit};
 use tetpbd::{
     Activation, EdgeConstraints, Particles, SoftBodyBuilder, Solver, SolverSettings, Surface,
-    Tetrahedra, VertexFaceConstraints, VolumeConstraints,
+    Tetrahedra, Untangle, VertexFaceConstraints, VolumeConstraints,
 };
 
 /// One body's components, as an application would store them.
@@ -21,6 +21,7 @@ struct Snapshot {
     vertex_face: Option<VertexFaceConstraints>,
     volume: Option<VolumeConstraints>,
     activation: Option<Activation>,
+    untangle: Option<Untangle>,
     settings: SolverSettings,
 }
 
@@ -39,6 +40,7 @@ fn take(world: &World, e: Entity, settings: &SolverSettings) -> Snapshot {
             .ok()
             .map(|c| (*c).clone()),
         activation: world.get::<&Activation>(e).ok().map(|a| *a),
+        untangle: world.get::<&Untangle>(e).ok().map(|u| (*u).clone()),
         settings: settings.clone(),
     }
 }
@@ -57,6 +59,9 @@ fn restore(s: Snapshot, world: &mut World) -> (Entity, SolverSettings) {
     }
     if let Some(a) = s.activation {
         b.add(a);
+    }
+    if let Some(u) = s.untangle {
+        b.add(u);
     }
     (world.spawn(b.build()), s.settings)
 }

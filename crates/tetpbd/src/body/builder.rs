@@ -53,6 +53,7 @@ impl SoftBody {
         let mut b = hecs::EntityBuilder::new();
         b.add(self.particles).add(self.tetrahedra).add(self.surface);
         b.add(crate::Activation::default());
+        b.add(crate::Untangle::default());
         if let Some(e) = self.edges {
             b.add(e);
         }

@@ -57,6 +57,15 @@
 //!
 //! Against something that moves, [`ImpactReach::take_excess`] returns the multiplier the
 //! other side takes, as `tetpbd-rapier`'s contacts use it.
+//!
+//! The reach bounds how deep a particle goes, not how fast the body behind a stopped surface
+//! keeps coming: a compliant body at short substeps runs through its own stopped surface
+//! layer. Against something immovable, [`ImpactReach::limit_approach`] takes the whole
+//! body's approach beyond what its constraints carry within a substep
+//! ([`crate::impact_speed`]) before the particles are pushed out (the stability matrix's
+//! ground does); [`ImpactReach::limit_relative_approach`] against something immovable
+//! that itself moves, after the contacts are projected (`tetpbd-rapier` does, along the
+//! mean normal of a body's contacts with fixed, kinematic and supported bodies).
 
 use nalgebra::Vector3;
 
@@ -167,6 +176,51 @@ impl ImpactReach {
             .map_or(0.0, |(_, excess)| excess);
         p.positions_mut()[i] += dir * (depth - taken);
     }
+
+    /// For a body in contact with something immovable that pushes its particles out along
+    /// the unit direction `dir`: if the centre of mass of its free particles moved against
+    /// `dir` by more than `limit` (m) since the substep began (its previous positions), the
+    /// whole body is moved back along `dir` by the excess, which takes the excess off its
+    /// approach speed ([`crate::impact_speed`]: `limit` from
+    /// [`crate::impact_speed::approach_limit`]). Returns the distance moved, m; 0 when the
+    /// body approaches slower, cannot move, or `limit` is not a finite non-negative length.
+    pub fn limit_approach(&mut self, p: &mut Particles, dir: &Vector3<f32>, limit: f32) -> f32 {
+        self.limit_relative_approach(p, dir, 0.0, limit)
+    }
+
+    /// [`Self::limit_approach`] against something immovable by the body that itself moved
+    /// `toward` (m) against `dir`, towards the body, since the substep began (a kinematic
+    /// collider): the approach is the body's step along `−dir` plus `toward`. The whole body
+    /// may then be moved along `dir` farther than it came (it is carried along). 0 when
+    /// `toward` is not finite.
+    pub fn limit_relative_approach(
+        &mut self,
+        p: &mut Particles,
+        dir: &Vector3<f32>,
+        toward: f32,
+        limit: f32,
+    ) -> f32 {
+        if !(limit.is_finite() && limit >= 0.0 && toward.is_finite()) {
+            return 0.0;
+        }
+        let (mut step, mut mass) = (Vector3::zeros(), 0.0f32);
+        for i in 0..p.len() {
+            if p.inv_masses()[i] > 0.0 {
+                let m = p.masses()[i];
+                step += (p.positions()[i] - p.prev_positions()[i]) * m;
+                mass += m;
+            }
+        }
+        if mass <= 0.0 {
+            return 0.0;
+        }
+        let excess = -step.dot(dir) / mass + toward - limit;
+        if !(excess.is_finite() && excess > 0.0) {
+            return 0.0;
+        }
+        translate_free(p, &(dir * excess));
+        excess
+    }
 }
 
 /// Moves every free particle by `dx`, m.
@@ -261,6 +315,83 @@ mod tests {
             let expected = if i == 3 { 0.5 * reach } else { 0.0 };
             assert!((x.y - x0.y - expected).abs() < 1e-6);
         }
+    }
+
+    #[test]
+    fn a_body_approaching_faster_than_the_limit_is_moved_back_by_the_excess_only() {
+        for (step, limit) in [(0.5f32, 0.01f32), (0.06, 0.03), (0.02, 0.03), (0.01, 0.0)] {
+            let (mut p, s) = cube(0.5);
+            let mut impact = ImpactReach::of(&p, &s);
+            // The body moved `step` down this substep, one particle twice as far.
+            for i in 0..p.len() {
+                p.positions_mut()[i].y -= if i == 7 { 2.0 * step } else { step };
+            }
+            let before: Vec<_> = p.positions().to_vec();
+            let m = p.total_mass();
+            let approach = |p: &Particles| {
+                let d: f32 = (0..p.len())
+                    .map(|i| (p.prev_positions()[i].y - p.positions()[i].y) * p.masses()[i])
+                    .sum();
+                d / m
+            };
+            let came = approach(&p);
+            let moved = impact.limit_approach(&mut p, &Vector3::y(), limit);
+            let expected = (came - limit).max(0.0);
+            assert!(
+                (moved - expected).abs() < 1e-5,
+                "step {step}: moved {moved}"
+            );
+            // Rigidly: every particle by the same distance, the shape untouched.
+            for (x, b) in p.positions().iter().zip(&before) {
+                assert!(((x - b) - Vector3::y() * moved).norm() < 1e-5);
+            }
+            assert!(approach(&p) <= limit + 1e-5 || moved == 0.0);
+        }
+    }
+
+    #[test]
+    fn something_immovable_coming_at_the_body_counts_in_its_approach() {
+        for (step, toward, limit) in [
+            (0.0f32, 0.05f32, 0.01f32),
+            (0.02, 0.03, 0.01),
+            (0.0, 0.005, 0.01),
+        ] {
+            let (mut p, s) = cube(0.5);
+            let mut impact = ImpactReach::of(&p, &s);
+            for i in 0..p.len() {
+                p.positions_mut()[i].y -= step;
+            }
+            let moved = impact.limit_relative_approach(&mut p, &Vector3::y(), toward, limit);
+            let expected = (step + toward - limit).max(0.0);
+            assert!(
+                (moved - expected).abs() < 1e-5,
+                "{step} {toward}: moved {moved}"
+            );
+        }
+        let (mut p, s) = cube(0.5);
+        let mut impact = ImpactReach::of(&p, &s);
+        assert_eq!(
+            impact.limit_relative_approach(&mut p, &Vector3::y(), f32::NAN, 0.0),
+            0.0
+        );
+    }
+
+    #[test]
+    fn the_approach_limit_moves_no_pinned_body_and_takes_no_bad_limit() {
+        let (mut p, s) = cube(0.5);
+        for i in 0..p.len() {
+            p.positions_mut()[i].y -= 0.5;
+        }
+        let mut impact = ImpactReach::of(&p, &s);
+        for limit in [f32::NAN, f32::INFINITY, -1.0] {
+            assert_eq!(impact.limit_approach(&mut p, &Vector3::y(), limit), 0.0);
+        }
+        for i in 0..p.len() {
+            p.set_pinned(i, true).unwrap();
+        }
+        let before: Vec<_> = p.positions().to_vec();
+        assert_eq!(impact.limit_approach(&mut p, &Vector3::y(), 0.0), 0.0);
+        assert_eq!(p.positions(), &before[..]);
     }
 
     #[test]

@@ -19,6 +19,7 @@ use crate::body::split::{pieces, separate};
 use crate::body::tearing::{face_key, Pieces, Tearing};
 use crate::constraints::signed_volume;
 use crate::stabilisation::deformation_damping::DeformationDamping;
+use crate::stabilisation::untangle::Untangle;
 
 /// One piece of a body after a split.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -129,6 +130,15 @@ pub(crate) fn split_body(
     tetrahedra.indices = sep.tets;
     let (piece_of, count) = pieces(&tetrahedra.indices, particles.len());
     let count = if mode == Pieces::KeepOne { 1 } else { count };
+    let origin: Vec<u32> = (0..before as u32)
+        .chain(sep.origin.iter().copied())
+        .collect();
+    let mut old_edges: Vec<([u32; 2], u32)> = edges.map_or(Vec::new(), |e| {
+        (e.edges.iter().enumerate())
+            .map(|(k, &[a, b])| ([a.min(b), a.max(b)], k as u32))
+            .collect()
+    });
+    old_edges.sort_unstable();
     let split = SplitBody {
         particles,
         tetrahedra,
@@ -139,6 +149,8 @@ pub(crate) fn split_body(
         material,
         tearing: tearing.as_deref(),
         forces,
+        origin: &origin,
+        old_edges: &old_edges,
     };
     let built: Vec<(PieceParts, Vec<u32>)> = (0..count as u32)
         .map(|k| {
@@ -249,6 +261,9 @@ fn place_pieces(
     event: &mut TearEvent,
 ) {
     let activation = world.get::<&Activation>(entity).ok().map(|a| *a);
+    // Each piece is untangled as the body was (or not, without the component), from a fresh
+    // state: the body's windows and moves describe a shape that no longer exists.
+    let untangle = world.get::<&Untangle>(entity).ok().map(|u| u.restarted());
     let damping = world.get::<&DeformationDamping>(entity).ok().map(|d| *d);
     let accel = world.get::<&ExternalAcceleration>(entity).ok().map(|a| *a);
     let grab = world.get::<&Grab>(entity).ok().map(|g| (*g).clone());
@@ -270,6 +285,9 @@ fn place_pieces(
             entity
         } else {
             let e = body.spawn(world);
+            if untangle.is_none() {
+                let _ = world.remove_one::<Untangle>(e);
+            }
             if let Some(a) = activation {
                 let mut a = a;
                 a.restart();
@@ -283,6 +301,9 @@ fn place_pieces(
             }
             e
         };
+        if let Some(u) = &untangle {
+            let _ = world.insert_one(target, u.clone());
+        }
         if let Some(f) = forces {
             let _ = world.insert_one(target, f);
         }

@@ -5,7 +5,19 @@
 //! builds it (solver order and colour classes, edges and their rest lengths, surface), from
 //! the rest positions. What belongs to a tetrahedron travels with it: its rest volume,
 //! vertex–face rest heights, the material's rest shape and its plastic stretch; what belongs to a
-//! particle travels with it: position, velocity, masses, rest position, residual, forces.
+//! particle travels with it: position, velocity, masses, rest position, residual, forces,
+//! and the multipliers of the last substep (the tear's energy bound reads them,
+//! `crate::body::tear_relaxation`; the solver resets them each substep).
+//!
+//! A piece whose families leave its shape free is a degenerate fragment: without edges or a
+//! material, vertex–face and volume constraints fix four and one of a tetrahedron's six
+//! shape degrees of freedom, which a mesh's neighbours make up for but a single tetrahedron
+//! or a few split off do not (`4T + T < 3n − 6` for `T` tetrahedra over `n` particles), and
+//! such a piece shears, inverts and gains energy from its contacts. It gets edge constraints
+//! (at the vertex–face compliance, m/N, or hard for volumes alone) and starts in its rest
+//! shape, moved rigidly onto its current one (centre of mass and best rotation), moving with
+//! the rigid fit of its velocities: its momentum is kept, its deformation and the kinetic
+//! energy of its deformation are dropped.
 
 use nalgebra::Vector3;
 
@@ -33,6 +45,11 @@ pub(crate) struct SplitBody<'a> {
     pub material: Option<&'a NeoHookeanMaterial>,
     pub tearing: Option<&'a Tearing>,
     pub forces: Option<&'a UserForces>,
+    /// The particle each particle of the split body was before the split: itself, or for a
+    /// copy the particle it copies.
+    pub origin: &'a [u32],
+    /// The edges of the body before the split as sorted particle pairs, with their index.
+    pub old_edges: &'a [([u32; 2], u32)],
 }
 
 /// The rebuilt components of one piece.
@@ -53,7 +70,10 @@ pub(crate) fn assemble(b: &SplitBody, particles: &[u32], tets: &[u32]) -> PieceP
     for (k, &i) in particles.iter().enumerate() {
         local[i as usize] = k as u32;
     }
-    let new_particles = piece_particles(p, particles);
+    let mut new_particles = piece_particles(p, particles);
+    if shape_edges(b, tets.len(), particles.len()).is_some() {
+        settle_rigidly(&mut new_particles);
+    }
     let rest = &new_particles.rest_positions;
     let local_tets: Vec<[u32; 4]> = tets
         .iter()
@@ -78,22 +98,27 @@ pub(crate) fn assemble(b: &SplitBody, particles: &[u32], tets: &[u32]) -> PieceP
         vertices: rest.clone(),
         tets: tetrahedra.indices.clone(),
     };
-    let mut edges = b
+    let edge_compliance = b
         .edges
-        .map(|e| edge_constraints(&mesh, &part_of, parts, e.compliance));
+        .map(|e| e.compliance)
+        .or_else(|| shape_edges(b, count, rest.len()));
+    let mut edges = edge_compliance.map(|alpha| edge_constraints(&mesh, &part_of, parts, alpha));
+    if let (Some(e), Some(old)) = (edges.as_mut(), b.edges) {
+        carry_edge_multipliers(e, old, b, particles);
+    }
     let mut vertex_face = b.vertex_face.map(|v| VertexFaceConstraints {
         rest_heights: from.iter().map(|t| v.rest_heights[pick(t)]).collect(),
-        lambdas: vec![[0.0; 4]; count],
+        lambdas: from.iter().map(|t| v.lambdas[pick(t)]).collect(),
         compliance: v.compliance,
     });
     let volume = b.volume.map(|v| VolumeConstraints {
-        lambdas: vec![0.0; count],
+        lambdas: from.iter().map(|t| v.lambdas[pick(t)]).collect(),
         compliance: v.compliance,
     });
     let mut material = b.material.map(|m| NeoHookeanMaterial {
         material: m.material,
         rest_inverse: from.iter().map(|t| m.rest_inverse[pick(t)]).collect(),
-        lambdas: vec![[0.0; 2]; count],
+        lambdas: from.iter().map(|t| m.lambdas[pick(t)]).collect(),
         released: 0.0,
         tet_released: ReleasedScratch(vec![0.0; count]),
     });
@@ -140,6 +165,92 @@ pub(crate) fn assemble(b: &SplitBody, particles: &[u32], tets: &[u32]) -> PieceP
         forces,
         particles: particles.to_vec(),
         from,
+    }
+}
+
+/// The compliance of the edges a piece of `count` tetrahedra over `n` particles gets when its
+/// families leave its shape free (module docs): `Some` for a body without edges or a material
+/// whose vertex–face and volume constraints (four and one per tetrahedron) are fewer than the
+/// piece's `3n − 6` shape degrees of freedom; the vertex–face family's compliance (m/N, the
+/// same units as an edge's), or 0 for volumes alone.
+fn shape_edges(b: &SplitBody, count: usize, n: usize) -> Option<f32> {
+    if b.edges.is_some() || b.material.is_some() {
+        return None;
+    }
+    let per_tet = 4 * usize::from(b.vertex_face.is_some()) + usize::from(b.volume.is_some());
+    if per_tet * count >= (3 * n).saturating_sub(6) {
+        return None;
+    }
+    Some(b.vertex_face.map_or(0.0, |v| v.compliance))
+}
+
+/// Gives each edge of a piece (its particles `particles` of the split body) the multiplier
+/// of the edge of the body before the split it comes from (the energy bound reads them,
+/// `crate::body::tear_relaxation`; the solver resets them each substep).
+fn carry_edge_multipliers(
+    e: &mut EdgeConstraints,
+    old: &EdgeConstraints,
+    b: &SplitBody,
+    particles: &[u32],
+) {
+    for (k, &[i, j]) in e.edges.iter().enumerate() {
+        let o = |l: u32| b.origin[particles[l as usize] as usize];
+        let (a, c) = (o(i), o(j));
+        let key = [a.min(c), a.max(c)];
+        if let Ok(at) = b.old_edges.binary_search_by_key(&key, |x| x.0) {
+            e.lambdas[k] = old.lambdas[b.old_edges[at].1 as usize];
+        }
+    }
+}
+
+/// Puts a fragment in its rest shape, moved rigidly to fit its particles (centre of mass and
+/// best rotation of the rest shape onto the current one), moving with the rigid fit of its
+/// velocities (its linear and angular momentum): its deformation and the kinetic energy of
+/// its deformation are dropped. Pinned particles, or a fit that is not defined, leave it as
+/// it is.
+fn settle_rigidly(p: &mut Particles) {
+    if p.inv_masses.contains(&0.0) {
+        return;
+    }
+    let Some(fit) = p.rigid_fit() else {
+        return;
+    };
+    let total: f64 = p.masses.iter().map(|&m| f64::from(m)).sum();
+    if total.is_nan() || total <= 0.0 {
+        return;
+    }
+    let rest_centre: Vector3<f64> = p
+        .rest_positions
+        .iter()
+        .zip(&p.masses)
+        .map(|(r, &m)| r.cast::<f64>() * f64::from(m))
+        .sum::<Vector3<f64>>()
+        / total;
+    let c = fit.centre.cast::<f64>();
+    let mut a = nalgebra::Matrix3::<f64>::zeros();
+    for ((x, r), &m) in p.positions.iter().zip(&p.rest_positions).zip(&p.masses) {
+        a += (x.cast::<f64>() - c) * (r.cast::<f64>() - rest_centre).transpose() * f64::from(m);
+    }
+    let svd = a.svd(true, true);
+    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return;
+    };
+    let mut d = nalgebra::Matrix3::<f64>::identity();
+    d[(2, 2)] = (u * v_t).determinant().signum();
+    let rot = u * d * v_t;
+    if !rot.iter().all(|x| x.is_finite()) {
+        return;
+    }
+    let (vc, omega) = (
+        fit.velocity.cast::<f64>(),
+        fit.angular_velocity.cast::<f64>(),
+    );
+    for i in 0..p.positions.len() {
+        let x = c + rot * (p.rest_positions[i].cast::<f64>() - rest_centre);
+        let v = vc + omega.cross(&(x - c));
+        p.positions[i] = x.cast::<f32>();
+        p.prev_positions[i] = p.positions[i];
+        p.velocities[i] = v.cast::<f32>();
     }
 }
 

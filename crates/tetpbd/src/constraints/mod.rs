@@ -28,7 +28,8 @@
 //! * [`vertex_face()`] — the seed's vertex–face constraint (`vertex_face.rs`), and
 //!   [`vertex_face_bounded()`], the degeneracy-aware form the solver runs
 //!   (`vertex_face_bounded.rs`);
-//! * [`volume()`] — signed volume (`volume.rs`);
+//! * [`volume()`] — signed volume, and [`volume_recovering`], the form with the recovery
+//!   direction of a tetrahedron collapsed onto a line that the solver runs (`volume.rs`);
 //! * [`neo_hookean_deviatoric`] and [`neo_hookean_hydrostatic`] — the stable Neo-Hookean
 //!   material's two constraints per tetrahedron, solved together by
 //!   [`neo_hookean_update`] (`neo_hookean.rs`), and
@@ -62,7 +63,7 @@ pub use vertex_face::{
     signed_height, vertex_face, vertex_face_step_bound, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER,
 };
 pub use vertex_face_bounded::{bounded_height, vertex_face_bounded, VERTEX_FACE_KAPPA};
-pub use volume::{signed_volume, volume};
+pub use volume::{signed_volume, volume, volume_recovering, VOLUME_GATE};
 pub use xpbd::{apply, bounded_step, xpbd_delta_lambda};
 
 /// A constraint value with its gradients with respect to each of its `N` particles.

@@ -54,7 +54,7 @@ use super::Evaluated;
 
 /// The largest collapse threshold: the recovery direction acts only on tetrahedra crushed
 /// below about a tenth of their rest size (`‖cof F‖_F < √3 · 0.01`).
-const TAU_CAP: f64 = 0.01;
+pub const TAU_CAP: f64 = 0.01;
 
 /// The collapse threshold `τ = min(4 (μ/(λ' + μ))², 0.01)` of
 /// [`neo_hookean_hydrostatic_recovering`] (dimensionless), `μ`, `λ'` in Pa: twice the

@@ -1,7 +1,8 @@
 //! The signed volume constraint.
 
-use nalgebra::{RealField, Vector3};
+use nalgebra::{Matrix3, RealField, Vector3};
 
+use super::neo_hookean_recovery::{neo_hookean_hydrostatic_recovering, TAU_CAP};
 use super::Evaluated;
 
 // ---------------------------------------------------------------------------------------
@@ -54,5 +55,50 @@ pub fn volume<T: RealField + Copy>(
     Evaluated {
         c: a.dot(&b.cross(&c)) * sixth - rest_volume,
         grad: [g0, g1, g2, g3],
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// A volume constraint with no direction.
+//
+// With Ds = [p1 − p0, p2 − p0, p3 − p0] = F Dm (Dm the rest edges, F the deformation
+// gradient), V = det Ds / 6 = V₀ det F and ∂V/∂Ds = V₀ cof F Dm⁻ᵀ: the gradient vanishes
+// with cof F, for every F of rank ≤ 1 (the four points on a line or at a point). A line is
+// then invariant: edges along it keep their particles on it, the volume constraints have
+// no direction, and a body collapsed onto a line stays there (a point collapse whose
+// zero-length edges re-expand along their rest directions one after another strings the
+// body out along the first one). The way out is the Neo-Hookean material's
+// (`neo_hookean_recovery.rs`): where ‖cof F‖_F < √3 τ the constraint is projected along
+// V₀ (cof F + b I) Dm⁻ᵀ, b = 1 − ‖cof F‖_F / (√3 τ), the rest gradient blended in
+// continuously; τ is that module's cap (only tetrahedra crushed below about a tenth of
+// their rest size are touched). V − V₀ = V₀ (det F − 1) is the hydrostatic constraint with
+// γ = 1 scaled by V₀: one implementation of the direction for both.
+// ---------------------------------------------------------------------------------------
+
+/// Below this, `(Σᵢ |∇ᵢC|²)³ < VOLUME_GATE · V₀⁴` (dimensionless), a volume constraint's
+/// gradient is weak enough that the kernels evaluate [`volume_recovering`]: about 100 times
+/// the value at the recovery region's edge on a regular tetrahedron (`Σ|∇C|² ≈ 1.16 V₀^{4/3}`
+/// at rest, `τ²` of that at the edge), so the region is always inside the gate.
+pub const VOLUME_GATE: f64 = 1e-6;
+
+/// The signed volume constraint `C = V − V₀` (m³, as [`volume`]) with the recovery direction
+/// of a tetrahedron collapsed onto a line or a point: particle directions (m²) the columns
+/// of `V₀ G Dm⁻ᵀ`, `∇p0 = −Σ`, `G = cof F + b I`, `b = max(0, 1 − ‖cof F‖_F / (√3 τ))`,
+/// `τ = 0.01`, `F = Ds Dm⁻¹` with `dm_inv` the inverse of the rest edge matrix (1/m).
+///
+/// Equal to [`volume`] (value and gradients) wherever `‖cof F‖_F ≥ √3 τ`; inside, the rest
+/// gradient blended in continuously (a search direction, not a gradient; theory in the
+/// module source). Always finite for finite input.
+#[inline]
+pub fn volume_recovering<T: RealField + Copy>(
+    p: &[Vector3<T>; 4],
+    dm_inv: &Matrix3<T>,
+    rest_volume: T,
+) -> Evaluated<T, 4> {
+    let tau = nalgebra::convert::<f64, T>(TAU_CAP);
+    let e = neo_hookean_hydrostatic_recovering(p, dm_inv, T::one(), tau);
+    Evaluated {
+        c: signed_volume(&p[0], &p[1], &p[2], &p[3]) - rest_volume,
+        grad: e.grad.map(|g| g * rest_volume),
     }
 }

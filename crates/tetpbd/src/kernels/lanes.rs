@@ -324,7 +324,19 @@ pub(crate) fn volumes<L: Lane, A: ParticleAccess>(
     let g0 = g1.add(g2).add(g3).neg();
     let cval = a.dot(bc) * sixth - lanes_of(rest, at);
     let g = [g0, g1, g2, g3];
-    let w_grad_sq = (0..4).fold(L::ZERO, |s, k| s + w[k] * g[k].dot(g[k]));
+    let (s0, s1, s2, s3) = (g0.dot(g0), g1.dot(g1), g2.dot(g2), g3.dot(g3));
+    let v0: L = lanes_of(rest, at);
+    // (q / |V₀|)³ < gate · |V₀|, q = Σ|∇C|²: scalar::volume_gradient_weak, lane by lane.
+    let v = v0.vmax(-v0);
+    let r = (s0 + s1 + s2 + s3) / v;
+    if (L::splat(crate::constraints::VOLUME_GATE as f32) * v)
+        .vgt(r * r * r)
+        .vbits()
+        != 0
+    {
+        return volumes_scalar::<L, A>(bd, at, rest, lambdas, alpha_tilde);
+    }
+    let w_grad_sq = w[0] * s0 + w[1] * s1 + w[2] * s2 + w[3] * s3;
     let lam: L = lanes_of(lambdas, at);
     let (dl, ok) = delta_lambda(cval, lam, L::splat(alpha_tilde), w_grad_sq);
     store_lanes(lam + dl, lambdas, at);
@@ -336,6 +348,38 @@ pub(crate) fn volumes<L: Lane, A: ParticleAccess>(
         applied: u64::from(ok.vbits().count_ones()),
         degenerate: u64::from((!ok.vbits() & any_free.vbits() & all_lanes::<L>()).count_ones()),
     }
+}
+
+/// [`volumes`] of a chunk with a lane whose gradient is weak
+/// ([`scalar::volume_gradient_weak`]): a pair of chunks chunk by chunk, a chunk of four
+/// through the scalar kernel, which owns the recovery direction.
+#[cold]
+fn volumes_scalar<L: Lane, A: ParticleAccess>(
+    bd: &mut Bounded<'_, A, 4>,
+    at: usize,
+    rest: &[f32],
+    lambdas: &mut [f32],
+    alpha_tilde: f32,
+) -> ProjectionCount {
+    let mut count = ProjectionCount::default();
+    if L::WIDTH > LANES {
+        for c in (0..L::WIDTH).step_by(LANES) {
+            count += volumes::<f32x4, A>(bd, at + c, rest, lambdas, alpha_tilde);
+        }
+        return count;
+    }
+    let tets = *chunk(bd.items(), at);
+    for (l, &t) in tets.iter().enumerate() {
+        let k = at + l;
+        count.add(scalar::volume(
+            bd.acc(),
+            t,
+            rest[k],
+            &mut lambdas[k],
+            alpha_tilde,
+        ));
+    }
+    count
 }
 
 /// The four vertex–face constraints of `L::WIDTH` tetrahedra from `at` of the run, the four

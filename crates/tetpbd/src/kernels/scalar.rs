@@ -181,8 +181,10 @@ pub(crate) fn vertex_face_held<A: ParticleAccess>(
     (applied, degenerate)
 }
 
-/// The signed volume constraint of one tetrahedron. Vanishing gradients (all four points
-/// collinear) skip it.
+/// The signed volume constraint of one tetrahedron. A weak gradient
+/// ([`volume_gradient_weak`]: the four points near a line or a point) takes the recovery
+/// direction of [`constraints::volume_recovering`] from the rest positions; a rest shape with
+/// no inverse, or vanishing directions, skip it.
 #[inline(always)]
 pub(crate) fn volume<A: ParticleAccess>(
     acc: &mut A,
@@ -193,14 +195,38 @@ pub(crate) fn volume<A: ParticleAccess>(
 ) -> Outcome {
     let idx = tet.map(|i| i as usize);
     let p = idx.map(|i| acc.x(i));
-    let e = constraints::volume(&p[0], &p[1], &p[2], &p[3], rest_volume);
+    let mut e = constraints::volume(&p[0], &p[1], &p[2], &p[3], rest_volume);
+    let q = e.grad.iter().fold(0.0f32, |s, g| s + g.norm_squared());
+    let weak = volume_gradient_weak(q, rest_volume);
+    if weak {
+        let r = idx.map(|i| acc.rest(i));
+        let dm = nalgebra::Matrix3::from_columns(&[r[1] - r[0], r[2] - r[0], r[3] - r[0]]);
+        if let Some(dm_inv) = dm.try_inverse() {
+            e = constraints::volume_recovering(&p, &dm_inv, rest_volume);
+        }
+    }
     if apply(acc, idx, &e, lambda, alpha_tilde, f32::INFINITY) {
-        Outcome::Applied
+        if weak {
+            Outcome::Degenerate
+        } else {
+            Outcome::Applied
+        }
     } else if idx.iter().any(|&i| acc.w(i) > 0.0) {
         Outcome::Degenerate
     } else {
         Outcome::Skipped
     }
+}
+
+/// Whether a volume constraint's gradient is weak enough for the recovery direction:
+/// `q³ < VOLUME_GATE · V₀⁴`, `q = Σᵢ |∇ᵢC|²` (m⁴), `V₀` the rest volume (m³), evaluated as
+/// `(q/|V₀|)³ < VOLUME_GATE · |V₀|` (terms of the order of the tetrahedron's size cubed: no
+/// underflow on small bodies). The SIMD kernel hands a chunk with such a lane to [`volume`].
+#[inline(always)]
+pub(crate) fn volume_gradient_weak(q: f32, rest_volume: f32) -> bool {
+    let v = rest_volume.abs();
+    let r = q / v;
+    r * r * r < constraints::VOLUME_GATE as f32 * v
 }
 
 /// Constraint `k`'s entry of a run's held masks (`1.0` held, `0.0` left alone; an empty

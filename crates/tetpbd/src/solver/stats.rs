@@ -76,6 +76,9 @@ pub struct StepStats {
     pub bodies_fell_asleep: usize,
     /// Bodies asleep at the end of the step.
     pub bodies_asleep_after: usize,
+    /// Bodies found tangled at the end of the step and moved towards their rest shape
+    /// ([`crate::Untangle`]).
+    pub bodies_untangled: usize,
     /// Number of particles over the awake bodies.
     pub particles: usize,
     /// Substeps run.

@@ -113,6 +113,7 @@ impl Solver {
         // hook sees one mesh per frame.
         let t = Instant::now();
         self.events.clear();
+        crate::body::tear_relaxation::relax(world, dt, frame.h(), gravity);
         let torn = systems::tear_faces(world, dt, frame.h(), &mut self.events);
         if let Ok(stats) = &mut out {
             stats.faces_torn = torn;
@@ -248,6 +249,11 @@ impl Solver {
         hook.touching(world, &mut sleep.touching);
         hook_time += t.elapsed();
         stats.hook_time = hook_time;
+        if !hook.moves_particles() {
+            let g = frame.gravity();
+            stats.bodies_untangled =
+                crate::stabilisation::untangle::untangle_bodies(world, frame.dt(), g);
+        }
         let slept = sleeping::fall_asleep(world, frame.dt(), &sleep.touching, &mut sleep.islands);
         stats.bodies_fell_asleep = slept.fell_asleep;
         stats.bodies_asleep_after = slept.asleep;

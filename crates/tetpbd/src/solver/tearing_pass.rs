@@ -61,6 +61,8 @@ pub fn tear_faces(world: &mut World, dt: f32, h: f32, events: &mut Vec<TearEvent
         // The faces just marked torn are in the body's `Tearing`, which the split reads.
         if let Some(mut event) = split_body(world, entity, &[], mode) {
             event.faces_torn = newly;
+            let pieces = event.pieces.iter().map(|p| p.entity);
+            crate::body::tear_relaxation::start(world, pieces, h);
             events.push(event);
         }
         total += newly;

@@ -15,7 +15,10 @@
 //! * [`deformation_damping`] — damping a body's velocities towards their rigid fit
 //!   ([`crate::DeformationDamping`], a component; run after every velocity update);
 //! * [`rigid_fit`] — the rigid fit of a field on a body's particles, the one every pass here
-//!   and the couplings use ([`crate::Particles::rigid_fit`]).
+//!   and the couplings use ([`crate::Particles::rigid_fit`]);
+//! * [`untangle`] — pulling a body that came to rest tangled (inverted tetrahedra, or elastic
+//!   energy no load explains) back to its best-fit rest shape ([`crate::Untangle`], a
+//!   component spawned with every body, on by default).
 
 pub(crate) mod angular_momentum;
 pub(crate) mod correction_energy;
@@ -26,3 +29,4 @@ pub(crate) mod ground_up_sweep;
 pub(crate) mod hook_work;
 pub(crate) mod momentum_restoration;
 pub(crate) mod rigid_fit;
+pub(crate) mod untangle;

@@ -1,0 +1,326 @@
+//! [`Untangle`]: a body that came to rest tangled is pulled back to its rest shape.
+//!
+//! # Why tangled bodies stay tangled
+//!
+//! A body released from a scrambled, collapsed or mirrored start may come to rest in a fold:
+//! a local minimum of its elastic energy where compliant constraints (or the Neo-Hookean
+//! material) balance each other, with tetrahedra inverted or the volume percents off, and
+//! energy stored that nothing outside holds. Hard constraints fight their way out (every
+//! violation is removed at once); compliant ones only feel the local gradient, and a local
+//! minimum has none. More substeps make it worse (stiffer per substep, calmer faster).
+//!
+//! # The rule
+//!
+//! A body is **tangled** when it is calm and yet
+//!
+//! * a tetrahedron is inverted, or
+//! * it stores elastic energy no external load explains: `U > 2 M |g + a| u_max` with
+//!   `u_max > 10⁻³ L` — `U` its elastic energy ([`ElasticFamilies`]), `M` its mass,
+//!   `g + a` gravity plus its [`crate::ExternalAcceleration`], `u_max` the largest distance of
+//!   a particle from its goal below, `L` its rest bounding-box diagonal. A uniform load
+//!   stores at most the work it does, `½ Σ fᵢ·uᵢ ≤ M |g| u_max` (supports included, whose
+//!   reactions sum to `−Mg`), so a body sagging under its weight is never tangled; without
+//!   a load any stored energy is unexplained.
+//!
+//! **Calm**, over a check window of half the body's time until sleep: no particle moved
+//! faster than the body's sleep threshold ([`crate::Activation::linear_threshold`])
+//! relative to the centre-of-mass velocity (a tangled body is caught before it falls
+//! asleep), or its kinetic energy relative to the centre of mass stayed below 10 % of its
+//! elastic energy `U` over that window and the one before (a fold with a slow jiggle left).
+//! A body vibrating freely about its rest shape trades all of `U` into kinetic energy every
+//! period; it can be caught only at a turning point of a vibration whose period exceeds
+//! about ten windows (5 s at the default time until sleep), and then the move only releases
+//! elastic energy (it damps that vibration). The body is checked once per window, and every
+//! frame while it is being moved.
+//!
+//! A tangled body is moved, at the end of a frame, towards its **goal**: its rest shape
+//! under the best-fit rigid transform, `gᵢ = c + R (Xᵢ − X_c)` with `c`, `X_c` the current
+//! and rest centres of mass and `R` the rotation of the polar decomposition of
+//! `Σ mᵢ (xᵢ − c)(Xᵢ − X_c)ᵀ` (shape matching, Müller et al. 2005): the one shape whose only
+//! energy minimum is the rest shape. The move is `xᵢ ← xᵢ + β (gᵢ − xᵢ)` on positions alone
+//! (velocities kept), `β = min(1, β₀ 2ᵏ)` after `k` consecutive moves (`β₀ = 1/8`: paced,
+//! then escalating until the fold is left, at most four frames from the first move to the
+//! goal itself).
+//!
+//! **Energy.** The move is taken only where it releases elastic energy:
+//! `U(x + β(g − x)) ≤ U(x)`; otherwise `β` doubles until it does, which it does at `β = 1`
+//! (the goal stores none). The kinetic energy is unchanged (velocities kept), so the body's
+//! mechanical energy never grows. Linear momentum is kept (the goal keeps the centre of
+//! mass; velocities untouched). A body that moved restarts its sleep timer.
+//!
+//! **Scope.** Free bodies of an uncoupled world: not with a hook that moves particles (a
+//! coupling's contacts are loads the core does not see: a heavy box on a soft slab stores
+//! energy the slab's weight does not explain), not with a pinned particle, a
+//! [`crate::Grab`], [`crate::UserForces`], [`crate::Plasticity`] (its rest shape flows) or
+//! [`crate::Tearing`] (torn pieces have no common rest shape); not asleep.
+
+use hecs::World;
+use nalgebra::{Matrix3, Vector3};
+
+use crate::body::activation::{Activation, Asleep};
+use crate::body::elastic_energy::ElasticFamilies;
+use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::body::mesh::Tetrahedra;
+use crate::body::neo_hookean::NeoHookeanMaterial;
+use crate::body::particles::{ExternalAcceleration, Particles};
+
+/// The first move's fraction of the way to the goal.
+const FIRST_STEP: f32 = 0.125;
+/// The largest kinetic energy, as a fraction of the stored elastic energy, over the last two
+/// check windows of a calm body that moves faster than the sleep threshold.
+const KINETIC_FRACTION: f64 = 0.1;
+/// The smallest distance from the goal, as a fraction of the rest bounding-box diagonal, at
+/// which stored energy counts as a tangle.
+const DISTANCE_FLOOR: f32 = 1e-3;
+
+/// A body's tangle recovery (a hecs component, spawned with every body by
+/// [`crate::SoftBody::spawn`]; a body without it is never untangled). Rule in the module
+/// docs.
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Untangle {
+    /// `true`: the body is never untangled.
+    pub disabled: bool,
+    window: f32,
+    slow: bool,
+    kinetic_peak: f64,
+    kinetic_before: f64,
+    moves: u32,
+    /// Scratch: the goal and a trial move (filled only when the body is tangled: its first
+    /// move allocates them, once).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    goals: Vec<Vector3<f32>>,
+    #[cfg_attr(feature = "serde", serde(skip))]
+    trial: Vec<Vector3<f32>>,
+}
+
+impl Default for Untangle {
+    fn default() -> Self {
+        Untangle {
+            disabled: false,
+            window: 0.0,
+            slow: true,
+            kinetic_peak: 0.0,
+            kinetic_before: 0.0,
+            moves: 0,
+            goals: Vec::new(),
+            trial: Vec::new(),
+        }
+    }
+}
+
+impl PartialEq for Untangle {
+    fn eq(&self, o: &Untangle) -> bool {
+        // Every field but the scratch, which is neither state nor serialized.
+        self.disabled == o.disabled
+            && self.window == o.window
+            && self.slow == o.slow
+            && self.kinetic_peak == o.kinetic_peak
+            && self.kinetic_before == o.kinetic_before
+            && self.moves == o.moves
+    }
+}
+
+/// How calm a body was over the window since its last check.
+#[derive(Clone, Copy)]
+struct Calm {
+    /// No particle faster than the sleep threshold relative to the centre of mass.
+    slow: bool,
+    /// The largest kinetic energy relative to the centre of mass over this window and the
+    /// one before, J.
+    kinetic_peak: f64,
+}
+
+impl Calm {
+    /// Calm: slow, or moving with at most [`KINETIC_FRACTION`] of the stored energy `u` (J).
+    fn holds(&self, u: f64) -> bool {
+        self.slow || self.kinetic_peak < KINETIC_FRACTION * u
+    }
+}
+
+impl Untangle {
+    /// Consecutive frames the body has been moved towards its goal (0: not tangled).
+    pub fn moves(&self) -> u32 {
+        self.moves
+    }
+
+    /// The same settings from a fresh state (a piece of a torn body: the body's windows and
+    /// moves describe a shape that no longer exists).
+    pub(crate) fn restarted(&self) -> Untangle {
+        Untangle {
+            disabled: self.disabled,
+            ..Untangle::default()
+        }
+    }
+}
+
+/// Moves every tangled body towards its goal (module docs) at the end of a frame of length
+/// `dt` (s) under `gravity` (m/s²). Returns the bodies moved.
+pub(crate) fn untangle_bodies(world: &mut World, dt: f32, gravity: Vector3<f32>) -> usize {
+    let mut moved = 0;
+    let query = world
+        .query_mut::<(
+            &mut Particles,
+            &Tetrahedra,
+            &mut Untangle,
+            Option<&mut Activation>,
+            Option<&ExternalAcceleration>,
+            (
+                Option<&EdgeConstraints>,
+                Option<&VolumeConstraints>,
+                Option<&VertexFaceConstraints>,
+                Option<&NeoHookeanMaterial>,
+            ),
+        )>()
+        .without::<&Asleep>()
+        .without::<&crate::Grab>()
+        .without::<&crate::UserForces>()
+        .without::<&crate::Plasticity>()
+        .without::<&crate::Tearing>();
+    for (p, t, u, act, accel, (edges, volume, vertex_face, material)) in query {
+        if u.disabled || p.inv_masses.iter().any(|&w| w <= 0.0) {
+            continue;
+        }
+        let (threshold, calm_after) = act.as_ref().map_or(
+            (
+                Activation::DEFAULT_LINEAR_THRESHOLD,
+                Activation::DEFAULT_TIME_UNTIL_SLEEP,
+            ),
+            |a| (a.linear_threshold, a.time_until_sleep),
+        );
+        let (speed, kinetic) = internal_motion(p);
+        u.window += dt;
+        u.slow &= speed < threshold;
+        u.kinetic_peak = u.kinetic_peak.max(kinetic);
+        if u.moves == 0 && u.window < 0.5 * calm_after {
+            continue;
+        }
+        let calm = Calm {
+            slow: u.slow,
+            kinetic_peak: u.kinetic_peak.max(u.kinetic_before),
+        };
+        u.kinetic_before = u.kinetic_peak;
+        (u.window, u.slow, u.kinetic_peak) = (0.0, true, 0.0);
+        let families = ElasticFamilies {
+            edges,
+            volume,
+            vertex_face,
+            material,
+        };
+        let load = (gravity + accel.map_or(Vector3::zeros(), |a| a.0)).norm();
+        if !move_if_tangled(p, t, u, &families, load, calm) {
+            u.moves = 0;
+            continue;
+        }
+        moved += 1;
+        if let Some(a) = act {
+            a.restart();
+        }
+    }
+    moved
+}
+
+/// The largest particle speed (m/s) and the kinetic energy (J) relative to the
+/// centre-of-mass velocity.
+fn internal_motion(p: &Particles) -> (f32, f64) {
+    let m: f32 = p.masses.iter().sum();
+    if m <= 0.0 {
+        return (0.0, 0.0);
+    }
+    let vc = p
+        .velocities
+        .iter()
+        .zip(&p.masses)
+        .fold(Vector3::zeros(), |s, (v, &mi)| s + v * mi)
+        / m;
+    let (mut fastest, mut kinetic) = (0.0f32, 0.0f64);
+    for (v, &mi) in p.velocities.iter().zip(&p.masses) {
+        let s = (v - vc).norm_squared();
+        fastest = fastest.max(s);
+        kinetic += 0.5 * f64::from(mi) * f64::from(s);
+    }
+    (fastest.sqrt(), kinetic)
+}
+
+/// Checks whether the calm body `p` is tangled and, if so, moves it towards its goal
+/// (module docs); `load` is |g + a| (m/s²). Returns whether it moved.
+fn move_if_tangled(
+    p: &mut Particles,
+    t: &Tetrahedra,
+    u: &mut Untangle,
+    families: &ElasticFamilies<'_>,
+    load: f32,
+    calm: Calm,
+) -> bool {
+    let Some((c, xc, r)) = best_fit(p) else {
+        return false;
+    };
+    let goal = |x: &Vector3<f32>| (c + r * (x.cast::<f64>() - xc)).cast::<f32>();
+    let u_max = p
+        .rest_positions
+        .iter()
+        .zip(&p.positions)
+        .map(|(r, x)| (goal(r) - x).norm())
+        .fold(0.0f32, f32::max);
+    let (lo, hi) = p.rest_positions.iter().fold(
+        (Vector3::repeat(f32::MAX), Vector3::repeat(f32::MIN)),
+        |(lo, hi), x| (lo.inf(x), hi.sup(x)),
+    );
+    let size = (hi - lo).norm();
+    let mass: f64 = p.masses.iter().map(|&m| f64::from(m)).sum();
+    let energy = families.energy(t, &p.positions);
+    let unexplained =
+        u_max > DISTANCE_FLOOR * size && energy > 2.0 * mass * f64::from(load) * f64::from(u_max);
+    if !calm.holds(energy) || (!unexplained && t.count_inverted(&p.positions) == 0) {
+        return false;
+    }
+    // Only a tangled body fills the scratch: ordinary frames allocate nothing.
+    u.goals.clear();
+    u.goals.extend(p.rest_positions.iter().map(goal));
+    let mut beta = (FIRST_STEP * 2f32.powi(u.moves.min(8) as i32)).min(1.0);
+    loop {
+        u.trial.clear();
+        u.trial.extend(
+            p.positions
+                .iter()
+                .zip(&u.goals)
+                .map(|(x, g)| x + (g - x) * beta),
+        );
+        if beta >= 1.0 || families.energy(t, &u.trial) <= energy {
+            break;
+        }
+        beta = (2.0 * beta).min(1.0);
+    }
+    let to = if beta >= 1.0 { &u.goals } else { &u.trial };
+    p.positions.copy_from_slice(to);
+    u.moves += 1;
+    true
+}
+
+/// The best-fit rigid transform of the rest shape onto the current positions: current and
+/// rest centres of mass and the rotation (polar decomposition by SVD, reflection removed).
+fn best_fit(p: &Particles) -> Option<(Vector3<f64>, Vector3<f64>, Matrix3<f64>)> {
+    let mass: f64 = p.masses.iter().map(|&m| f64::from(m)).sum();
+    if mass <= 0.0 {
+        return None;
+    }
+    let (mut c, mut xc) = (Vector3::zeros(), Vector3::zeros());
+    for ((x, r), &m) in p.positions.iter().zip(&p.rest_positions).zip(&p.masses) {
+        c += x.cast::<f64>() * f64::from(m);
+        xc += r.cast::<f64>() * f64::from(m);
+    }
+    c /= mass;
+    xc /= mass;
+    let mut a = Matrix3::zeros();
+    for ((x, r), &m) in p.positions.iter().zip(&p.rest_positions).zip(&p.masses) {
+        a += (x.cast::<f64>() - c) * (r.cast::<f64>() - xc).transpose() * f64::from(m);
+    }
+    let svd = a.svd(true, true);
+    let (mut uu, vt) = (svd.u?, svd.v_t?);
+    if (uu * vt).determinant() < 0.0 {
+        let k = svd.singular_values.imin();
+        uu.column_mut(k).neg_mut();
+    }
+    let r = uu * vt;
+    r.iter().all(|v| v.is_finite()).then_some((c, xc, r))
+}
