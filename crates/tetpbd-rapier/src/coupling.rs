@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 
 use hecs::World;
 use nalgebra::Vector3;
-use rapier3d::dynamics::RigidBodySet;
+use rapier3d::dynamics::{MultibodyJointSet, RigidBodySet};
 use rapier3d::pipeline::QueryFilter;
 use tetpbd::{Solver, SolverSettings, SubstepHook};
 
@@ -310,7 +310,7 @@ impl Coupling {
             out?
         };
         let mut stats = std::mem::take(&mut self.frame.stats);
-        self.write_back(world, ctx.bodies, &mut stats);
+        self.write_back(world, (ctx.bodies, ctx.multibody_joints), &mut stats);
         let (waking, proxies) = (&mut self.frame.waking, &self.frame.bodies);
         waking.remember_rest(proxies, ctx.bodies, world);
         stats.soft = soft;
@@ -325,7 +325,13 @@ impl Coupling {
 
     /// Hands the soft reaction to the rapier bodies the soft bodies touched (module docs of
     /// [`Coupling`], step 3), and the anchored bodies' reaction to their dynamic supports.
-    fn write_back(&mut self, world: &World, bodies: &mut RigidBodySet, stats: &mut CouplingStats) {
+    /// A multibody link gets it through its multibody (`rigid::body::link` module docs).
+    fn write_back(
+        &mut self,
+        world: &World,
+        (bodies, multibodies): (&mut RigidBodySet, &mut MultibodyJointSet),
+        stats: &mut CouplingStats,
+    ) {
         // Only the bodies that get a reaction are borrowed mutably: `get_mut` marks a body
         // as modified for rapier's next step.
         for (i, b) in self.frame.bodies.iter().enumerate() {
@@ -333,6 +339,20 @@ impl Coupling {
                 continue;
             }
             let asleep = crate::sleeping::soft_asleep(&self.frame.waking, i, world);
+            let scratch = &mut self.frame.generalized;
+            if let Some(written) = b.write_back_link(bodies, multibodies, scratch) {
+                if !written {
+                    stats.non_finite_bodies += 1;
+                } else if let Some(rb) = bodies.get_mut(b.handle) {
+                    stats.bodies_written += 1;
+                    if asleep {
+                        rb.sleep();
+                    } else {
+                        rb.wake_up(true);
+                    }
+                }
+                continue;
+            }
             if let Some(rb) = bodies.get_mut(b.handle) {
                 if b.write_back(rb, asleep) {
                     stats.bodies_written += 1;

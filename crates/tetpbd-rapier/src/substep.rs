@@ -10,6 +10,7 @@ use tetpbd::{
 };
 
 use crate::attachments::{anchor_of, project_attachments, Attachments};
+use crate::contacts::approach::limit_approach;
 use crate::contacts::corner::{project_corners, CornerPass};
 use crate::contacts::particle::{finish_substep, project_contacts, velocity_pass};
 use crate::contacts::support::{
@@ -214,6 +215,15 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 CornerPass::Ordinary,
                 self.max_depenetration_speed * h,
                 &mut impact,
+            );
+            limit_approach(
+                &mut contacts[s.contacts.clone()],
+                &mut corners[s.corners.clone()],
+                p,
+                bodies,
+                colliders,
+                &mut impact,
+                tetpbd::impact_speed::approach_limit(s.reach, s.wave_speed, h),
             );
             project_attachments(&mut attachments[s.attachments.clone()], p, bodies, frac, h);
             let mut stacking = Stacking {

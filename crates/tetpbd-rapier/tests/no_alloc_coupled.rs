@@ -400,3 +400,70 @@ fn stacking_pass_steps_without_allocating() {
     assert!(passes > 0, "the stacking pass ran");
     check("stacking", &tally, frames as u64);
 }
+
+/// A soft cube resting on a box hinged below a fixed bar (a pivoting impulse-jointed body),
+/// and a soft cube attached to a box on a spherical multibody joint (its soft reaction goes
+/// through the multibody).
+#[test]
+fn jointed_bodies_step_without_allocating() {
+    use rapier3d::prelude::{RevoluteJointBuilder, SphericalJointBuilder};
+    let mut scene = scene();
+    let bar = |scene: &mut CoupledWorld, x: f32| {
+        scene
+            .physics
+            .bodies
+            .insert(RigidBodyBuilder::fixed().translation(Vector::new(x, 3.0, 0.0)))
+    };
+    let hinge = bar(&mut scene, 0.0);
+    let (hinged, _) = scene.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 2.0, 0.0)),
+        ColliderBuilder::cuboid(0.6, 0.1, 0.6).mass(20.0),
+    );
+    let joint = RevoluteJointBuilder::new(Vector::Z)
+        .local_anchor2(Vector::new(0.0, 1.0, 0.0))
+        .build();
+    scene
+        .physics
+        .impulse_joints
+        .insert(hinge, hinged, joint, true);
+    soft_cube_with_density(&mut scene, 2, Vector3::new(0.0, 2.601, 0.0), 10.0);
+    let ball = bar(&mut scene, 3.0);
+    let (link, _) = scene.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vector::new(3.0, 2.0, 0.0)),
+        ColliderBuilder::cuboid(0.1, 0.1, 0.1).mass(2.0),
+    );
+    let joint = SphericalJointBuilder::new()
+        .local_anchor2(Vector::new(0.0, 1.0, 0.0))
+        .build();
+    scene
+        .physics
+        .multibody_joints
+        .insert(ball, link, joint, true)
+        .expect("multibody joint");
+    let hanging = soft_cube_with_density(&mut scene, 2, Vector3::new(3.0, 1.4, 0.0), 2.0);
+    let mut att = Attachments::new();
+    {
+        let p = scene.soft.get::<&Particles>(hanging).expect("body");
+        let top = (0..p.len() as u32)
+            .max_by(|&a, &b| {
+                p.positions()[a as usize]
+                    .y
+                    .total_cmp(&p.positions()[b as usize].y)
+            })
+            .expect("particles");
+        att.attach_to_body(&p, top, &scene.physics.bodies, link, 0.0)
+            .expect("attachment");
+    }
+    scene.soft.insert_one(hanging, att).expect("entity");
+    // The swinging bodies pass through the fast-collider list's high-water mark first.
+    for _ in 0..120 {
+        scene.step().expect("step");
+    }
+    let frames = 30;
+    let mut written = 0;
+    let tally = counted(frames, || {
+        written += scene.step().expect("step").bodies_written;
+    });
+    assert!(written > 0, "the jointed bodies get the soft reaction");
+    check("jointed", &tally, frames as u64);
+}

@@ -2,6 +2,8 @@
 //! rapier colliders, projected every iteration of every substep.
 //!
 //! * [`particle`]: a soft surface particle against a collider (parry point projection).
+//! * [`approach`]: a fast body touching something immovable stopped as a whole, down to
+//!   what its constraints carry within a substep.
 //! * [`corner`]: a rigid corner or support point against a soft surface triangle.
 //! * [`support`]: the rigid contacts of a body anchored by an attachment.
 //!
@@ -9,6 +11,7 @@
 //! [`crate::response::friction`], restitution and rolling resistance act on whole bodies in
 //! [`crate::response`].
 
+pub(crate) mod approach;
 pub(crate) mod corner;
 pub(crate) mod particle;
 pub(crate) mod support;

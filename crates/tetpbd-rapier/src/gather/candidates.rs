@@ -55,13 +55,14 @@ impl Frame {
             .run(world, input, &self.fast, input.soft_margin, dt);
         let fall = 0.5 * self.gravity * dt * dt;
         // Sleeping bodies take no part (`sleeping` module docs).
-        for (entity, p, surface, sc, att) in world
+        for (entity, p, surface, sc, att, families) in world
             .query_mut::<(
                 Entity,
                 &Particles,
                 &Surface,
                 Option<&SoftCollider>,
                 Option<&Attachments>,
+                Families<'_>,
             )>()
             .without::<&tetpbd::Asleep>()
         {
@@ -92,6 +93,11 @@ impl Frame {
                 attachments: a0..self.attachments.len(),
                 stacked: false,
                 reach: tetpbd::local_reach(p, surface),
+                wave_speed: if self.contacts.len() > c0 {
+                    wave_speed(p, families)
+                } else {
+                    f32::INFINITY
+                },
             });
         }
         self.anchor_supported_bodies(input);
@@ -312,6 +318,22 @@ impl Frame {
             }
         }
     }
+}
+
+/// The components a soft body's wave speed is computed from.
+type Families<'a> = (
+    Option<&'a tetpbd::Tetrahedra>,
+    Option<&'a tetpbd::EdgeConstraints>,
+    Option<&'a tetpbd::VertexFaceConstraints>,
+    Option<&'a tetpbd::VolumeConstraints>,
+    Option<&'a tetpbd::NeoHookeanMaterial>,
+);
+
+/// [`tetpbd::impact_speed::wave_speed`] of a body; `f32::INFINITY` without tetrahedra.
+fn wave_speed(p: &Particles, (tets, edges, vf, volume, material): Families<'_>) -> f32 {
+    tets.map_or(f32::INFINITY, |t| {
+        tetpbd::impact_speed::wave_speed(p, t, edges, vf, volume, material)
+    })
 }
 
 /// Bounds of a body's surface particles, m.

@@ -46,6 +46,10 @@ pub(crate) struct SoftEntry {
     /// How deep an impact its surface takes locally within a substep, m
     /// ([`tetpbd::ImpactReach`]).
     pub reach: f32,
+    /// Its longitudinal wave speed, m/s ([`tetpbd::impact_speed::wave_speed`]; computed from
+    /// rest data each frame for a body with contact candidates, `f32::INFINITY` otherwise):
+    /// with `reach`, how fast it may approach something immovable (`contacts::approach`).
+    pub wave_speed: f32,
 }
 
 /// A particle–collider pair: `(entity bits, collider handle (index, generation), particle)`.
@@ -85,6 +89,8 @@ pub(crate) struct Frame {
     /// Force (N) and torque (N·m) added to bodies for rapier's next step (the load of the
     /// previous frame, `BodyProxy::load`), taken off again after that step.
     pub loads: Vec<(RigidBodyHandle, Vector3<f32>, Vector3<f32>)>,
+    /// Scratch: generalized velocities of a multibody (`rigid::body::link` module docs).
+    pub generalized: nalgebra::DVector<f32>,
     /// Ground-up sweeps of the stacking pass (`heavy_loads` module docs), one per soft body
     /// (by its index in `soft`), kept across frames.
     pub sweeps: Vec<tetpbd::GroundUpSweep>,
@@ -252,64 +258,46 @@ impl Frame {
 
     /// Makes every dynamic body taking part that a joint locks in all six degrees of freedom
     /// to a fixed or kinematic body *welded* (immovable inside the substeps, its soft
-    /// reaction handed to rapier), and one whose joint to such a body locks its rotation and
-    /// some of its translation *sliding* along the free axes (`joints` module docs, "Welded
-    /// and sliding bodies").
+    /// reaction handed to rapier), one whose joint to such a body locks its rotation and
+    /// some of its translation *sliding* along the free axes, and one whose joint to such a
+    /// body locks its translation and leaves it one or three rotations (revolute, spherical)
+    /// *pivoting* about the joint's anchor (`joints` module docs, "Welded, sliding and
+    /// pivoting bodies").
+    /// The joint a pivoting body pivots on holds by construction and is not projected
+    /// ([`Self::gather_joints`]).
     pub(crate) fn weld_jointed_bodies(&mut self, input: &GatherInput<'_, '_>) {
+        self.joint_keys.clear();
         for b in 0..self.bodies.len() {
             if !self.bodies[b].is_dynamic() {
                 continue;
             }
-            let handle = self.bodies[b].handle;
-            let mut welded = false;
-            let mut slide: Option<Matrix3<f32>> = None;
-            for (h1, h2, _, joint) in
-                joints_of(handle, input.impulse_joints, input.multibody_joints)
-            {
-                let other = if h1 == handle { h2 } else { h1 };
-                let immovable = input.qp.bodies.get(other).is_some_and(|o| !o.is_dynamic());
-                let m = joint.locked_axes;
-                if !joint.is_enabled() || !immovable || !m.contains(JointAxesMask::ANG_AXES) {
-                    continue;
+            let Some((restriction, key)) = restriction(self.bodies[b].handle, input) else {
+                continue;
+            };
+            match restriction {
+                Restriction::Weld => self.bodies[b].weld(),
+                Restriction::Slide(free) => self.bodies[b].slide(&free),
+                Restriction::Pivot(anchor, axis, (other, at)) => {
+                    let q = input.qp.bodies;
+                    let Some(o) = self.body_proxy(other, q, input.narrow_phase) else {
+                        continue;
+                    };
+                    let (start, end) = self.bodies[o].frame_poses();
+                    let path = (start * at, end * at);
+                    self.bodies[b].pivot(anchor, axis, (path.0.coords, path.1.coords));
                 }
-                if m.contains(JointAxesMask::LOCKED_FIXED_AXES) {
-                    welded = true;
-                    break;
-                }
-                let Some(b1) = input.qp.bodies.get(h1) else {
-                    continue;
-                };
-                let frame = pose_to_na(b1.position()) * pose_to_na(&joint.local_frame1);
-                // The projector onto the joint's free translations (first frame's axes).
-                let lin = [
-                    JointAxesMask::LIN_X,
-                    JointAxesMask::LIN_Y,
-                    JointAxesMask::LIN_Z,
-                ];
-                let free =
-                    (0..3)
-                        .filter(|&k| !m.contains(lin[k]))
-                        .fold(Matrix3::zeros(), |p, k| {
-                            let a = frame.rotation * Vector3::ith(k, 1.0);
-                            p + a * a.transpose()
-                        });
-                // Two such joints: the body can only move along what both leave free; keep
-                // the first and let the second's projection hold the rest.
-                slide.get_or_insert(free);
             }
-            if welded {
-                self.bodies[b].weld();
-            } else if let Some(free) = slide {
-                self.bodies[b].slide(&free);
+            if self.bodies[b].is_pivoting() {
+                self.joint_keys.push(key);
             }
         }
     }
 
-    /// The joints of the dynamic bodies taking part (`joints` module docs); the other body of
-    /// a joint gets a proxy if it has none.
+    /// The joints of the dynamic bodies taking part (`joints` module docs), but for those
+    /// already in `joint_keys` ([`Self::weld_jointed_bodies`]); the other body of a joint gets
+    /// a proxy if it has none.
     pub(crate) fn gather_joints(&mut self, input: &GatherInput<'_, '_>) {
         self.joints.clear();
-        self.joint_keys.clear();
         let n = self.bodies.len();
         for b in 0..n {
             if !self.bodies[b].is_dynamic() {
@@ -334,4 +322,90 @@ impl Frame {
             }
         }
     }
+}
+
+/// How a joint to an immovable body restricts a dynamic body inside the substeps (`joints`
+/// module docs, "Welded, sliding and pivoting bodies").
+enum Restriction {
+    /// Locked in all six degrees of freedom.
+    Weld,
+    /// Rotation locked, translation free along the projector's range (world).
+    Slide(Matrix3<f32>),
+    /// Translation locked at the anchor (m, the body's frame); rotation free about the unit
+    /// axis (world) of a hinge, or about any axis (`None`); the immovable body and the
+    /// anchor in its frame (m).
+    Pivot(
+        Vector3<f32>,
+        Option<Vector3<f32>>,
+        (RigidBodyHandle, nalgebra::Point3<f32>),
+    ),
+}
+
+/// The restriction of the dynamic body `handle` by its first enabled joint to a fixed or
+/// kinematic body that locks all its translations or all its rotations, and that joint's
+/// key; a weld wins over the others.
+fn restriction(
+    handle: RigidBodyHandle,
+    input: &GatherInput<'_, '_>,
+) -> Option<(Restriction, (bool, u32, u32))> {
+    let lin = [
+        JointAxesMask::LIN_X,
+        JointAxesMask::LIN_Y,
+        JointAxesMask::LIN_Z,
+    ];
+    let ang = [
+        JointAxesMask::ANG_X,
+        JointAxesMask::ANG_Y,
+        JointAxesMask::ANG_Z,
+    ];
+    let mut found = None;
+    for (h1, h2, key, joint) in joints_of(handle, input.impulse_joints, input.multibody_joints) {
+        let other = if h1 == handle { h2 } else { h1 };
+        let immovable = input.qp.bodies.get(other).is_some_and(|o| !o.is_dynamic());
+        let m = joint.locked_axes;
+        if !joint.is_enabled() || !immovable {
+            continue;
+        }
+        if m.contains(JointAxesMask::LOCKED_FIXED_AXES) {
+            return Some((Restriction::Weld, key));
+        }
+        // Two such joints: the body can only move as both allow; keep the first and let
+        // the second's projection hold the rest.
+        if found.is_some() {
+            continue;
+        }
+        let Some(b1) = input.qp.bodies.get(h1) else {
+            continue;
+        };
+        let frame1 = pose_to_na(b1.position()) * pose_to_na(&joint.local_frame1);
+        if m.contains(JointAxesMask::ANG_AXES) {
+            // The projector onto the joint's free translations (first frame's axes).
+            let free = (0..3)
+                .filter(|&k| !m.contains(lin[k]))
+                .fold(Matrix3::zeros(), |p, k| {
+                    let a = frame1.rotation * Vector3::ith(k, 1.0);
+                    p + a * a.transpose()
+                });
+            found = Some((Restriction::Slide(free), key));
+        } else if m.contains(JointAxesMask::LIN_AXES) {
+            let (local, far) = if h2 == handle {
+                (&joint.local_frame2, &joint.local_frame1)
+            } else {
+                (&joint.local_frame1, &joint.local_frame2)
+            };
+            let anchor = crate::convert::to_na(local.translation);
+            let far = nalgebra::Point3::from(crate::convert::to_na(far.translation));
+            let free: usize = (0..3).filter(|&k| !m.contains(ang[k])).count();
+            let axis = match free {
+                3 => None,
+                1 => {
+                    let k = (0..3).find(|&k| !m.contains(ang[k])).unwrap_or(0);
+                    Some(frame1.rotation * Vector3::ith(k, 1.0))
+                }
+                _ => continue,
+            };
+            found = Some((Restriction::Pivot(anchor, axis, (other, far)), key));
+        }
+    }
+    found
 }

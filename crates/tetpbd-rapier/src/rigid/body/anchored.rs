@@ -36,7 +36,7 @@ impl BodyProxy {
 
     /// Restricts a dynamic body that a joint holds to an immovable body without letting it
     /// turn to sliding along the joint's free translations, `project` the orthogonal
-    /// projector onto them (world; `joints` module docs, "Welded and sliding bodies"): soft
+    /// projector onto them (world; `joints` module docs, "Welded, sliding and pivoting bodies"): soft
     /// impulses move it only along them and never turn it.
     pub fn slide(&mut self, project: &nalgebra::Matrix3<f32>) {
         if self.kind != BodyKind::Dynamic {

@@ -37,6 +37,8 @@ use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vec
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
 
 mod anchored;
+mod link;
+mod pivoting;
 
 use crate::convert::{inertia_to_na, pose_to_glam, to_glam, to_na};
 
@@ -121,6 +123,8 @@ pub(crate) struct BodyProxy {
     /// Whether the base path has been made to end at rapier's centre of mass (module docs;
     /// done in the frame's first substep, whose length the path depends on).
     ends_at_rapier: bool,
+    /// The pivot of a pivoting body (`pivoting` module docs).
+    pivot: Option<pivoting::Pivot>,
 }
 
 impl BodyKind {
@@ -233,6 +237,7 @@ impl BodyProxy {
             pre: (Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
             smooth_accel,
             ends_at_rapier: false,
+            pivot: None,
         }
     }
 
@@ -305,8 +310,13 @@ impl BodyProxy {
             return;
         }
         self.frac = frac;
-        let com = self.base_com(frac * self.dt) + self.dx;
-        let rot = self.dq * self.rot_start.nlerp(&self.rot_end, frac);
+        let base_rot = self.rot_start.nlerp(&self.rot_end, frac);
+        let base_com = self.base_com(frac * self.dt);
+        if let Some(com) = self.pivot_com(frac, &base_rot) {
+            self.dx = com - base_com;
+        }
+        let com = base_com + self.dx;
+        let rot = self.dq * base_rot;
         self.pose = Isometry3::from_parts(Translation3::from(com - rot * self.com_local), rot);
     }
 
@@ -355,6 +365,9 @@ impl BodyProxy {
         if self.kind != BodyKind::Dynamic {
             return 0.0;
         }
+        if let Some(w) = self.pivot_inv_mass_at(q, n) {
+            return w;
+        }
         let rn = (q - self.com()).cross(n);
         n.dot(&(self.inv_mass * n)) + rn.dot(&(self.inv_inertia * rn))
     }
@@ -365,7 +378,10 @@ impl BodyProxy {
         if self.kind != BodyKind::Dynamic {
             return 0.0;
         }
-        a.dot(&(self.inv_inertia * a))
+        match self.pivot_turn_angular(a) {
+            Some(turn) => a.dot(&turn),
+            None => a.dot(&(self.inv_inertia * a)),
+        }
     }
 
     /// Turns the body by the angular positional impulse `l` (kg·m²·rad: axis × Δλ) of a
@@ -374,8 +390,15 @@ impl BodyProxy {
         if self.kind != BodyKind::Dynamic {
             return;
         }
-        let dtheta = self.inv_inertia * l;
-        let dq = Quaternion::from_parts(0.0, dtheta) * self.dq.into_inner() * 0.5;
+        let dtheta = self
+            .pivot_turn_angular(l)
+            .unwrap_or_else(|| self.inv_inertia * l);
+        self.turn_offset(&dtheta);
+    }
+
+    /// Turns the offset rotation by `dtheta` (rad, world) and moves the pose to it.
+    fn turn_offset(&mut self, dtheta: &Vector3<f32>) {
+        let dq = Quaternion::from_parts(0.0, *dtheta) * self.dq.into_inner() * 0.5;
         self.dq = UnitQuaternion::new_normalize(self.dq.into_inner() + dq);
         self.touched = true;
         let frac = self.frac;
@@ -413,13 +436,13 @@ impl BodyProxy {
         if self.kind != BodyKind::Dynamic {
             return;
         }
+        if let Some(turn) = self.pivot_turn(p, q) {
+            self.turn_offset(&turn);
+            return;
+        }
         let dtheta = self.inv_inertia * (q - self.com()).cross(p);
         self.dx += self.inv_mass * p;
-        let dq = Quaternion::from_parts(0.0, dtheta) * self.dq.into_inner() * 0.5;
-        self.dq = UnitQuaternion::new_normalize(self.dq.into_inner() + dq);
-        self.touched = true;
-        let frac = self.frac;
-        self.set_pose(frac);
+        self.turn_offset(&dtheta);
     }
 
     /// Ends a substep: the offset velocities follow from the offset motion.
@@ -462,7 +485,7 @@ impl BodyProxy {
             self.touched = true;
             return;
         }
-        if self.kind != BodyKind::Dynamic {
+        if self.kind != BodyKind::Dynamic || self.pivot_velocity_impulse(j, q) {
             return;
         }
         self.dv += self.inv_mass * j;
