@@ -15,57 +15,30 @@
 
 use hecs::{Entity, World};
 use nalgebra::Vector3;
-use tetpbd::constraint::{bounded_height, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
 use tetpbd::{
-    EdgeConstraints, NeoHookeanMaterial, Particles, Tetrahedra, VertexFaceConstraints,
-    VolumeConstraints,
+    EdgeConstraints, ElasticFamilies, NeoHookeanMaterial, Particles, Tetrahedra,
+    VertexFaceConstraints, VolumeConstraints,
 };
 
-/// Elastic energy of the compliant families of body `e`, J.
+/// Elastic energy of the compliant families and the material of body `e`, J
+/// ([`tetpbd::ElasticFamilies`]).
 pub fn elastic(world: &World, e: Entity) -> f64 {
-    let Ok(p) = world.get::<&Particles>(e) else {
+    let (Ok(p), Ok(t)) = (world.get::<&Particles>(e), world.get::<&Tetrahedra>(e)) else {
         return 0.0;
     };
-    let x = p.positions();
-    let mut u = 0.0f64;
-    let term = |c: f32, alpha: f32| f64::from(c) * f64::from(c) / (2.0 * f64::from(alpha));
-    if let Ok(f) = world.get::<&EdgeConstraints>(e) {
-        let alpha = f.compliance();
-        if alpha > 0.0 {
-            for (&[a, b], &l) in f.edges().iter().zip(f.rest_lengths()) {
-                u += term((x[a as usize] - x[b as usize]).norm() - l, alpha);
-            }
-        }
+    let (edges, volume, vertex_face, material) = (
+        world.get::<&EdgeConstraints>(e).ok(),
+        world.get::<&VolumeConstraints>(e).ok(),
+        world.get::<&VertexFaceConstraints>(e).ok(),
+        world.get::<&NeoHookeanMaterial>(e).ok(),
+    );
+    ElasticFamilies {
+        edges: edges.as_deref(),
+        volume: volume.as_deref(),
+        vertex_face: vertex_face.as_deref(),
+        material: material.as_deref(),
     }
-    let Ok(t) = world.get::<&Tetrahedra>(e) else {
-        return u;
-    };
-    if let Ok(m) = world.get::<&NeoHookeanMaterial>(e) {
-        u += m.elastic_energy(&t, x);
-    }
-    if let Ok(f) = world.get::<&VolumeConstraints>(e) {
-        let alpha = f.compliance();
-        if alpha > 0.0 {
-            for (k, &v0) in t.rest_volumes().iter().enumerate() {
-                u += term(t.volume_at(k, x) - v0, alpha);
-            }
-        }
-    }
-    if let Ok(f) = world.get::<&VertexFaceConstraints>(e) {
-        let alpha = f.compliance();
-        if alpha > 0.0 {
-            for (tet, rest) in t.indices().iter().zip(f.rest_heights()) {
-                for (k, order) in VERTEX_FACE_ORDER.iter().enumerate() {
-                    let [a, b, c, d] = order.map(|o| x[tet[o] as usize]);
-                    // A face collapsed to a point has no height: its violation is the rest value.
-                    let h =
-                        bounded_height(&a, &b, &c, &d, VERTEX_FACE_KAPPA, rest[k]).unwrap_or(0.0);
-                    u += term(h - rest[k], alpha);
-                }
-            }
-        }
-    }
-    u
+    .energy(&t, p.positions())
 }
 
 /// Kinetic + elastic + gravitational energy of body `e` under gravity `g` (m/s²), J.

@@ -1,6 +1,8 @@
 //! The immovable ground of the impact cases: the plane y = 0, restitution 0.
 //!
-//! A [`SubstepHook`] that runs after the families every substep: a particle below the plane
+//! A [`SubstepHook`] that runs after the families every substep: a body touching the plane
+//! that approaches it faster than its constraints carry a push has the excess approach taken
+//! as a whole ([`ImpactReach::limit_approach`], [`impact_speed`]); a particle below the plane
 //! is put back on it (a position constraint, as a coupling's contacts are), the depth beyond
 //! the body's local reach taken by the whole body ([`ImpactReach`], as the rapier coupling's
 //! contacts do), and a particle on it leaves the substep with no normal velocity (the
@@ -14,7 +16,10 @@
 //! inside the frame it happens in, where a frame-by-frame sample would miss it.
 
 use tetpbd::nalgebra::Vector3;
-use tetpbd::{hecs, ImpactReach, Particles, SubstepHook, Surface};
+use tetpbd::{
+    hecs, impact_speed, EdgeConstraints, ImpactReach, NeoHookeanMaterial, Particles, SubstepHook,
+    Surface, Tetrahedra, VertexFaceConstraints, VolumeConstraints,
+};
 
 /// The plane y = 0 (see the module docs).
 #[derive(Clone, Copy, Debug, Default)]
@@ -30,10 +35,26 @@ impl Ground {
 }
 
 impl SubstepHook for Ground {
-    fn project(&mut self, world: &mut hecs::World, _substep: tetpbd::SubstepContext) {
-        for (p, surface) in world.query_mut::<(&mut Particles, Option<&Surface>)>() {
+    fn project(&mut self, world: &mut hecs::World, substep: tetpbd::SubstepContext) {
+        type Body<'a> = (
+            &'a mut Particles,
+            Option<&'a Surface>,
+            Option<&'a Tetrahedra>,
+            Option<&'a EdgeConstraints>,
+            Option<&'a VertexFaceConstraints>,
+            Option<&'a VolumeConstraints>,
+            Option<&'a NeoHookeanMaterial>,
+        );
+        for (p, surface, tets, edges, vf, volume, material) in world.query_mut::<Body<'_>>() {
             let mut impact =
                 surface.map_or(ImpactReach::new(f32::INFINITY), |s| ImpactReach::of(p, s));
+            let touching =
+                (0..p.len()).any(|i| p.positions()[i].y < 0.0 && p.inv_masses()[i] > 0.0);
+            if let (true, Some(t)) = (touching, tets) {
+                let c = impact_speed::wave_speed(p, t, edges, vf, volume, material);
+                let limit = impact_speed::approach_limit(impact.reach(), c, substep.h());
+                impact.limit_approach(p, &Vector3::y(), limit);
+            }
             for i in 0..p.len() {
                 let depth = -p.positions()[i].y;
                 impact.push_out(p, i, depth, &Vector3::y());

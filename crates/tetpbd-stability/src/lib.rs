@@ -17,12 +17,15 @@ pub mod energy;
 mod ground;
 mod report;
 mod run;
+pub mod settle;
 
 pub use cases::{all_cases, impact, Case, CaseKind, SWEEP_SUBSTEPS};
 pub use config::{Config, ConstraintSet};
 pub use coupled::{coupled_cases, CoupledCase, CoupledOutcome};
 pub use coupled_rapier::rapier_comparison;
-pub use coupled_robust::{pull_apart, PullFigures, BLOWN_UP_SPEED, PULL_SPEEDS};
+pub use coupled_robust::{
+    pull_apart, pull_apart_in, PullFigures, BLOWN_UP_SPEED, FRAGMENT_SPEED_MARGIN, PULL_SPEEDS,
+};
 pub use ground::Ground;
 pub use report::{markdown, verdict, Verdict};
 pub use run::{

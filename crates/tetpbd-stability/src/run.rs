@@ -95,11 +95,18 @@ pub struct Outcome {
     /// |total volume / rest − 1| at the end; for a body thrown at the ground, |total volume /
     /// the volume of the same body set down at rest ([`Outcome::resting_volume_ratio`]) − 1|.
     pub final_volume_error: f32,
-    /// Total volume / rest volume at the end.
+    /// Total volume / rest volume at the end; for a body on the ground, once settled
+    /// ([`crate::settle`]).
     pub final_volume_ratio: f32,
     /// For a body thrown at the ground: its [`Outcome::final_volume_ratio`] when set down on
     /// the ground at rest instead (the same scene without the throw).
     pub resting_volume_ratio: Option<f32>,
+    /// For a body thrown at the ground: the peak internal kinetic energy of the same body set
+    /// down on the ground at rest instead, divided by this run's reference energy (its own
+    /// settling oscillation, which [`Outcome::calm`] does not count against the impact).
+    pub resting_internal_ratio: Option<f32>,
+    /// The reference energy the ratios are taken against, J.
+    pub reference: f32,
     /// Final max |C| per family (edge m, vertex–face m, volume m³), where present.
     pub final_max_c: [Option<f32>; 3],
     /// Largest particle speed at the end, m/s.
@@ -174,15 +181,19 @@ impl Outcome {
     /// or roll when the run ends (it rebounds, slower than it came): what must have decayed
     /// is its internal kinetic energy, the motion relative to its best-fit rigid motion
     /// ([`crate::energy::internal_kinetic`]), to ≤ 10 % of its peak (the impact) or below
-    /// [`Self::AT_REST`] × the reference. A body still jiggling, spinning itself apart or
-    /// crushed keeps internal kinetic energy and is not calm.
+    /// [`Self::AT_REST`] × the reference, or to no more than the same body set down on the
+    /// ground at rest reaches ([`Outcome::resting_internal_ratio`]: a soft, barely damped
+    /// body still sways from landing at the end, as it does set down). A body still
+    /// jiggling from the impact, spinning itself apart or crushed keeps internal kinetic
+    /// energy and is not calm.
     pub fn calm(&self) -> bool {
         let (peak, last) = if self.rebound.is_some() {
             (self.peak_internal_ratio, self.final_internal_ratio)
         } else {
             (self.peak_ke_ratio, self.final_ke_ratio)
         };
-        last <= 0.1 * peak || last <= Self::AT_REST
+        let resting = self.resting_internal_ratio.unwrap_or(0.0);
+        last <= 0.1 * peak || last <= Self::AT_REST || last <= resting
     }
 
     /// [`Self::pass`] without the shape: what a body that need not recover its shape (the
@@ -219,6 +230,8 @@ pub struct FrameView<'a> {
     pub particles: &'a Particles,
     /// The reference energy the outcome's kinetic energy ratios are taken against, J.
     pub reference: f32,
+    /// Total volume / rest volume after it.
+    pub volume_ratio: f32,
 }
 
 impl Start {
@@ -304,7 +317,9 @@ pub fn run_scene_observed(
             velocity: Vector3::zeros(),
             ..scene.clone()
         };
-        out.resting_volume_ratio = Some(run_scene(&resting, config).final_volume_ratio);
+        let r = run_scene(&resting, config);
+        out.resting_volume_ratio = Some(r.final_volume_ratio);
+        out.resting_internal_ratio = Some(r.peak_internal_ratio * r.reference);
     }
     let resting = out.resting_volume_ratio.unwrap_or(1.0);
     let body = match builder(scene, config).build() {
@@ -409,6 +424,7 @@ pub fn run_scene_observed(
             stats: &stats,
             particles: &p,
             reference,
+            volume_ratio: out.final_volume_ratio,
         });
     }
     out.peak_ke_ratio = peak / reference;
@@ -424,5 +440,12 @@ pub fn run_scene_observed(
     out.final_ke_ratio = last / reference;
     out.peak_internal_ratio = (peak_internal / f64::from(reference)) as f32;
     out.final_internal_ratio = (last_internal / f64::from(reference)) as f32;
+    out.reference = reference;
+    if let Some(r) = out.resting_internal_ratio.as_mut() {
+        *r /= reference;
+    }
+    if scene.ground {
+        crate::settle::settle(&mut solver, &mut world, e, &mut ground, &mut out, resting);
+    }
     out
 }

@@ -6,6 +6,7 @@
 //! cargo run --release -p tetpbd-bench --bin stack_rest -- [--cubes 5] [--size-mm 500]
 //!     [--substeps 10] [--iterations 1] [--seconds 13] [--column] [--damping RATE]
 //!     [--soft-friction-off] [--skin-speed-mm-s 100] [--touching] [--every-frames 30]
+//!     [--five] [--spin-off] [--energy-limit-off] [--stacking-off] [--self-weight]
 //! ```
 //!
 //! * `--column`: one body as tall as the stack (4 × 4·cubes × 4 cells) instead of cubes;
@@ -14,11 +15,16 @@
 //!   friction 0, the ground's 1, so the ground contact keeps the default 0.5 by the average
 //!   combine rule);
 //! * `--skin-speed-mm-s`: `SoftContactSettings::skin_speed` in mm/s (default 100);
-//! * `--touching`: the cubes start at the contact thickness instead of 2 cm apart.
+//! * `--touching`: the cubes start at the contact thickness instead of 2 cm apart;
+//! * `--five`: cells split in five tetrahedra instead of six around the diagonal;
+//! * `--spin-off`, `--energy-limit-off`: `SafetySettings::conserve_angular_momentum`,
+//!   `limit_correction_energy` off; `--stacking-off`: `CouplingSettings::stacking` `None`;
+//!   `--self-weight`: `StackingSettings::self_weight` on.
 //!
-//! Prints every `--every-frames` frames the largest particle speed per body (bottom first) and
-//! the top body's centre, then the largest speed over the last second, how far any particle of
-//! the top body moved over the last 10 s, and per interface of two cubes the largest change of
+//! Prints every `--every-frames` frames the mean kinetic energy since the last print, the
+//! largest particle speed per body (bottom first) and the top body's centre, then the largest
+//! speed over the last second, how far any particle of the top body moved over the last 10 s,
+//! from when on every particle stayed below 1 mm/s, and per interface of two cubes the largest change of
 //! their horizontal offset over those 10 s (the upper cube's bottom-face centre against the
 //! lower cube's top-face centre: slip and rocking at the contact).
 
@@ -68,6 +74,22 @@ struct Args {
     /// One body as tall as the stack (4 × 4·cubes × 4 cells) instead of cubes.
     #[arg(long)]
     column: bool,
+    /// `SafetySettings::conserve_angular_momentum` off.
+    #[arg(long)]
+    spin_off: bool,
+    /// `SafetySettings::limit_correction_energy` off.
+    #[arg(long)]
+    energy_limit_off: bool,
+    /// `CouplingSettings::stacking` off.
+    #[arg(long)]
+    stacking_off: bool,
+    /// The cubes' cells split in five tetrahedra (mirrored in alternate cells) instead of six
+    /// around the main diagonal.
+    #[arg(long)]
+    five: bool,
+    /// `StackingSettings::self_weight` on.
+    #[arg(long)]
+    self_weight: bool,
 }
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftColliderBuilder};
 
@@ -81,13 +103,21 @@ fn main() -> Res<()> {
     let seconds = args.seconds as f32;
     let every = args.every_frames as usize;
     let (damping, soft_friction_off) = (args.damping, args.soft_friction_off);
-    let solver = SolverSettings {
+    let mut solver = SolverSettings {
         dt: DT,
         substeps,
         iterations,
         ..SolverSettings::default()
     };
+    solver.safety.conserve_angular_momentum &= !args.spin_off;
+    solver.safety.limit_correction_energy &= !args.energy_limit_off;
     let mut coupling = CouplingSettings::default();
+    if args.stacking_off {
+        coupling.stacking = None;
+    }
+    if let (true, Some(s)) = (args.self_weight, coupling.stacking.as_mut()) {
+        s.self_weight = true;
+    }
     let mut ground = ColliderBuilder::cuboid(20.0, 0.5, 20.0);
     if soft_friction_off {
         coupling.default_collider = SoftColliderBuilder::new()
@@ -125,9 +155,14 @@ fn main() -> Res<()> {
             })
             .collect()
     };
+    let split = if args.five {
+        CellSplit::Five
+    } else {
+        CellSplit::Six
+    };
     let mut bodies = Vec::new();
     for (extent, cells, y) in shapes {
-        let e = SoftBodyBuilder::new(box_grid(extent, cells, CellSplit::Six)?)
+        let e = SoftBodyBuilder::new(box_grid(extent, cells, split)?)
             .density(1000.0)
             .edges(0.0)
             .volume(0.0)
@@ -150,12 +185,21 @@ fn main() -> Res<()> {
     let mut reference: Option<Vec<Vector3<f32>>> = None;
     let mut offsets0: Vec<Vector3<f32>> = Vec::new();
     let mut slip = vec![0.0f32; bodies.len().saturating_sub(1)];
+    let mut ke_sum = 0.0f64;
+    // The last frame at which some particle moved at 1 mm/s or faster.
+    let mut last_moving = 0usize;
     for f in 1..=frames {
         w.step()?;
+        for &e in &bodies {
+            ke_sum += f64::from(w.soft.get::<&Particles>(e)?.kinetic_energy());
+        }
         let speeds: Vec<f32> = bodies.iter().map(|&e| speed(&w, e)).collect::<Res<_>>()?;
         let max = speeds.iter().copied().fold(0.0f32, f32::max);
         if f + 60 > frames {
             last_second = last_second.max(max);
+        }
+        if max >= 1e-3 {
+            last_moving = f;
         }
         let offsets = interface_offsets(&w, &bodies)?;
         if f == from {
@@ -176,19 +220,30 @@ fn main() -> Res<()> {
             let c = p.center_of_mass();
             let per: Vec<String> = speeds.iter().map(|v| format!("{v:.4}")).collect();
             println!(
-                "t {:5.2} s  max|v| {max:.5} m/s  per body [{}]  top centre ({:.4}, {:.4}, {:.4}) m",
+                "t {:5.2} s  mean KE {:.2e} J  max|v| {max:.5} m/s  per body [{}]  top centre ({:.4}, {:.4}, {:.4}) m",
                 f as f32 * DT,
+                ke_sum / every as f64,
                 per.join(" "),
                 c.x,
                 c.y,
                 c.z
             );
+            ke_sum = 0.0;
         }
     }
     println!(
         "largest speed over the last second {last_second:.2e} m/s; top body moved {:.2} mm over the last {:.0} s",
         drift * 1e3,
         (frames - from) as f32 * DT
+    );
+    println!(
+        "below 1 mm/s for good from t = {:.2} s{}",
+        last_moving as f32 * DT,
+        if last_moving == frames {
+            " (never)"
+        } else {
+            ""
+        }
     );
     let slip: Vec<String> = slip.iter().map(|s| format!("{:.2}", s * 1e3)).collect();
     println!(
