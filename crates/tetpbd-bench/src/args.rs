@@ -41,4 +41,13 @@ impl FamilySet {
             FamilySet::VertexFace => "vertex-face",
         }
     }
+
+    /// `b` with this set's families at the cost benchmarks' compliances: edges 1e-6 m/N +
+    /// volume 1e-9 m⁵/N, or vertex–face 1e-6 m/N.
+    pub fn add_to(self, b: tetpbd::SoftBodyBuilder) -> tetpbd::SoftBodyBuilder {
+        match self {
+            FamilySet::EdgesVolume => b.edges(1e-6).volume(1e-9),
+            FamilySet::VertexFace => b.vertex_face(1e-6),
+        }
+    }
 }

@@ -11,6 +11,7 @@ mod clock;
 mod contact_metrics;
 mod contact_scene;
 mod contact_sim;
+mod on_off;
 mod perturb;
 mod rapier_setup;
 mod tear_scene;
@@ -24,6 +25,7 @@ pub use contact_metrics::{
 };
 pub use contact_scene::{ContactKind, ContactScene, GROUND_HALF_EXTENTS};
 pub use contact_sim::{build_contact, tetpbd_contact_world, ContactEngine, ContactSim};
+pub use on_off::{free_body, step_alternately, zero_gravity_solver, Run};
 pub use perturb::perturb;
 pub use rapier_setup::{
     lumped_masses, rapier_label, rapier_material, to_rapier, RAPIER_HARD_HZ, RAPIER_POISSON,

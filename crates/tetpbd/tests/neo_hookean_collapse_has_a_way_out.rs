@@ -13,16 +13,6 @@ use tetpbd::constraints::{
 };
 use tetpbd::Material;
 
-fn rest_tet(rng: &mut Rng, size: f64) -> [Vector3<f64>; 4] {
-    loop {
-        let t = [rng.vec(size), rng.vec(size), rng.vec(size), rng.vec(size)];
-        let d = Matrix3::from_columns(&[t[1] - t[0], t[2] - t[0], t[3] - t[0]]).determinant();
-        if d.abs() > 0.05 * size.powi(3) {
-            return t;
-        }
-    }
-}
-
 fn det_at(p: &[Vector3<f64>; 4], dm: &Matrix3<f64>) -> f64 {
     deformation_gradient(p, dm).determinant()
 }
@@ -65,7 +55,7 @@ fn recovering_hydrostatic_is_the_exact_gradient_outside_collapse() {
     let mut outside = 0;
     for n in 0..400 {
         let size = rng.range(0.05, 2.0);
-        let rest = rest_tet(&mut rng, size);
+        let rest = rng.tet(size);
         let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
         let a = Matrix3::identity() + Matrix3::from_fn(|_, _| rng.range(-0.6, 0.6));
         let p = rest.map(|x| a * x + rng.vec(0.05 * size));
@@ -102,7 +92,7 @@ fn recovery_direction_is_continuous() {
     let mut rng = Rng::new(42);
     for tau in thresholds() {
         for _ in 0..50 {
-            let rest = rest_tet(&mut rng, 1.0);
+            let rest = rng.tet(1.0);
             let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
             let centre = rng.vec(1.0);
             // Shrink the rest shape towards its centre through the threshold.
@@ -138,7 +128,7 @@ fn collapsed_tetrahedron_gets_a_direction_to_positive_volume() {
     for tau in thresholds() {
         for _ in 0..100 {
             let size = rng.range(0.05, 2.0);
-            let rest = rest_tet(&mut rng, size);
+            let rest = rng.tet(size);
             let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
             let centre = rng.vec(1.0);
             let axis = rng.vec(1.0).normalize();

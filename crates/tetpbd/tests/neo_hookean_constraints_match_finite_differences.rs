@@ -64,16 +64,6 @@ fn check(
 }
 
 /// A random rest tetrahedron of edge about `size`, positively or negatively wound.
-fn rest_tet(rng: &mut Rng, size: f64) -> [Vector3<f64>; 4] {
-    loop {
-        let t = [rng.vec(size), rng.vec(size), rng.vec(size), rng.vec(size)];
-        let d = Matrix3::from_columns(&[t[1] - t[0], t[2] - t[0], t[3] - t[0]]).determinant();
-        if d.abs() > 0.05 * size.powi(3) {
-            return t;
-        }
-    }
-}
-
 /// `rest` deformed by a random linear map plus a random perturbation of each corner.
 fn deformed(rng: &mut Rng, rest: &[Vector3<f64>; 4], strain: f64, noise: f64) -> [Vector3<f64>; 4] {
     let a = Matrix3::identity() + Matrix3::from_fn(|_, _| rng.range(-strain, strain));
@@ -113,7 +103,7 @@ fn neo_hookean_gradients_match_finite_differences_on_random_tetrahedra() {
     let mut rng = Rng::new(27);
     for _ in 0..400 {
         let size = rng.range(0.01, 2.0);
-        let rest = rest_tet(&mut rng, size);
+        let rest = rng.tet(size);
         let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
         let p = deformed(&mut rng, &rest, 0.6, 0.2 * size);
         let gamma = 1.0 + rng.range(0.0, 1.0);
@@ -126,7 +116,7 @@ fn neo_hookean_gradients_match_finite_differences_on_inverted_tetrahedra() {
     let mut rng = Rng::new(28);
     for _ in 0..300 {
         let size = rng.range(0.05, 1.0);
-        let rest = rest_tet(&mut rng, size);
+        let rest = rng.tet(size);
         let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
         // Mirror corner 3 through the plane of the other three: det F < 0.
         let mut p = deformed(&mut rng, &rest, 0.2, 0.02 * size);
@@ -150,7 +140,7 @@ fn neo_hookean_gradients_match_finite_differences_on_near_degenerate_tetrahedra(
     let mut rng = Rng::new(29);
     for squeeze in [1e-2, 1e-4, 1e-6] {
         for _ in 0..100 {
-            let rest = rest_tet(&mut rng, 1.0);
+            let rest = rng.tet(1.0);
             let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
             // Corner 3 squeezed to within `squeeze` of the plane of the other three (flat),
             // or all four squeezed onto a line (needle).
@@ -165,7 +155,7 @@ fn neo_hookean_gradients_match_finite_differences_on_near_degenerate_tetrahedra(
     }
     // All four corners at one point: the deviatoric direction is undefined (None), the
     // hydrostatic constraint finite with zero gradients.
-    let rest = rest_tet(&mut rng, 1.0);
+    let rest = rng.tet(1.0);
     let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
     let point = [Vector3::new(0.3, 0.2, 0.1); 4];
     assert!(neo_hookean_deviatoric(&point, &dm).is_none());
@@ -182,7 +172,7 @@ fn constraint_energy_is_the_neo_hookean_energy() {
         let (mu, lp) = (rng.range(1e3, 1e6), 0.0);
         let lp = lp + mu * rng.range(1.0, 50.0);
         let gamma = neo_hookean_rest_offset(mu, lp);
-        let rest = rest_tet(&mut rng, 0.5);
+        let rest = rng.tet(0.5);
         let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
         let v0 = dm.determinant().abs().recip() / 6.0;
         let p = deformed(&mut rng, &rest, 0.5, 0.05);
@@ -243,7 +233,7 @@ fn random_setup(
     let mu = rng.range(1e2, 1e7);
     let lp = mu * rng.range(1.0, 100.0);
     let size = rng.range(0.01, 1.0);
-    let rest = rest_tet(rng, size);
+    let rest = rng.tet(size);
     let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
     let v0 = dm.determinant().abs().recip() / 6.0;
     let w: [f64; 4] = std::array::from_fn(|_| rng.range(0.1, 10.0));
@@ -350,7 +340,7 @@ fn coupled_update_keeps_the_rest_state() {
 fn f32_matches_f64() {
     let mut rng = Rng::new(32);
     for _ in 0..100 {
-        let rest = rest_tet(&mut rng, 1.0);
+        let rest = rng.tet(1.0);
         let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
         let p = deformed(&mut rng, &rest, 0.3, 0.05);
         let (d64, h64) = (

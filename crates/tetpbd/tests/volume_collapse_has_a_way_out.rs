@@ -10,16 +10,6 @@ use tetpbd::constraints::{
     rest_shape_inverse, signed_volume, volume, volume_recovering, VOLUME_GATE,
 };
 
-fn rest_tet(rng: &mut Rng, size: f64) -> [Vector3<f64>; 4] {
-    loop {
-        let t = [rng.vec(size), rng.vec(size), rng.vec(size), rng.vec(size)];
-        let d = Matrix3::from_columns(&[t[1] - t[0], t[2] - t[0], t[3] - t[0]]).determinant();
-        if d.abs() > 0.05 * size.powi(3) {
-            return t;
-        }
-    }
-}
-
 fn vol(p: &[Vector3<f64>; 4]) -> f64 {
     signed_volume(&p[0], &p[1], &p[2], &p[3])
 }
@@ -31,7 +21,7 @@ fn recovering_volume_is_the_exact_gradient_outside_collapse() {
     let mut rng = Rng::new(7);
     for _ in 0..300 {
         let size = rng.range(0.01, 10.0);
-        let rest = rest_tet(&mut rng, size);
+        let rest = rng.tet(size);
         let v0 = vol(&rest);
         let dm = rest_shape_inverse(&rest[0], &rest[1], &rest[2], &rest[3]).unwrap();
         let a = Matrix3::identity() + Matrix3::from_fn(|_, _| rng.range(-0.6, 0.6));
@@ -67,7 +57,7 @@ fn collapsed_tetrahedron_has_a_direction_that_restores_volume() {
     let mut rng = Rng::new(8);
     for n in 0..200 {
         let size = rng.range(0.01, 10.0);
-        let mut rest = rest_tet(&mut rng, size);
+        let mut rest = rng.tet(size);
         if vol(&rest) < 0.0 {
             rest.swap(2, 3);
         }

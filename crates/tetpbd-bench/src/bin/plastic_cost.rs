@@ -13,8 +13,8 @@ use std::time::Instant;
 use clap::Parser;
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
-use tetpbd::{Particles, PlasticitySettings, SoftBodyBuilder, Solver, SolverSettings};
-use tetpbd_bench::{median, DT};
+use tetpbd::{Particles, PlasticitySettings, SoftBodyBuilder};
+use tetpbd_bench::{free_body, median, step_alternately, zero_gravity_solver, DT};
 
 /// Cost of plasticity: free cubes of about 1k, 10k and 100k tetrahedra with and without the
 /// component, then the flow pass alone with every tetrahedron flowing.
@@ -26,17 +26,14 @@ struct Args {
     frames: usize,
 }
 
-fn body(mesh: &tetpbd::TetMesh, plastic: bool) -> Result<tetpbd::SoftBody, tetpbd::BuildError> {
-    let b = SoftBodyBuilder::new(mesh.clone())
-        .density(1000.0)
-        .edges(1e-6)
-        .volume(1e-9);
-    let b = if plastic {
+/// `b` with the benchmark's families and, for `plastic`, the default plasticity.
+fn with_plasticity(b: SoftBodyBuilder, plastic: bool) -> SoftBodyBuilder {
+    let b = b.edges(1e-6).volume(1e-9);
+    if plastic {
         b.plasticity(PlasticitySettings::default())
     } else {
         b
-    };
-    b.build()
+    }
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -49,38 +46,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let tets = mesh.tets.len();
         let mut runs = Vec::new();
         for plastic in [false, true] {
-            let mut world = hecs::World::new();
-            let e = body(&mesh, plastic)?.spawn(&mut world);
-            world.insert_one(e, tetpbd::Activation::never_sleeps())?;
-            {
-                let mut p = world.get::<&mut Particles>(e)?;
-                let c = p.center_of_mass();
-                for i in 0..p.len() {
-                    let v = Vector3::new(0.0, 2.0, 0.0).cross(&(p.positions()[i] - c));
-                    p.set_velocity(i, v)?;
-                }
-            }
-            let solver = Solver::new(SolverSettings {
-                dt: DT,
-                gravity: Vector3::zeros(),
-                ..Default::default()
-            })?;
-            runs.push((world, solver, Vec::new()));
+            let (world, _) = free_body(&mesh, 2.0, |b| with_plasticity(b, plastic))?;
+            runs.push((world, zero_gravity_solver(|_| ())?));
         }
-        for f in 0..frames + 2 {
-            for (world, solver, times) in runs.iter_mut() {
-                let t = Instant::now();
-                solver.step(world)?;
-                if f >= 2 {
-                    times.push(t.elapsed().as_secs_f64() * 1e3);
-                }
-            }
-        }
-        let without = median(std::mem::take(&mut runs[0].2));
-        let with = median(std::mem::take(&mut runs[1].2));
+        let mut times = [Vec::new(), Vec::new()];
+        step_alternately(&mut runs, frames, |run, ms, _, _| {
+            times[run].push(ms);
+            Ok(())
+        })?;
+        let [without, with] = times.map(median);
         // Every tetrahedron past the yield: twisted by 1 rad/m, pinned there.
-        let mut world = hecs::World::new();
-        let e = body(&mesh, true)?.spawn(&mut world);
+        let (mut world, e) = free_body(&mesh, 0.0, |b| with_plasticity(b, true))?;
         {
             let mut p = world.get::<&mut Particles>(e)?;
             for i in 0..p.len() {

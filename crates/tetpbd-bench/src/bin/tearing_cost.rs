@@ -14,8 +14,8 @@ use std::time::Instant;
 use clap::Parser;
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
-use tetpbd::{Blade, Particles, SoftBodyBuilder, Solver, SolverSettings, TearingSettings};
-use tetpbd_bench::{median, DT};
+use tetpbd::{Blade, Particles, SoftBodyBuilder, TearingSettings};
+use tetpbd_bench::{free_body, median, step_alternately, zero_gravity_solver};
 
 /// Cost of tearing: free cubes of about 1k, 10k and 100k tetrahedra with and without the
 /// component while nothing tears, then a frame that tears everywhere and a cut.
@@ -27,33 +27,17 @@ struct Args {
     frames: usize,
 }
 
-/// The cube, tearing at `strain` (`None`: without the component).
-fn body(
-    mesh: &tetpbd::TetMesh,
-    strain: Option<f32>,
-) -> Result<tetpbd::SoftBody, tetpbd::BuildError> {
-    let b = SoftBodyBuilder::new(mesh.clone())
-        .density(1000.0)
-        .edges(1e-6)
-        .volume(1e-9);
+/// `b` with the benchmark's families, tearing at `strain` (`None`: without the component).
+fn with_tearing(b: SoftBodyBuilder, strain: Option<f32>) -> SoftBodyBuilder {
+    let b = b.edges(1e-6).volume(1e-9);
     match strain {
-        Some(strain) => b
-            .tearing(TearingSettings {
-                strain: Some(strain),
-                smoothing_time: 0.0,
-                ..Default::default()
-            })
-            .build(),
-        None => b.build(),
+        Some(strain) => b.tearing(TearingSettings {
+            strain: Some(strain),
+            smoothing_time: 0.0,
+            ..Default::default()
+        }),
+        None => b,
     }
-}
-
-fn solver() -> Result<Solver, tetpbd::SettingsError> {
-    Solver::new(SolverSettings {
-        dt: DT,
-        gravity: Vector3::zeros(),
-        ..Default::default()
-    })
 }
 
 /// Median ms per frame without and with the component, spinning at 2 rad/s, nothing torn,
@@ -64,45 +48,28 @@ fn untorn(
 ) -> Result<(f64, f64, f64), Box<dyn std::error::Error>> {
     let mut runs = Vec::new();
     for strain in [None, Some(0.5)] {
-        let mut world = hecs::World::new();
-        let e = body(mesh, strain)?.spawn(&mut world);
-        world.insert_one(e, tetpbd::Activation::never_sleeps())?;
-        {
-            let mut p = world.get::<&mut Particles>(e)?;
-            let c = p.center_of_mass();
-            for i in 0..p.len() {
-                let v = Vector3::new(0.0, 2.0, 0.0).cross(&(p.positions()[i] - c));
-                p.set_velocity(i, v)?;
-            }
-        }
-        runs.push((world, solver()?, Vec::new()));
+        let (world, _) = free_body(mesh, 2.0, |b| with_tearing(b, strain))?;
+        runs.push((world, zero_gravity_solver(|_| ())?));
     }
-    let mut pass = Vec::new();
-    for f in 0..frames + 2 {
-        for (world, solver, times) in runs.iter_mut() {
-            let t = Instant::now();
-            let stats = solver.step(world)?;
-            if f >= 2 {
-                times.push(t.elapsed().as_secs_f64() * 1e3);
-                if !stats.tearing_time.is_zero() {
-                    pass.push(stats.tearing_time.as_secs_f64() * 1e3);
-                }
-            }
-            if !solver.tear_events().is_empty() {
-                return Err("the spinning cube tore".into());
-            }
+    let (mut times, mut pass) = ([Vec::new(), Vec::new()], Vec::new());
+    step_alternately(&mut runs, frames, |run, ms, stats, solver| {
+        times[run].push(ms);
+        if !stats.tearing_time.is_zero() {
+            pass.push(stats.tearing_time.as_secs_f64() * 1e3);
         }
-    }
-    let without = median(std::mem::take(&mut runs[0].2));
-    let with = median(std::mem::take(&mut runs[1].2));
+        if !solver.tear_events().is_empty() {
+            return Err("the spinning cube tore".into());
+        }
+        Ok(())
+    })?;
+    let [without, with] = times.map(median);
     Ok((without, with, median(pass)))
 }
 
 /// The tearing pass's ms in the frame the cube, stretched to twice its length along x,
 /// tears (strain 0.3), with the faces torn; then the ms of a plane cut through its middle.
 fn torn(mesh: &tetpbd::TetMesh) -> Result<(f64, usize, f64), Box<dyn std::error::Error>> {
-    let mut world = hecs::World::new();
-    let e = body(mesh, Some(0.3))?.spawn(&mut world);
+    let (mut world, e) = free_body(mesh, 0.0, |b| with_tearing(b, Some(0.3)))?;
     {
         let mut p = world.get::<&mut Particles>(e)?;
         for i in 0..p.len() {
@@ -110,12 +77,11 @@ fn torn(mesh: &tetpbd::TetMesh) -> Result<(f64, usize, f64), Box<dyn std::error:
             p.set_position(i, Vector3::new(2.0 * x.x, x.y, x.z))?;
         }
     }
-    let mut solver = solver()?;
+    let mut solver = zero_gravity_solver(|_| ())?;
     let stats = solver.step(&mut world)?;
     let faces: usize = solver.tear_events().iter().map(|ev| ev.faces_torn).sum();
     let tearing = stats.tearing_time.as_secs_f64() * 1e3;
-    let mut world = hecs::World::new();
-    let e = body(mesh, None)?.spawn(&mut world);
+    let (mut world, e) = free_body(mesh, 0.0, |b| with_tearing(b, None))?;
     let blade = Blade::Plane {
         point: Vector3::new(0.013, 0.0, 0.0),
         normal: Vector3::x(),

@@ -13,8 +13,8 @@
 use clap::Parser;
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
-use tetpbd::{SoftBodyBuilder, Solver, SolverSettings, StepStats, Untangle};
-use tetpbd_bench::{FamilySet, DT};
+use tetpbd::Untangle;
+use tetpbd_bench::{free_body, step_alternately, zero_gravity_solver, FamilySet};
 
 /// Cost of the tangle recovery: free calm cubes of about 1k, 10k and 100k tetrahedra stepped
 /// with the recovery on and off in alternating frames.
@@ -31,46 +31,30 @@ struct Args {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let Args { frames, set } = Args::parse();
-    let set = set.name();
-    println!("free cube at rest, {set}, zero gravity, never sleeping; 10 substeps × 1 iteration per 1/60 s frame; mean of {frames} frames per column");
+    println!("free cube at rest, {}, zero gravity, never sleeping; 10 substeps × 1 iteration per 1/60 s frame; mean of {frames} frames per column", set.name());
     println!("| tetrahedra | off, ms/frame | on, ms/frame | on/off | frames moved |");
     println!("|---|---|---|---|---|");
     for cells in [6u32, 13, 28] {
         let mesh = box_grid(Vector3::new(1.0, 1.0, 1.0), [cells; 3], CellSplit::Five)?;
-        let tets = mesh.tets.len();
-        let mut worlds = Vec::new();
+        let mut runs = Vec::new();
         for on in [false, true] {
-            let b = SoftBodyBuilder::new(mesh.clone()).density(1000.0);
-            let b = if set == "vertex-face" {
-                b.vertex_face(1e-6)
-            } else {
-                b.edges(1e-6).volume(1e-9)
-            };
-            let mut world = hecs::World::new();
-            let e = b.build()?.spawn(&mut world);
-            world.insert_one(e, tetpbd::Activation::never_sleeps())?;
+            let (world, e) = free_body(&mesh, 0.0, |b| set.add_to(b))?;
             world.get::<&mut Untangle>(e)?.disabled = !on;
-            let solver = Solver::new(SolverSettings {
-                dt: DT,
-                gravity: Vector3::zeros(),
-                ..Default::default()
-            })?;
-            worlds.push((world, solver, 0.0f64, 0usize));
+            runs.push((world, zero_gravity_solver(|_| ())?));
         }
-        for f in 0..frames + 2 {
-            for (world, solver, total, moved) in worlds.iter_mut() {
-                let s: StepStats = solver.step(world)?;
-                if f >= 2 {
-                    *total += s.total_time.as_secs_f64() * 1e3 / frames as f64;
-                    *moved += s.bodies_untangled;
-                }
+        let (mut total, mut moved) = ([0.0f64; 2], 0usize);
+        step_alternately(&mut runs, frames, |run, _, stats, _| {
+            total[run] += stats.total_time.as_secs_f64() * 1e3 / frames as f64;
+            if run == 1 {
+                moved += stats.bodies_untangled;
             }
-        }
-        let (off, on) = (worlds[0].2, worlds[1].2);
+            Ok(())
+        })?;
+        let [off, on] = total;
         println!(
-            "| {tets} | {off:.3} | {on:.3} | {:.3} | {} |",
-            on / off,
-            worlds[1].3
+            "| {} | {off:.3} | {on:.3} | {:.3} | {moved} |",
+            mesh.tets.len(),
+            on / off
         );
     }
     Ok(())

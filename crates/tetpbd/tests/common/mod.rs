@@ -36,6 +36,24 @@ impl Rng {
             self.range(-half, half),
         )
     }
+
+    /// A tetrahedron of four points within `size` of the origin, not near degenerate:
+    /// `|det [x₁−x₀, x₂−x₀, x₃−x₀]| > 0.05 size³` (either orientation).
+    pub fn tet(&mut self, size: f64) -> [Vector3<f64>; 4] {
+        loop {
+            let t = [
+                self.vec(size),
+                self.vec(size),
+                self.vec(size),
+                self.vec(size),
+            ];
+            let d = nalgebra::Matrix3::from_columns(&[t[1] - t[0], t[2] - t[0], t[3] - t[0]])
+                .determinant();
+            if d.abs() > 0.05 * size.powi(3) {
+                return t;
+            }
+        }
+    }
 }
 
 /// One tetrahedron: the origin and the three unit points of the axes.
