@@ -60,12 +60,13 @@
 //! rigid body, as before, lost the soft reaction (a soft beam did not swing a multibody
 //! link; now it swings it within 0.2 rad of an impulse-jointed box over a 1.6 rad swing).
 //!
-//! Known limits. A soft cube 10 times heavier than a ball-jointed box rests only from 20
-//! substeps (or 2 iterations): at 5–10 substeps it tilts the box and slides off (the anchor
-//! holds). At 5 substeps with edges and volume, a 3:1 cube on a ball joint slides 1.3–1.4 cm
-//! and a 10:1 cube on a hinge slides off. With more iterations the same runs rest (2
-//! iterations at 10 substeps: 6–9 mm; 4 at 5: 4–7 mm), so it is the Gauss–Seidel convergence
-//! of the heavy soft body against the light box, not the joint. A soft body 100 or more
+//! Friction against a pivoting body is swept again after the iteration's other contacts
+//! (`rigid::body::pivoting` module docs, "Friction on a pivoting body"): without it a soft
+//! cube kept awake on a hinged or ball-jointed box crept downhill and tilted the box until it
+//! slid off.
+//!
+//! Known limits. A soft cube 10 times heavier than a ball-jointed box at 5 substeps with
+//! edges and volume tilts the box and slides off (the anchor holds). A soft body 100 or more
 //! times heavier than a box on a *multibody* slider, or on one at 5 substeps, keeps jiggling
 //! at 0.02–0.5 m/s (it stays on the box).
 

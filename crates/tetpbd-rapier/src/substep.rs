@@ -12,7 +12,9 @@ use tetpbd::{
 use crate::attachments::{anchor_of, project_attachments, Attachments};
 use crate::contacts::approach::limit_approach;
 use crate::contacts::corner::{project_corners, CornerPass};
-use crate::contacts::particle::{finish_substep, project_contacts, velocity_pass};
+use crate::contacts::particle::{
+    finish_substep, friction_on_pivoting, project_contacts, velocity_pass,
+};
 use crate::contacts::support::{
     end_substep_supports, hold_supported, measure_clearance, project_supports,
 };
@@ -252,6 +254,13 @@ impl SubstepHook for CouplingHook<'_, '_> {
         }
         project_supports(supports, bodies);
         project_joints(joints, bodies);
+        // Friction against pivoting bodies once more, against where the iteration left them
+        // (`rigid::body::pivoting` module docs, "Friction on a pivoting body").
+        for s in soft.iter() {
+            if let Ok(p) = world.query_one_mut::<&mut Particles>(s.entity) {
+                friction_on_pivoting(&mut contacts[s.contacts.clone()], p, bodies, colliders);
+            }
+        }
     }
 
     fn end_substep(&mut self, world: &mut World, substep: SubstepContext) {

@@ -245,6 +245,34 @@ fn friction(
     }
 }
 
+/// Sweeps of [`friction_on_pivoting`] per iteration (`rigid::body::pivoting` module docs,
+/// "Friction on a pivoting body": one sweep let a 10× cube creep off a ball-jointed box in
+/// 7 s, two left the rig spinning up about the vertical, four hold it).
+const PIVOTING_FRICTION_SWEEPS: usize = 4;
+
+/// Friction of one soft body's active contacts with pivoting bodies once more, against
+/// where every contact of the iteration left the bodies (`rigid::body::pivoting` module
+/// docs, "Friction on a pivoting body"); the static cone is shared with the contact's first
+/// friction in the substep (`lambda_t` goes on accumulating).
+pub(crate) fn friction_on_pivoting(
+    contacts: &mut [ParticleContact],
+    p: &mut Particles,
+    bodies: &mut [BodyProxy],
+    colliders: &[ColliderProxy],
+) {
+    for _ in 0..PIVOTING_FRICTION_SWEEPS {
+        for c in contacts.iter_mut() {
+            let cp = &colliders[c.collider];
+            let pivoting = cp.body.is_some_and(|b| bodies[b].is_pivoting());
+            if !(pivoting && c.active && c.solve && c.lambda_n > 0.0) {
+                continue;
+            }
+            let (q, n) = (c.point, c.normal);
+            friction(c, p, bodies, cp, &q, &n);
+        }
+    }
+}
+
 /// Velocity pass after a substep, per particle: the relative normal velocity of every
 /// contact active in the substep is set to zero (Müller et al. 2020 with `e = 0`), which
 /// removes the separating velocity the position projection created. Restitution itself

@@ -18,6 +18,23 @@
 //! (`body` module docs) every frame, and a swinging box crept off its anchor by 0.4 mm a
 //! second. Its generalized inverse
 //! mass at `p` along the unit `n` is `w = ((p − a) × n)ᵀ I_p⁻¹ ((p − a) × n)` (1/kg).
+//!
+//! # Friction on a pivoting body
+//!
+//! Positional friction removes a contact's slip `Δp_t` against the body's material point
+//! right after the contact's normal projection (`response::friction`). A later contact of the
+//! same iteration turns the body by `Δθ = I_p⁻¹((p' − a) × J')`, which moves the point `q` of
+//! the contact already solved by `Δθ × (q − a)`, partly along the surface; the next substep
+//! measures slip from where the particle and the body then stand, so that residual is never
+//! taken back. It has a direction: the contacts undo what rapier's step did to the body
+//! (which swings a light box back towards the vertical, unaware of its load), so the residual
+//! drags the load downhill, the body leans under it, and a load whose rig's centre of mass
+//! is little below the anchor creeps off (a 10× soft cube on a hinged 2 kg box: 0.025 mm a
+//! frame, off after 7 s, with the energy never growing). So after every contact, attachment
+//! and joint of the iteration, the contacts with pivoting bodies get their friction again,
+//! against where the iteration left the body, a few Gauss–Seidel sweeps with the static cone
+//! shared with the first (`contacts::particle::friction_on_pivoting`;
+//! `docs/decisions/pivoting-friction.md`).
 
 use nalgebra::{Matrix3, Vector3};
 
