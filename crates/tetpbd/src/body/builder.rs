@@ -325,11 +325,13 @@ impl SoftBodyBuilder {
             lambdas: vec![0.0; mesh.tets.len()],
             compliance: alpha,
         });
+        let slivers = crate::stabilisation::sliver_orientation::slivers(&mesh.tets, &mesh.vertices);
         let tetrahedra = Tetrahedra {
             indices: mesh.tets,
             rest_volumes,
             source,
             classes: tet_classes,
+            slivers,
         };
         let material =
             material.map(|m| crate::NeoHookeanMaterial::new(m, &tetrahedra, &mesh.vertices));

@@ -22,6 +22,10 @@ pub struct Tetrahedra {
     pub(crate) source: Vec<u32>,
     /// Colour classes of `indices` (tetrahedra of one class share no particle).
     pub(crate) classes: crate::ordering::colouring::ColourClasses,
+    /// The slivers among `indices`, by index: their orientation constraints are projected
+    /// once more after the edges ([`crate::stabilisation::sliver_orientation`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub(crate) slivers: Vec<u32>,
 }
 
 impl Tetrahedra {

@@ -168,7 +168,6 @@ impl NeoHookeanMaterial {
 /// The smallest altitude `3|V|/A_max` of the tetrahedra of `tets` at the rest positions
 /// `rest`, m (f64; `f64::INFINITY` for no tetrahedron or indices past `rest`).
 fn smallest_rest_altitude(tets: &Tetrahedra, rest: &[nalgebra::Vector3<f32>]) -> f64 {
-    const FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
     let mut smallest = f64::INFINITY;
     for (t, v0) in tets.indices.iter().zip(&tets.rest_volumes) {
         let corners = t.map(|i| rest.get(i as usize).map(|v| v.cast::<f64>()));
@@ -176,10 +175,7 @@ fn smallest_rest_altitude(tets: &Tetrahedra, rest: &[nalgebra::Vector3<f32>]) ->
             continue;
         };
         let x = [a, b, c, d];
-        let largest_face = FACES
-            .iter()
-            .map(|f| 0.5 * (x[f[1]] - x[f[0]]).cross(&(x[f[2]] - x[f[0]])).norm())
-            .fold(0.0f64, f64::max);
+        let largest_face = crate::stabilisation::sliver_orientation::largest_face(&x);
         if largest_face > 0.0 {
             smallest = smallest.min(3.0 * f64::from(v0.abs()) / largest_face);
         }

@@ -84,8 +84,11 @@ pub(crate) fn assemble(b: &SplitBody, particles: &[u32], tets: &[u32]) -> PieceP
     let (order, classes) = part_order(&local_tets, &part_of, parts, rest.len());
     let from: Vec<u32> = order.iter().map(|&k| tets[k]).collect();
     let pick = |t: &u32| *t as usize;
+    let indices: Vec<[u32; 4]> = order.iter().map(|&k| local_tets[k]).collect();
+    let slivers = crate::stabilisation::sliver_orientation::slivers(&indices, rest);
     let tetrahedra = Tetrahedra {
-        indices: order.iter().map(|&k| local_tets[k]).collect(),
+        indices,
+        slivers,
         rest_volumes: from
             .iter()
             .map(|t| b.tetrahedra.rest_volumes[pick(t)])

@@ -25,7 +25,8 @@ use crate::stabilisation::{correction_energy, deformation_damping};
 ///     reset λ
 ///     repeat `iterations` times:
 ///         copy the particles into the projections' working copy (crate::kernels::working_copy)
-///         project families in `order` on it, remove the rigid rotation of their
+///         project families in `order` on it, then the slivers' orientation constraints
+///         once more (stabilisation::sliver_orientation), remove the rigid rotation of their
 ///         corrections (conserve_angular_momentum), limit the kinetic energy they add
 ///         (limit_correction_energy), copy back, project the grabs (Grab), then
 ///         hook.project
@@ -362,6 +363,7 @@ impl Solver {
             f.projections += c.applied;
             f.degenerate += c.degenerate;
         }
+        crate::stabilisation::sliver_orientation::project_slivers(world, h);
         let t = Instant::now();
         if s.safety.conserve_angular_momentum || s.safety.limit_correction_energy {
             let (spin, limit) = (

@@ -16,6 +16,9 @@
 //!   ([`crate::DeformationDamping`], a component; run after every velocity update);
 //! * [`rigid_fit`] — the rigid fit of a field on a body's particles, the one every pass here
 //!   and the couplings use ([`crate::Particles::rigid_fit`]);
+//! * [`sliver_orientation`] — projecting the orientation constraints (volume, vertex–face)
+//!   of a body's slivers once more after its edges, which cannot tell an inverted sliver
+//!   from an upright one;
 //! * [`untangle`] — pulling a body that came to rest tangled (inverted tetrahedra, or elastic
 //!   energy no load explains) back to its best-fit rest shape ([`crate::Untangle`], a
 //!   component spawned with every body, on by default).
@@ -29,4 +32,5 @@ pub(crate) mod ground_up_sweep;
 pub(crate) mod hook_work;
 pub(crate) mod momentum_restoration;
 pub(crate) mod rigid_fit;
+pub(crate) mod sliver_orientation;
 pub(crate) mod untangle;
