@@ -196,7 +196,7 @@ pub(crate) fn store_measured(
         slots: &work.0,
         masses,
     };
-    let tau = give_back_within_budget(run, h, allowed, spin && scale < 1.0);
+    let tau = give_back_within_budget(run, h, allowed, spin);
     scale < 1.0 || tau < 1.0
 }
 

@@ -38,7 +38,10 @@
 //! ([`crate::stabilisation::give_back`], more passes only in iterations where the limit
 //! acts), so the limit never pushes or turns a free body. That pass also measures the
 //! velocity change it leaves, exactly, and scales it to the budget where the give-back
-//! would add energy (the limit wins over the momentum there). A body with pinned particles
+//! would add energy (the limit wins over the momentum there). It also runs, with `s = 1`,
+//! where the sums cannot tell the gain from the budget: they are f32 blocks, and a
+//! correction undoing most of the motion makes the gain a small difference of large terms
+//! ([`SUMS_UNCERTAINTY`] of them). A body with pinned particles
 //! (no spin removal) exchanges momentum with its pins anyway. The sums are
 //! the spin removal's ([`crate::stabilisation::angular_momentum`]), taken in the same pass; the limit costs a few
 //! multiply–adds per particle there and one more pass only in iterations where it acts.
