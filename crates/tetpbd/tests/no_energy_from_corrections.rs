@@ -290,7 +290,10 @@ fn impacts_end_intact_at_any_substep_count() {
 /// while the limit holds back its snap-back: one scale per body keeps the linear momentum,
 /// and the rigid part of what it holds back, fitted about the positions the substep ends
 /// at, is given back. Typical over these 30 frames of untangling: linear 1–2e-5, angular
-/// 4e-6 relative (8 % of the angular momentum lost without the give-back).
+/// 4e-6 relative (8 % of the angular momentum lost without the give-back). Where giving it
+/// all back would add kinetic energy (corrections pulling a turning body's particles
+/// inwards spin it up) the energy bound wins (`stabilisation::give_back`): the
+/// six-tetrahedra cube keeps its angular momentum to 2e-3.
 #[test]
 fn limited_tangled_body_keeps_its_momentum() {
     for split in SPLITS {
@@ -346,7 +349,7 @@ fn limited_tangled_body_keeps_its_momentum() {
             "{split:?}: linear momentum drift {dp:e} (relative)"
         );
         assert!(
-            dl < 1e-4,
+            dl < 1e-2,
             "{split:?}: angular momentum drift {dl:e} (relative)"
         );
     }

@@ -332,7 +332,7 @@ pub(crate) fn fix_up(
     fix: rigid_fit::FixUp<'_>,
     origin_centre: [Vector3<f32>; 2],
     theta: Vector3<f32>,
-    scale: f32,
+    limit: crate::stabilisation::correction_energy::Limit,
 ) {
     let n = fix.positions.len();
     let xp = fix.prev_positions;
@@ -347,7 +347,7 @@ pub(crate) fn fix_up(
             prev_positions: &xp[i],
             before,
         }
-        .apply(origin_centre, theta, scale);
+        .apply(origin_centre, theta, limit);
         Nothing
     });
 }

@@ -53,7 +53,8 @@
 use nalgebra::Vector3;
 
 use crate::body::particles::Particles;
-use crate::stabilisation::rigid_fit::{give_back_rigid, FixUp, Moments, StoreRun, BLOCK};
+use crate::stabilisation::give_back::{give_back_within_budget, GiveBack};
+use crate::stabilisation::rigid_fit::{FixUp, Moments, StoreRun, BLOCK};
 
 /// Copies a body's working copy back ([`crate::kernels::working_copy::store`]), removes the rigid-rotation
 /// part of the corrections the families made on it since it was loaded (the copy in the
@@ -146,7 +147,7 @@ pub(crate) fn store_measured(
     // The work was summed with velocities relative to `v0`: Σ m v·Δ = Σ m (v − v0)·Δ + v0·Σ m Δ
     // (the last term vanishes on a free body, not on a pinned one).
     sums.work += v0.cast::<f64>().dot(&sums.push);
-    let scale = crate::stabilisation::correction_energy::velocity_scale(
+    let limit = crate::stabilisation::correction_energy::velocity_scale(
         &sums,
         o.norm(),
         c,
@@ -154,7 +155,8 @@ pub(crate) fn store_measured(
         h,
         budget,
     );
-    if theta == Vector3::zeros() && scale == 1.0 {
+    let scale = limit.scale;
+    if theta == Vector3::zeros() && limit.check.is_none() {
         return false;
     }
     // Δᵢ −= θ × rᵢ = rᵢ × θ, with rᵢ = x̄ᵢ − o − c; then the velocity of (1 − s) Δᵢ taken out.
@@ -175,18 +177,27 @@ pub(crate) fn store_measured(
     };
     #[cfg(feature = "parallel")]
     if parallel {
-        crate::parallel::sweeps::fix_up(fix, [o, c], theta, scale);
+        crate::parallel::sweeps::fix_up(fix, [o, c], theta, limit);
     } else {
-        fix.apply([o, c], theta, scale);
+        fix.apply([o, c], theta, limit);
     }
     #[cfg(not(feature = "parallel"))]
-    fix.apply([o, c], theta, scale);
+    fix.apply([o, c], theta, limit);
     // The scale keeps the momentum of the corrections about the substep start, not about
-    // where the velocity update ends: give that back on a free body.
-    if scale < 1.0 && spin {
-        give_back_rigid(positions, residuals, &work.0, masses);
-    }
-    scale < 1.0
+    // where the velocity update ends: give that back on a free body, and hold the whole
+    // change to the budget.
+    let Some(allowed) = limit.check else {
+        return false;
+    };
+    let run = GiveBack {
+        positions,
+        residuals,
+        prev_positions,
+        slots: &work.0,
+        masses,
+    };
+    let tau = give_back_within_budget(run, h, allowed, spin);
+    scale < 1.0 || tau < 1.0
 }
 
 #[cfg(feature = "parallel")]

@@ -35,8 +35,13 @@
 //! zero linear momentum, and its zero angular momentum about the substep starts; about the
 //! positions the velocity update ends at, the part held back `(1 − s)Δ` carries a little
 //! angular momentum, whose rigid fit is given back to a free body
-//! ([`crate::stabilisation::rigid_fit::give_back_rigid`], one more pass in iterations where the
-//! limit acts), so the limit never pushes or turns a free body. A body with pinned particles
+//! ([`crate::stabilisation::give_back`], more passes only in iterations where the limit
+//! acts), so the limit never pushes or turns a free body. That pass also measures the
+//! velocity change it leaves, exactly, and scales it to the budget where the give-back
+//! would add energy (the limit wins over the momentum there). It also runs, with `s = 1`,
+//! where the sums cannot tell the gain from the budget: they are f32 blocks, and a
+//! correction undoing most of the motion makes the gain a small difference of large terms
+//! ([`SUMS_UNCERTAINTY`] of them). A body with pinned particles
 //! (no spin removal) exchanges momentum with its pins anyway. The sums are
 //! the spin removal's ([`crate::stabilisation::angular_momentum`]), taken in the same pass; the limit costs a few
 //! multiply–adds per particle there and one more pass only in iterations where it acts.
@@ -69,7 +74,8 @@ use nalgebra::Vector3;
 /// `θ` (zero when not removed), the substep `h` (s) and the budget (J, asked only when the
 /// corrections add energy at all; its arguments are the body's largest inverse mass, 1/kg,
 /// the work term `A` and the gain `ΔK(1)`, J: it may stop summing once it has reached the
-/// gain).
+/// gain). Returns `s` and, where the sums cannot tell the gain from the budget, the budget
+/// the exact check ([`crate::stabilisation::give_back`]) holds the iteration to.
 pub(crate) fn velocity_scale(
     sums: &Moments<f64>,
     origin: f32,
@@ -77,23 +83,41 @@ pub(crate) fn velocity_scale(
     theta: Vector3<f64>,
     h: f32,
     budget: impl FnOnce(f32, f64, f64) -> f64,
-) -> f32 {
+) -> Limit {
     let h = f64::from(h);
     // The corrections after the spin removal, Δ' = Δ − θ × r with r = x̄ − o − c:
     // Σ m v·Δ' = Σ m v·Δ − θ·Σ m r × v and Σ m|Δ'|² = Σ m|Δ|² − θ·Σ m r × Δ (θ = I⁺ Σ m r × Δ).
     let r_cross_v = sums.momentum_moment - c.cross(&sums.momentum);
     let r_cross_d = sums.torque - c.cross(&sums.push);
-    let work = sums.work - theta.dot(&r_cross_v);
-    let square = (sums.square - theta.dot(&r_cross_d)).max(0.0);
+    let (spin_work, spin_square) = (theta.dot(&r_cross_v), theta.dot(&r_cross_d));
+    let work = sums.work - spin_work;
+    let square = (sums.square - spin_square).max(0.0);
     let (a, q) = (work / h, square / (2.0 * h * h));
     let gain = a + q;
+    let none = Limit {
+        scale: 1.0,
+        check: None,
+    };
+    // The sums are f32 blocks and the rotation is removed in closed form: where the gain is
+    // a small difference of large terms (a correction undoing most of the motion), its sign
+    // is not known to better than this, J.
+    let terms =
+        (sums.work.abs() + spin_work.abs()) / h + (sums.square + spin_square.abs()) / (2.0 * h * h);
+    let unsure = SUMS_UNCERTAINTY * terms;
     // No gain, or a NaN one, or one within rounding: nothing to limit.
-    if gain.partial_cmp(&rounding_floor(sums, origin, h)) != Some(std::cmp::Ordering::Greater) {
-        return 1.0;
+    let floor = rounding_floor(sums, origin, h);
+    if (gain + unsure).partial_cmp(&floor) != Some(std::cmp::Ordering::Greater) {
+        return none;
     }
-    let e = budget(sums.inv_mass as f32, a, gain).max(0.0);
-    if gain <= e || !e.is_finite() {
-        return 1.0;
+    let e = budget(sums.inv_mass as f32, a, gain + unsure).max(0.0);
+    if gain + unsure <= e.max(floor) || !e.is_finite() {
+        return none;
+    }
+    if gain <= e {
+        return Limit {
+            scale: 1.0,
+            check: Some(e),
+        };
     }
     // The larger root of q s² + a s − e = 0: ΔK(s) ≤ e on [0, s], and ΔK(1) > e.
     let s = if q > 0.0 {
@@ -101,11 +125,28 @@ pub(crate) fn velocity_scale(
     } else {
         e / a
     };
-    if s.is_finite() {
-        s.clamp(0.0, 1.0) as f32
-    } else {
-        1.0
+    Limit {
+        scale: if s.is_finite() {
+            s.clamp(0.0, 1.0) as f32
+        } else {
+            1.0
+        },
+        check: Some(e),
     }
+}
+
+/// Relative uncertainty of the gain the store pass's sums give (dimensionless): f32 sums over
+/// blocks of 256 particles, a few times `256 ε`.
+const SUMS_UNCERTAINTY: f64 = 1e-4;
+
+/// What [`velocity_scale`] decided for one body and iteration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Limit {
+    /// The fraction `s ∈ [0, 1]` of the corrections that becomes velocity.
+    pub scale: f32,
+    /// The budget (J) the iteration's velocity change is then checked against, exactly,
+    /// after the give-back; `None`: the sums show it within the budget.
+    pub check: Option<f64>,
 }
 
 /// The kinetic energy (J) of corrections at the rounding of the positions: a particle at

@@ -6,7 +6,8 @@
 //! * [`correction_energy`] — keeping the families' corrections from adding more kinetic
 //!   energy than their compliant constraints release
 //!   ([`crate::SafetySettings::limit_correction_energy`], on by default), counting what a
-//!   hook's position corrections hand them as external work ([`hook_work`]);
+//!   hook's position corrections hand them as external work ([`hook_work`]), and giving a
+//!   free body back the momentum it held back within the same budget ([`give_back`]);
 //! * [`momentum_restoration`] — giving back, as a rigid velocity change, the momentum the
 //!   correction-speed safety net ([`crate::SafetySettings::max_correction_speed`]) clamped;
 //! * [`ground_up`] — one more sweep ordered from a body's supports outwards, for heavy loads
@@ -26,6 +27,7 @@
 pub(crate) mod angular_momentum;
 pub(crate) mod correction_energy;
 pub(crate) mod deformation_damping;
+pub(crate) mod give_back;
 pub(crate) mod ground_up;
 pub(crate) mod ground_up_levels;
 pub(crate) mod ground_up_sweep;

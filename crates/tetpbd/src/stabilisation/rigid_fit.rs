@@ -301,16 +301,24 @@ pub(crate) struct FixUp<'a> {
     /// Substep starts, m.
     pub prev_positions: &'a [Vector3<f32>],
     /// The slots, holding the positions and residuals before the families; with `s < 1`
-    /// they return the displacement `(1 − s) Δᵢ` whose velocity was taken out.
+    /// they return the displacement `(1 − s) Δᵢ` whose velocity was taken out (position
+    /// lanes) and the part `s Δᵢ` that stays velocity (residual lanes).
     pub before: &'a mut [Slot],
 }
 
 impl FixUp<'_> {
     /// `xᵢ += (x̄ᵢ − o − c) × θ` (compensated), `[o, c]` the sums' origin and the centre of
-    /// mass relative to it; then, with `s < 1`, the residual loses `(1 − s)` of the
+    /// mass relative to it; then, where the limit's check follows, the residual loses `(1 − s)` of the
     /// correction `xᵢ + rᵢ − (xᵢ + rᵢ)_before`, so the velocity update sees `s` of it (the
-    /// part taken out is left in the slots for [`give_back_rigid`]).
-    pub(crate) fn apply(self, [o, c]: [Vector3<f32>; 2], theta: Vector3<f32>, scale: f32) {
+    /// part taken out and the part kept are left in the slots for
+    /// [`crate::stabilisation::give_back::give_back_within_budget`]).
+    pub(crate) fn apply(
+        self,
+        [o, c]: [Vector3<f32>; 2],
+        theta: Vector3<f32>,
+        limit: crate::stabilisation::correction_energy::Limit,
+    ) {
+        let scale = limit.scale;
         let FixUp {
             positions,
             residuals,
@@ -327,13 +335,15 @@ impl FixUp<'_> {
             if rotate {
                 add_compensated(x, r, (xb - o - c).cross(&theta));
             }
-            if scale < 1.0 {
+            if limit.check.is_some() {
                 let [a, b0, c0, _] = b.xw.to_array();
                 let [ra, rb, rc, _] = b.r.to_array();
                 let d = (*x - Vector3::new(a, b0, c0)) + (*r - Vector3::new(ra, rb, rc));
                 let w = d * (1.0 - scale);
                 *r -= w;
+                let kept = d - w;
                 b.xw = f32x4::new([w.x, w.y, w.z, 0.0]);
+                b.r = f32x4::new([kept.x, kept.y, kept.z, 0.0]);
             }
         }
     }
@@ -386,44 +396,5 @@ impl StoreRun<'_> {
             slot.r = f32x4::new([r0.x, r0.y, r0.z, 0.0]);
         }
         m
-    }
-}
-
-/// Gives back the linear and angular momentum that taking the velocity of `wᵢ` (the
-/// displacements left in `slots` by [`FixUp::apply`]) out of a free body removed: the rigid
-/// fit of `w` about the body's current positions, `w̄ + θ × (xᵢ − c)`, goes back into the
-/// residuals, so what is taken out has no momentum about the positions the velocity update
-/// ends at. Sums in f64 in particle order on one thread (the same for any thread count).
-pub(crate) fn give_back_rigid(
-    positions: &[Vector3<f32>],
-    residuals: &mut [Vector3<f32>],
-    slots: &[Slot],
-    masses: &[f32],
-) {
-    let Some(&o) = positions.first() else {
-        return;
-    };
-    let (mut mass, mut first, mut second) = (0.0f64, Vector3::zeros(), Matrix3::zeros());
-    let (mut moment, mut total) = (Vector3::<f64>::zeros(), Vector3::<f64>::zeros());
-    for ((x, s), m) in positions.iter().zip(slots).zip(masses) {
-        let [a, b, c, _] = s.xw.to_array();
-        let (m, x) = (f64::from(*m), (x - o).cast::<f64>());
-        let w = Vector3::new(a, b, c).cast::<f64>() * m;
-        mass += m;
-        first += x * m;
-        second += x * x.transpose() * m;
-        moment += x.cross(&w);
-        total += w;
-    }
-    let Some((c, theta)) = rigid_fit(mass, first, second, moment, total) else {
-        return;
-    };
-    let mean = total / mass;
-    for (x, r) in positions.iter().zip(residuals) {
-        let back = mean + theta.cross(&((x - o).cast::<f64>() - c));
-        let back = back.cast::<f32>();
-        if back.iter().all(|v| v.is_finite()) {
-            *r += back;
-        }
     }
 }
