@@ -348,8 +348,14 @@ fn limited_tangled_body_keeps_its_momentum() {
             dp < 1e-4,
             "{split:?}: linear momentum drift {dp:e} (relative)"
         );
+        // Five tetrahedra per cell: the whole give-back fits the energy bound; six: the
+        // bound trims it.
+        let angular_bound = match split {
+            CellSplit::Five => 1e-4,
+            CellSplit::Six => 1e-2,
+        };
         assert!(
-            dl < 1e-2,
+            dl < angular_bound,
             "{split:?}: angular momentum drift {dl:e} (relative)"
         );
     }
