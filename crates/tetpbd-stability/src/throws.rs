@@ -94,7 +94,7 @@ impl Throw {
     pub const FRAMES: usize = 120;
 
     /// Throws number `index` of the family seeded `seed`: sizes 0.1–2 m, 2–8 cells per side,
-    /// both splits (balls: six), cubes and balls, 50–300 m/s, 1–80 substeps, edges + volume or
+    /// both splits, cubes and balls, 50–300 m/s, 1–80 substeps, edges + volume or
     /// vertex–face + edges, hard or compliant. A compliant body is drawn as a material: a
     /// modulus `M` of 0.1–10 MPa for every family, its compliances those of its cells
     /// (edges and vertex–face `1/(M L)` m/N with `L` the cell's edge, volume `V/M` m⁵/N with
@@ -110,10 +110,8 @@ impl Throw {
         } else {
             CellSplit::Six
         };
-        // Balls are split in six: a ball of five-split cells can end with inverted
-        // tetrahedra released at rest (known limit, `docs/decisions/impact-approach-speed.md`).
         let shape = if r.below(3) == 0 {
-            Shape::Ball(size / 2.0, cells.max(3), CellSplit::Six)
+            Shape::Ball(size / 2.0, cells.max(3), split)
         } else {
             Shape::Cube(size, cells, split)
         };
