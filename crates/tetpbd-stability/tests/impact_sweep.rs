@@ -61,7 +61,7 @@ fn fails_landing(t: &Throw, coupled: bool) -> bool {
 }
 
 /// Known limit: a ball of five-split cells can still end with one or two inverted
-/// tetrahedra (4 of 48 seeded throws on the suite's ground, each a Five ball, none of a
+/// tetrahedra (3–4 of 48 seeded throws on the suite's ground, each a Five ball, none of a
 /// cube or a Six ball; `docs/decisions/impact-approach-speed.md`). Its volume and its
 /// rebound still hold.
 fn known_limit(t: &Throw, l: &Landing) -> bool {

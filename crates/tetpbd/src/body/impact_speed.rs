@@ -18,11 +18,11 @@
 //! tilted face), the stopped region is smaller than the body's cross-section and the strain
 //! around it is larger: a soft ball (radius 0.4 m, 6³ cells) inverted tetrahedra thrown at
 //! 0.38 `c` and none at 0.19 `c`, while a cube took 0.25 `c` at any size. So a body that
-//! approaches a contact faster than [`APPROACH_STRAIN`] × `min(c, L/h)` (an eighth of its
-//! wave speed, or of a cell a substep) has the excess approach taken by the whole body, as
-//! a contact's excess depth is ([`crate::ImpactReach::limit_approach`]). With hard
-//! constraints (`c = ∞`) this is an eighth of a cell per substep; with compliant ones it is
-//! less.
+//! approaches a contact faster than [`APPROACH_STRAIN`] × `c` (an eighth of its wave speed)
+//! or than its local reach a substep (a quarter cell) has the excess approach taken by the
+//! whole body, as a contact's excess depth is ([`crate::ImpactReach::limit_approach`]).
+//! With hard constraints (`c = ∞`) this is the quarter cell per substep the particle rule
+//! already holds; with compliant ones it is less.
 
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::body::mesh::Tetrahedra;
@@ -92,24 +92,20 @@ pub fn wave_speed(
 }
 
 /// The elastic strain `v/c` an impact may leave in a body's cells before the excess of its
-/// approach speed `v` is taken by the whole body (dimensionless; module docs), `c` at most
-/// a cell a substep. An eighth: a quarter, enough on a flat face, inverted tetrahedra of
+/// approach speed `v` is taken by the whole body (dimensionless; module docs). An eighth: a quarter, enough on a flat face, inverted tetrahedra of
 /// balls (`docs/decisions/impact-approach-speed.md`).
 pub const APPROACH_STRAIN: f32 = 0.125;
 
 /// How far a body may approach a contact within a substep of `h` (s) before the excess is
-/// taken by the whole body, m: [`APPROACH_STRAIN`] × `min(c h, L)` with `c` the body's
-/// [`wave_speed`] (m/s) and `L = reach / LOCAL_REACH` its mean surface edge, from its local
-/// reach `reach` ([`crate::local_reach`], m): the strain an eighth, the push carried at
-/// most a cell a substep. Half the reach for a rigid family (`c = ∞`).
+/// taken by the whole body, m: `min(APPROACH_STRAIN × c h, reach)` with `c` the body's
+/// [`wave_speed`] (m/s) and `reach` its local reach ([`crate::local_reach`], m, a quarter
+/// cell). `reach` itself for a rigid family (`c = ∞`).
 pub fn approach_limit(reach: f32, c: f32, h: f32) -> f32 {
-    let cell = reach / crate::LOCAL_REACH;
     let carried = APPROACH_STRAIN * c * h;
-    let most = APPROACH_STRAIN * cell;
     if carried.is_nan() {
-        most
+        reach
     } else {
-        most.min(carried)
+        reach.min(carried)
     }
 }
 
@@ -167,10 +163,9 @@ mod tests {
     }
 
     #[test]
-    fn the_approach_limit_is_an_eighth_of_a_cell_when_the_constraints_keep_up_and_less_when_not() {
-        let cell = 0.03 / crate::LOCAL_REACH;
-        assert!((approach_limit(0.03, f32::INFINITY, 1e-3) - APPROACH_STRAIN * cell).abs() < 1e-7);
-        assert!((approach_limit(0.03, 1e6, 1e-3) - APPROACH_STRAIN * cell).abs() < 1e-7);
+    fn the_approach_limit_is_the_reach_when_the_constraints_keep_up_and_less_when_not() {
+        assert_eq!(approach_limit(0.03, f32::INFINITY, 1e-3), 0.03);
+        assert_eq!(approach_limit(0.03, 1e6, 1e-3), 0.03);
         let slow = approach_limit(0.03, 10.0, 1e-3);
         assert!((slow - APPROACH_STRAIN * 10.0 * 1e-3).abs() < 1e-9);
     }
