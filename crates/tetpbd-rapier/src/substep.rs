@@ -325,6 +325,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 bodies,
                 colliders,
                 threshold,
+                h,
             );
             rolling_pass(
                 active_colliders,

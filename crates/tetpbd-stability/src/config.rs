@@ -80,8 +80,22 @@ impl Config {
     /// (a case's "stiffest finite compliance" passes a tiny value with `soft`). The material
     /// has no compliance to scale: it keeps its preset's E and ν (its stiff case is rubber).
     pub fn apply(&self, b: SoftBodyBuilder, scale: f32) -> SoftBodyBuilder {
+        self.apply_scaled(b, scale, scale)
+    }
+
+    /// [`Config::apply`] with the length compliances (edges, vertex–face) multiplied by
+    /// `length_scale` and the volume compliance by `volume_scale`.
+    pub fn apply_scaled(
+        &self,
+        b: SoftBodyBuilder,
+        length_scale: f32,
+        volume_scale: f32,
+    ) -> SoftBodyBuilder {
         let (l, v) = if self.soft {
-            (Self::SOFT_LENGTH * scale, Self::SOFT_VOLUME * scale)
+            (
+                Self::SOFT_LENGTH * length_scale,
+                Self::SOFT_VOLUME * volume_scale,
+            )
         } else {
             (0.0, 0.0)
         };

@@ -18,6 +18,7 @@ mod ground;
 mod report;
 mod run;
 pub mod settle;
+mod throws;
 
 pub use cases::{all_cases, impact, Case, CaseKind, SWEEP_SUBSTEPS};
 pub use config::{Config, ConstraintSet};
@@ -31,3 +32,4 @@ pub use report::{markdown, verdict, Verdict};
 pub use run::{
     run_scene, run_scene_observed, stable_substeps, substeps_for, FrameView, Outcome, Scene, Start,
 };
+pub use throws::{Landing, Shape, Throw};

@@ -40,6 +40,9 @@ pub struct Scene {
     pub frames: usize,
     /// Multiplies the soft compliances (1 = the configuration's own).
     pub compliance_scale: f32,
+    /// Multiplies the soft volume compliance on top of [`Scene::compliance_scale`] (1: the
+    /// same scale for every family).
+    pub volume_compliance_scale: f32,
     /// Relative volume epsilon of the builder.
     pub epsilon: f32,
     /// The case demands recovery: no inverted tetrahedron and volume within 1 % at the end.
@@ -63,6 +66,7 @@ impl Scene {
             settings: SolverSettings::default(),
             frames: 60,
             compliance_scale: 1.0,
+            volume_compliance_scale: 1.0,
             epsilon: SoftBodyBuilder::DEFAULT_EPSILON,
             require_recovery: false,
             free_fall: false,
@@ -289,7 +293,8 @@ fn builder(scene: &Scene, config: &Config) -> SoftBodyBuilder {
         .density(1000.0)
         .pinned(scene.pinned.iter().copied())
         .volume_epsilon(scene.epsilon);
-    config.apply(builder, scene.compliance_scale)
+    let scale = scene.compliance_scale;
+    config.apply_scaled(builder, scale, scale * scene.volume_compliance_scale)
 }
 
 /// Runs `scene` under `config`.

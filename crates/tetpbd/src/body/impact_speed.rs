@@ -13,15 +13,18 @@
 //! The speed at which the constraints carry a push is the body's longitudinal wave speed
 //! `c = √(M/ρ)`, `M` the stiffest family's modulus and `ρ` the body's density
 //! ([`wave_speed`]); within one substep no solver carries it faster than one cell, `L/h`.
-//! A body that approaches a contact faster than [`LOCAL_REACH`] × `min(c, L/h)` — the
-//! elastic strain `v/c` of a quarter, the strain the reach allows a cell — is compressed
-//! beyond the reach by its own momentum before its constraints can stop it; the excess
-//! approach is taken by the whole body, as a contact's excess depth is
-//! ([`crate::ImpactReach::limit_approach`]). With hard constraints (`c = ∞`) this is the
-//! quarter cell per substep the particle rule already holds; with compliant ones it is less.
+//! A body meeting a wall at speed `v` is strained by `v/c` where the wall stops a whole
+//! face at once. Where the contact first meets it on a small patch (a ball, an edge, a
+//! tilted face), the stopped region is smaller than the body's cross-section and the strain
+//! around it is larger: a soft ball (radius 0.4 m, 6³ cells) inverted tetrahedra thrown at
+//! 0.38 `c` and none at 0.19 `c`, while a cube took 0.25 `c` at any size. So a body that
+//! approaches a contact faster than [`APPROACH_STRAIN`] × `c` (an eighth of its wave speed)
+//! or than its local reach a substep (a quarter cell) has the excess approach taken by the
+//! whole body, as a contact's excess depth is ([`crate::ImpactReach::limit_approach`]).
+//! With hard constraints (`c = ∞`) this is the quarter cell per substep the particle rule
+//! already holds; with compliant ones it is less.
 
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
-use crate::body::impact_reach::LOCAL_REACH;
 use crate::body::mesh::Tetrahedra;
 use crate::body::neo_hookean::NeoHookeanMaterial;
 use crate::body::particles::Particles;
@@ -88,12 +91,17 @@ pub fn wave_speed(
     }
 }
 
+/// The elastic strain `v/c` an impact may leave in a body's cells before the excess of its
+/// approach speed `v` is taken by the whole body (dimensionless; module docs). An eighth: a quarter, enough on a flat face, inverted tetrahedra of
+/// balls (`docs/decisions/impact-approach-speed.md`).
+pub const APPROACH_STRAIN: f32 = 0.125;
+
 /// How far a body may approach a contact within a substep of `h` (s) before the excess is
-/// taken by the whole body, m: [`LOCAL_REACH`] × `min(c h, L)` with `c` the body's
-/// [`wave_speed`] (m/s) and `reach = LOCAL_REACH × L` its local reach
-/// ([`crate::local_reach`], m). `reach` itself for a rigid family (`c = ∞`).
+/// taken by the whole body, m: `min(APPROACH_STRAIN × c h, reach)` with `c` the body's
+/// [`wave_speed`] (m/s) and `reach` its local reach ([`crate::local_reach`], m, a quarter
+/// cell). `reach` itself for a rigid family (`c = ∞`).
 pub fn approach_limit(reach: f32, c: f32, h: f32) -> f32 {
-    let carried = LOCAL_REACH * c * h;
+    let carried = APPROACH_STRAIN * c * h;
     if carried.is_nan() {
         reach
     } else {
@@ -159,6 +167,6 @@ mod tests {
         assert_eq!(approach_limit(0.03, f32::INFINITY, 1e-3), 0.03);
         assert_eq!(approach_limit(0.03, 1e6, 1e-3), 0.03);
         let slow = approach_limit(0.03, 10.0, 1e-3);
-        assert!((slow - LOCAL_REACH * 10.0 * 1e-3).abs() < 1e-9);
+        assert!((slow - APPROACH_STRAIN * 10.0 * 1e-3).abs() < 1e-9);
     }
 }
