@@ -325,7 +325,6 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 bodies,
                 colliders,
                 threshold,
-                h,
             );
             rolling_pass(
                 active_colliders,

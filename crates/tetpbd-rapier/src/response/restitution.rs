@@ -21,19 +21,6 @@
 //!    soft body squeezed under a load after an impact therefore does not spring back while
 //!    the load rests on it (it does once the load is lifted).
 //!
-//! *Returning is not bouncing.* A soft body that stops on a contact is compressed: its centre
-//! of mass goes on towards the collider after the contact surface stopped, by up to its
-//! strain times its depth. To take its shape back with its contact surface at rest, its
-//! centre of mass must move back as far. Capping `v_n` at `−e·v⁻` from the end of the
-//! compression on would hold it there, the body pressed into its own stopped surface for as
-//! long as it touches: a compliant cube at 250 m/s stayed 4 % short of its volume, a ball
-//! released from 5 cm kept 12 tetrahedra inverted. So the episode also counts how far the
-//! centre of mass went towards the collider since it began (`sunk`, m, from `v_n h` each
-//! substep) and lets it move back by that much: the cap is `max(−e·v⁻ + allowance, sunk/h)`.
-//! The body's own recoil then returns its centre of mass at most to where it touched, and a
-//! recoil beyond, which would lift it off, is removed as before; nothing is added, so no
-//! energy is gained.
-//!
 //! `e` is the largest combined restitution among the pair's contacts.
 //!
 //! The cap stops the body's own recoil, not a pull: the loads applied to the body besides
@@ -75,55 +62,35 @@ pub(crate) struct Episode {
     /// The separation speed the applied loads have given since the episode began, m/s
     /// (module docs).
     allowance: f32,
-    /// How far the centre of mass moved towards the collider since the episode began, m
-    /// (module docs: it may move back as far).
-    sunk: f32,
     compressing: bool,
     seen: bool,
 }
 
 impl Episode {
     /// The change of the relative normal velocity `v_n` (m/s, > 0 separating) that steps 2
-    /// and 3 of the module docs ask for in this substep of `h` (s), `e` the pair's
-    /// restitution and `pull` (m/s) the change of `v_n` the applied loads gave in the
-    /// substep; `None` when nothing is to change. A contact that is not an impact is capped
-    /// at the allowance. The cap is at least the speed that returns the centre of mass to
-    /// where the episode began within the substep (module docs).
-    pub fn change(&mut self, v_n: f32, e: f32, pull: f32, h: f32) -> Option<f32> {
+    /// and 3 of the module docs ask for in this substep, `e` the pair's restitution and
+    /// `pull` (m/s) the change of `v_n` the applied loads gave in the substep; `None` when
+    /// nothing is to change. A contact that is not an impact is capped at the allowance.
+    pub fn change(&mut self, v_n: f32, e: f32, pull: f32) -> Option<f32> {
         if pull.is_finite() {
             self.allowance = (self.allowance + pull).max(0.0);
         }
         let bounce = if self.impact { -e * self.approach } else { 0.0 };
         let target = bounce + self.allowance;
-        let back = if h > 0.0 && self.sunk > 0.0 {
-            self.sunk / h
-        } else {
-            0.0
-        };
         let dv = if self.compressing {
             if v_n < 0.0 {
-                self.sink(v_n, h);
                 return None;
             }
             self.compressing = false;
-            Some(target.max(v_n.min(back)) - v_n).filter(|dv| *dv != 0.0)
+            Some(target - v_n)
         } else {
-            (v_n > target.max(back)).then_some(target.max(back) - v_n)
+            (v_n > target).then_some(target - v_n)
         };
         // The allowance never runs ahead of the separation the body has: loads that the
         // contact balances (a lower body's weight on its support) add nothing.
-        let after = v_n + dv.unwrap_or(0.0);
-        self.allowance = self.allowance.min((after - bounce).max(0.0));
-        self.sink(after, h);
+        let after = v_n + dv.unwrap_or(0.0) - bounce;
+        self.allowance = self.allowance.min(after.max(0.0));
         dv
-    }
-
-    /// Counts the substep's normal motion `v_n h` (m) into [`Self::sunk`].
-    fn sink(&mut self, v_n: f32, h: f32) {
-        let moved = v_n * h;
-        if moved.is_finite() {
-            self.sunk -= moved;
-        }
     }
 }
 
@@ -166,7 +133,6 @@ impl Episodes {
                     approach,
                     impact,
                     allowance: 0.0,
-                    sunk: 0.0,
                     compressing: impact,
                     seen: false,
                 };
@@ -191,7 +157,7 @@ impl Episodes {
 /// Runs the episodes of one soft body after a substep's velocity update. `contacts` are the
 /// body's contacts (contiguous per collider), `v_cm_pre` its centre-of-mass velocity before
 /// the substep, `pull` the change of its velocity the applied loads and gravity gave in the
-/// substep (m/s, module docs), `h` the substep, s. `active` is scratch space (its capacity is reused across
+/// substep (m/s, module docs). `active` is scratch space (its capacity is reused across
 /// calls).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn restitution_pass(
@@ -206,7 +172,6 @@ pub(crate) fn restitution_pass(
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
     threshold: f32,
-    h: f32,
 ) {
     let Some((v_cm, mass)) = p.free_velocity() else {
         return;
@@ -234,7 +199,7 @@ pub(crate) fn restitution_pass(
             continue;
         };
         let pull = if anchored { 0.0 } else { n.dot(pull) };
-        let Some(dv) = ep.change(n.dot(&(v_cm - vb)), e, pull, h) else {
+        let Some(dv) = ep.change(n.dot(&(v_cm - vb)), e, pull) else {
             continue;
         };
         let w_soft = if anchored { 0.0 } else { 1.0 / mass };

@@ -111,14 +111,14 @@ impl BodyRestitution {
                 .extend(g.bodies.iter().map(|b| b.pull(world, gravity, h)));
             let threshold = 2.0 * a_max * h;
             for k in 0..g.pairs.len() {
-                self.pair(world, g, k, threshold, h);
+                self.pair(world, g, k, threshold);
             }
         }
         self.episodes.end_substep();
     }
 
     /// The restitution of pair `k` of the frame.
-    fn pair(&mut self, world: &mut World, g: &Gather, k: usize, threshold: f32, h: f32) {
+    fn pair(&mut self, world: &mut World, g: &Gather, k: usize, threshold: f32) {
         let (a, b) = g.pairs[k];
         let len = self.sums[k].norm();
         if len.is_nan() || len <= 1e-9 {
@@ -141,7 +141,7 @@ impl BodyRestitution {
         let dv = self
             .episodes
             .episode(key, approach, threshold)
-            .change(v_n, e, pull, h);
+            .change(v_n, e, pull);
         if let Some(dv) = dv.filter(|dv| !dv.is_nan()) {
             // A body resting on a support that holds a much heavier one still takes no
             // share (`carrying` module docs).

@@ -5,7 +5,10 @@
 use hecs::Entity;
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
-use rapier3d::prelude::{ColliderBuilder, ColliderHandle, RigidBodyBuilder, RigidBodyHandle};
+use rapier3d::prelude::{
+    ColliderBuilder, ColliderHandle, GenericJoint, RevoluteJointBuilder, RigidBodyBuilder,
+    RigidBodyHandle, SphericalJointBuilder,
+};
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider};
@@ -68,4 +71,41 @@ pub fn particles(scene: &CoupledWorld, e: Entity) -> Particles {
 pub fn com(scene: &CoupledWorld, e: Entity) -> (Vector3<f32>, Vector3<f32>) {
     let p = scene.soft.get::<&Particles>(e).expect("soft body");
     (p.center_of_mass(), p.linear_momentum() / p.total_mass())
+}
+
+/// A 2 kg box of 0.2 m, its centre at (0, 0.8, 0), on `joint` (impulse or multibody) from a
+/// fixed body at (0, 1, 0).
+pub fn hanging_box(s: &mut CoupledWorld, joint: GenericJoint, multibody: bool) -> RigidBodyHandle {
+    let anchor = s
+        .physics
+        .bodies
+        .insert(RigidBodyBuilder::fixed().translation(Vector::new(0.0, 1.0, 0.0)));
+    let (bx, _) = s.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 0.8, 0.0)),
+        ColliderBuilder::cuboid(0.1, 0.1, 0.1).mass(2.0),
+    );
+    if multibody {
+        s.physics.multibody_joints.insert(anchor, bx, joint, true);
+    } else {
+        s.physics.impulse_joints.insert(anchor, bx, joint, true);
+    }
+    bx
+}
+
+/// A revolute joint about z from the anchor at (0, 1, 0) to the top of the box.
+pub fn hinge() -> (GenericJoint, [bool; 3]) {
+    let joint = RevoluteJointBuilder::new(Vector::Z)
+        .local_anchor2(Vector::new(0.0, 0.2, 0.0))
+        .build()
+        .into();
+    (joint, [true; 3])
+}
+
+/// A spherical joint from the anchor at (0, 1, 0) to the top of the box.
+pub fn ball() -> (GenericJoint, [bool; 3]) {
+    let joint = SphericalJointBuilder::new()
+        .local_anchor2(Vector::new(0.0, 0.2, 0.0))
+        .build()
+        .into();
+    (joint, [true; 3])
 }

@@ -92,8 +92,9 @@ pub fn wave_speed(
 }
 
 /// The elastic strain `v/c` an impact may leave in a body's cells before the excess of its
-/// approach speed `v` is taken by the whole body (dimensionless; module docs). An eighth: a quarter, enough on a flat face, inverted tetrahedra of
-/// balls (`docs/decisions/impact-approach-speed.md`).
+/// approach speed `v` is taken by the whole body (dimensionless; module docs). An eighth: a
+/// quarter holds on a flat face but inverted tetrahedra of balls
+/// (`docs/decisions/impact-approach-speed.md`).
 pub const APPROACH_STRAIN: f32 = 0.125;
 
 /// How far a body may approach a contact within a substep of `h` (s) before the excess is
