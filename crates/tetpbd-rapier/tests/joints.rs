@@ -9,10 +9,8 @@ use rapier3d::prelude::{
     FixedJointBuilder, GenericJoint, PrismaticJointBuilder, RevoluteJointBuilder,
     SphericalJointBuilder,
 };
-use robust_common::{ball, hanging_box, hinge, scene, scene_substeps};
-use tetpbd::generators::{self, CellSplit};
-use tetpbd::SoftBodyBuilder;
-use tetpbd_rapier::{Attachments, CoupledWorld};
+use robust_common::{attach_beam, ball, cube_on_box, hanging_box, hinge, scene, scene_substeps};
+use tetpbd_rapier::CoupledWorld;
 
 /// The joints tried: name, joint with anchors (0, 0, 0) on the fixed body and (0, 0.2, 0)
 /// on the box, and which components of the anchor drift count (a prismatic joint slides
@@ -73,22 +71,7 @@ fn hang(
 ) -> Vec<f32> {
     let mut s: CoupledWorld = scene();
     let bx = hanging_box(&mut s, joint, multibody);
-    let mesh = generators::beam(0.6, 0.1, 6, 1, CellSplit::Six).expect("mesh");
-    let roots = generators::beam_root(&mesh);
-    let body = SoftBodyBuilder::new(mesh)
-        .density(beam_mass / 0.006)
-        .edges(0.0)
-        .volume(0.0)
-        .translation(Vector3::new(0.1, 0.75, -0.05))
-        .build()
-        .expect("beam");
-    let mut att = Attachments::new();
-    for &i in &roots {
-        att.attach_to_body(&body.particles, i, &s.physics.bodies, bx, 0.0)
-            .expect("attach");
-    }
-    let e = body.spawn(&mut s.soft);
-    s.soft.insert_one(e, att).expect("entity");
+    attach_beam(&mut s, bx, beam_mass);
     let mut drift = Vec::new();
     let mut worst = 0.0f32;
     for f in 0..60 * seconds {
@@ -165,16 +148,7 @@ fn cube_on_jointed_box(
 ) -> (f32, f32, f32) {
     let mut s: CoupledWorld = scene_substeps(substeps);
     let bx = hanging_box(&mut s, joint, multibody);
-    let mesh = generators::box_grid(Vector3::repeat(0.2), [3; 3], CellSplit::Six).expect("mesh");
-    let b = SoftBodyBuilder::new(mesh)
-        .density(2.0 * ratio / 0.008)
-        .translation(Vector3::new(0.0, 1.003, 0.0));
-    let b = if vertex_face {
-        b.vertex_face(0.0).edges(0.0)
-    } else {
-        b.edges(0.0).volume(0.0)
-    };
-    let e = b.build().expect("cube").spawn(&mut s.soft);
+    let e = cube_on_box(&mut s, ratio, vertex_face);
     let centre = |s: &CoupledWorld| {
         let p = s.soft.get::<&tetpbd::Particles>(e).expect("particles");
         p.positions().iter().sum::<Vector3<f32>>() / p.len() as f32
@@ -298,22 +272,7 @@ fn slider() -> (GenericJoint, [bool; 3]) {
 fn swing(joint: GenericJoint, multibody: bool, frames: usize) -> Vec<Vector3<f32>> {
     let mut s: CoupledWorld = scene();
     let bx = hanging_box(&mut s, joint, multibody);
-    let mesh = generators::beam(0.6, 0.1, 6, 1, CellSplit::Six).expect("mesh");
-    let roots = generators::beam_root(&mesh);
-    let body = SoftBodyBuilder::new(mesh)
-        .density(2.0 / 0.006)
-        .edges(0.0)
-        .volume(0.0)
-        .translation(Vector3::new(0.1, 0.75, -0.05))
-        .build()
-        .expect("beam");
-    let mut att = Attachments::new();
-    for &i in &roots {
-        att.attach_to_body(&body.particles, i, &s.physics.bodies, bx, 0.0)
-            .expect("attach");
-    }
-    let e = body.spawn(&mut s.soft);
-    s.soft.insert_one(e, att).expect("entity");
+    attach_beam(&mut s, bx, 2.0);
     (0..frames)
         .map(|_| {
             s.step().expect("step");

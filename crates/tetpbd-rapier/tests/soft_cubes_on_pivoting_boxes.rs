@@ -7,9 +7,7 @@ mod robust_common;
 use nalgebra::Vector3;
 use rapier3d::math::Vector;
 use rapier3d::prelude::{GenericJoint, RigidBodyHandle};
-use robust_common::{ball, hanging_box, hinge, scene_substeps};
-use tetpbd::generators::{self, CellSplit};
-use tetpbd::SoftBodyBuilder;
+use robust_common::{ball, cube_on_box, hanging_box, hinge, scene_substeps};
 use tetpbd_rapier::CoupledWorld;
 
 /// What a soft cube kept awake on a pivoting box did: its largest horizontal slide on the
@@ -52,16 +50,7 @@ fn awake_cube_on_pivoting_box(
 ) -> Pivoted {
     let mut s: CoupledWorld = scene_substeps(substeps);
     let bx = hanging_box(&mut s, joint, multibody);
-    let mesh = generators::box_grid(Vector3::repeat(0.2), [3; 3], CellSplit::Six).expect("mesh");
-    let b = SoftBodyBuilder::new(mesh)
-        .density(2.0 * ratio / 0.008)
-        .translation(Vector3::new(0.0, 1.003, 0.0));
-    let b = if vertex_face {
-        b.vertex_face(0.0).edges(0.0)
-    } else {
-        b.edges(0.0).volume(0.0)
-    };
-    let e = b.build().expect("cube").spawn(&mut s.soft);
+    let e = cube_on_box(&mut s, ratio, vertex_face);
     s.soft
         .insert_one(e, tetpbd::Activation::never_sleeps())
         .expect("entity");

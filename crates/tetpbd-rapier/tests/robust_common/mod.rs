@@ -109,3 +109,40 @@ pub fn ball() -> (GenericJoint, [bool; 3]) {
         .into();
     (joint, [true; 3])
 }
+
+/// A hard soft beam of `mass` kg (0.6 m along x, 6 × 1 × 1 cells) whose root face is
+/// attached to the +x side of the box `bx` of [`hanging_box`].
+pub fn attach_beam(s: &mut CoupledWorld, bx: RigidBodyHandle, mass: f32) -> Entity {
+    let mesh = generators::beam(0.6, 0.1, 6, 1, CellSplit::Six).expect("mesh");
+    let roots = generators::beam_root(&mesh);
+    let body = SoftBodyBuilder::new(mesh)
+        .density(mass / 0.006)
+        .edges(0.0)
+        .volume(0.0)
+        .translation(Vector3::new(0.1, 0.75, -0.05))
+        .build()
+        .expect("beam");
+    let mut att = tetpbd_rapier::Attachments::new();
+    for &i in &roots {
+        att.attach_to_body(&body.particles, i, &s.physics.bodies, bx, 0.0)
+            .expect("attach");
+    }
+    let e = body.spawn(&mut s.soft);
+    s.soft.insert_one(e, att).expect("entity");
+    e
+}
+
+/// A hard soft cube (0.2 m, 3³ cells) of `ratio` × the 2 kg of the box of [`hanging_box`],
+/// resting on its top: edges + vertex–face for `vertex_face`, else edges + volume.
+pub fn cube_on_box(s: &mut CoupledWorld, ratio: f32, vertex_face: bool) -> Entity {
+    let mesh = generators::box_grid(Vector3::repeat(0.2), [3; 3], CellSplit::Six).expect("mesh");
+    let b = SoftBodyBuilder::new(mesh)
+        .density(2.0 * ratio / 0.008)
+        .translation(Vector3::new(0.0, 1.003, 0.0));
+    let b = if vertex_face {
+        b.vertex_face(0.0).edges(0.0)
+    } else {
+        b.edges(0.0).volume(0.0)
+    };
+    b.build().expect("cube").spawn(&mut s.soft)
+}
