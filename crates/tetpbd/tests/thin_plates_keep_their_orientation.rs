@@ -4,22 +4,11 @@
 //! plates end with their tetrahedra upright at 1–80 substeps (all but one tetrahedron in a
 //! few runs), and the pass adds no energy.
 
+mod common;
+
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{hecs, Particles, SoftBodyBuilder, Solver, SolverSettings, Tetrahedra};
-
-/// Kinetic + gravitational energy, J.
-fn energy(p: &Particles) -> f64 {
-    p.positions()
-        .iter()
-        .zip(p.velocities())
-        .zip(p.masses())
-        .map(|((x, v), &m)| {
-            let m = f64::from(m);
-            m * 9.81 * f64::from(x.y) + 0.5 * m * v.cast::<f64>().norm_squared()
-        })
-        .sum()
-}
 
 /// What one swing measured.
 struct Swing {
@@ -54,13 +43,16 @@ fn swing(thickness: f32, cells: u32, split: CellSplit, volume: bool, substeps: u
     let mut solver = Solver::new(settings).unwrap();
     let (e0, scale) = {
         let p = world.get::<&Particles>(body).unwrap();
-        (energy(&p), f64::from(p.total_mass()) * 9.81)
+        (
+            common::mechanical_energy(&p),
+            f64::from(p.total_mass()) * 9.81,
+        )
     };
     let mut gain = f64::NEG_INFINITY;
     for _ in 0..120 {
         solver.step(&mut world).unwrap();
         let p = world.get::<&Particles>(body).unwrap();
-        gain = gain.max(energy(&p) - e0);
+        gain = gain.max(common::mechanical_energy(&p) - e0);
     }
     let (p, t) = world
         .query_one_mut::<(&Particles, &Tetrahedra)>(body)

@@ -3,6 +3,8 @@
 //! 1 m × 1 cm, stay inverted after its largest bend (a known limit of sliver meshes, listed
 //! in the stability report's findings).
 
+mod common;
+
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{hecs, Particles, SoftBodyBuilder, Solver, SolverSettings, Tetrahedra};
@@ -18,18 +20,6 @@ struct Bend {
     gain: f64,
     /// `M g L` (L the slab's length), J.
     scale: f64,
-}
-
-fn energy(p: &Particles) -> f64 {
-    p.positions()
-        .iter()
-        .zip(p.velocities())
-        .zip(p.masses())
-        .map(|((x, v), &m)| {
-            let m = f64::from(m);
-            m * 9.81 * f64::from(x.y) + 0.5 * m * v.cast::<f64>().norm_squared()
-        })
-        .sum()
 }
 
 /// A 10 m × 1 cm × 1 m slab of 10 × 1 × 1 cells, hard edges + volume, its end at x = −5 m
@@ -51,7 +41,10 @@ fn bend(split: CellSplit) -> Bend {
     let mut solver = Solver::new(SolverSettings::default()).unwrap();
     let (e0, scale) = {
         let p = world.get::<&Particles>(body).unwrap();
-        (energy(&p), f64::from(p.total_mass()) * 9.81 * 10.0)
+        (
+            common::mechanical_energy(&p),
+            f64::from(p.total_mass()) * 9.81 * 10.0,
+        )
     };
     let (mut most, mut lowest, mut gain) = (0, f32::INFINITY, f64::NEG_INFINITY);
     for _ in 0..180 {
@@ -67,7 +60,7 @@ fn bend(split: CellSplit) -> Bend {
             .map(|x| x.y)
             .fold(f32::INFINITY, f32::min);
         lowest = lowest.min(tip);
-        gain = gain.max(energy(p) - e0);
+        gain = gain.max(common::mechanical_energy(p) - e0);
     }
     let (p, t) = world
         .query_one_mut::<(&Particles, &Tetrahedra)>(body)

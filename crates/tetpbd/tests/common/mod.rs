@@ -158,3 +158,16 @@ pub fn state_bits(p: &tetpbd::Particles) -> Vec<[u32; 3]> {
         .map(|x| x.map(f32::to_bits).into())
         .collect()
 }
+
+/// Kinetic + gravitational energy (g = 9.81 m/s² along −y) of the particles, J, in `f64`.
+pub fn mechanical_energy(p: &Particles) -> f64 {
+    p.positions()
+        .iter()
+        .zip(p.velocities())
+        .zip(p.masses())
+        .map(|((x, v), &m)| {
+            let m = f64::from(m);
+            m * 9.81 * f64::from(x.y) + 0.5 * m * v.cast::<f64>().norm_squared()
+        })
+        .sum()
+}
