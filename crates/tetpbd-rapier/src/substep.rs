@@ -277,6 +277,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             supports,
             stats,
             depenetrating,
+            attachments,
             ..
         } = &mut *self.frame;
         for b in bodies.iter_mut() {
@@ -324,6 +325,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 &pull,
                 bodies,
                 colliders,
+                &attachments[s.attachments.clone()],
                 threshold,
             );
             rolling_pass(

@@ -11,13 +11,16 @@
 //!    surface triangle); `v⁻ = n·(v_cm − v_rigid(q))` is
 //!    the approach speed of the body's centre of mass before that substep (`n`, `q` the mean
 //!    normal and point of the active contacts). Only an approach faster than `2|g|h` is an
-//!    impact (resting contacts never bounce);
+//!    impact; a slower one (a resting contact, a tumbling body setting a corner down) has
+//!    no compression phase and a bounce of 0, so it never springs off (step 3);
 //! 2. compression ends at the first substep where the relative normal velocity `v_n` of the
 //!    centre of mass is ≥ 0; the body then receives the uniform velocity change that makes
 //!    `v_n = −e·v⁻` (with the opposite impulse on a dynamic rigid body, generalized inverse
 //!    mass at `q`; a soft body with pinned particles is anchored and takes no share);
-//! 3. while the contact lasts, `v_n` is capped at `−e·v⁻`, so the body's elastic recoil does
-//!    not add bounce; the episode ends with the last active contact (kept across frames). A
+//! 3. while the contact lasts, `v_n` is capped at `−e·v⁻` (at 0 for a contact that is not
+//!    an impact), so the body's elastic recoil does not add bounce: a corner squashed when
+//!    a body was set down does not throw it back up as it recovers its shape; the episode
+//!    ends with the last active contact (kept across frames). A
 //!    soft body squeezed under a load after an impact therefore does not spring back while
 //!    the load rests on it (it does once the load is lifted).
 //!
@@ -46,6 +49,7 @@ use nalgebra::Vector3;
 use rapier3d::geometry::ColliderHandle;
 use tetpbd::Particles;
 
+use crate::attachments::AttachRun;
 use crate::contacts::corner::CornerContact;
 use crate::contacts::particle::ParticleContact;
 use crate::rigid::body::BodyProxy;
@@ -103,20 +107,8 @@ pub(crate) struct Episodes {
 
 impl Episodes {
     /// The episode of pair `key`, begun now with the approach speed `approach()` (m/s,
-    /// normal velocity before the substep, < 0 approaching) if it is new, marked as seen in
-    /// this substep; `None` when it is not an impact (approach slower than `threshold`,
-    /// m/s).
-    pub fn impact(
-        &mut self,
-        key: (u64, u64),
-        approach: impl FnOnce() -> f32,
-        threshold: f32,
-    ) -> Option<&mut Episode> {
-        let ep = self.episode(key, approach, threshold);
-        ep.impact.then_some(ep)
-    }
-
-    /// The episode of pair `key`, impact or not (as [`Episodes::impact`]).
+    /// normal velocity before the substep, < 0 approaching) if it is new (an impact when
+    /// faster than `threshold`, m/s), marked as seen in this substep.
     pub fn episode(
         &mut self,
         key: (u64, u64),
@@ -157,8 +149,8 @@ impl Episodes {
 /// Runs the episodes of one soft body after a substep's velocity update. `contacts` are the
 /// body's contacts (contiguous per collider), `v_cm_pre` its centre-of-mass velocity before
 /// the substep, `pull` the change of its velocity the applied loads and gravity gave in the
-/// substep (m/s, module docs). `active` is scratch space (its capacity is reused across
-/// calls).
+/// substep (m/s, module docs), `attached` its attachment runs. `active` is scratch space
+/// (its capacity is reused across calls).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn restitution_pass(
     episodes: &mut Episodes,
@@ -171,6 +163,7 @@ pub(crate) fn restitution_pass(
     pull: &Vector3<f32>,
     bodies: &mut [BodyProxy],
     colliders: &[ColliderProxy],
+    attached: &[AttachRun],
     threshold: f32,
 ) {
     let Some((v_cm, mass)) = p.free_velocity() else {
@@ -185,6 +178,11 @@ pub(crate) fn restitution_pass(
             continue;
         };
         let cp = &colliders[ci];
+        // A body attached to the collider's rigid body moves with it through the attachment,
+        // which owns their relative motion: no episode between them.
+        if cp.body.is_some() && attached.iter().any(|a| a.body == cp.body) {
+            continue;
+        }
         let vb = cp
             .body
             .map_or(Vector3::zeros(), |b| bodies[b].velocity_at(&q));
@@ -195,9 +193,7 @@ pub(crate) fn restitution_pass(
                 .map_or(Vector3::zeros(), |b| bodies[b].velocity_at_pre(&q));
             n.dot(&(v_cm_pre - vb_pre))
         };
-        let Some(ep) = episodes.impact(key, approach, threshold) else {
-            continue;
-        };
+        let ep = episodes.episode(key, approach, threshold);
         let pull = if anchored { 0.0 } else { n.dot(pull) };
         let Some(dv) = ep.change(n.dot(&(v_cm - vb)), e, pull) else {
             continue;
