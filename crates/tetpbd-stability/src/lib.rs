@@ -13,6 +13,7 @@ mod config;
 mod coupled;
 mod coupled_rapier;
 mod coupled_robust;
+mod draws;
 pub mod energy;
 mod ground;
 mod report;
@@ -27,6 +28,7 @@ pub use coupled_rapier::rapier_comparison;
 pub use coupled_robust::{
     pull_apart, pull_apart_in, PullFigures, BLOWN_UP_SPEED, FRAGMENT_SPEED_MARGIN, PULL_SPEEDS,
 };
+pub use draws::Draws;
 pub use ground::Ground;
 pub use report::{markdown, verdict, Verdict};
 pub use run::{

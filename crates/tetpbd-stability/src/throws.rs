@@ -17,6 +17,7 @@ use tetpbd::{Particles, SoftBodyBuilder, SolverSettings, TetMesh, Tetrahedra};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings, SoftCollider};
 
 use crate::config::{Config, ConstraintSet};
+use crate::draws::Draws;
 use crate::run::{run_scene, Scene};
 use crate::settle::{SETTLE_DAMPING, SETTLE_FRAMES};
 
@@ -102,7 +103,7 @@ impl Throw {
     /// fixed compliance at any cell size is not one material: the matrix's 1e-9 m⁵/N on
     /// 2 cm cells is a bulk modulus of 20 Pa, a body that folds under a 2 m/s landing.)
     pub fn sample(seed: u64, index: u64) -> Throw {
-        let mut r = Draws::new(seed, index);
+        let mut r = Draws::stream(seed, index);
         let size = 0.1 * 20f32.powf(r.unit());
         let cells = 2 + r.below(7) as u32;
         let split = if r.below(2) == 0 {
@@ -252,35 +253,5 @@ impl Throw {
             self.speed,
             self.substeps
         )
-    }
-}
-
-/// A deterministic stream of draws (splitmix64).
-struct Draws(u64);
-
-impl Draws {
-    /// The stream of draw `index` of family `seed`.
-    fn new(seed: u64, index: u64) -> Draws {
-        let mut d = Draws(seed);
-        d.0 ^= d.next().wrapping_add(index);
-        d
-    }
-
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    /// Uniform in 0..n.
-    fn below(&mut self, n: u64) -> u64 {
-        (self.next() >> 33) % n
     }
 }

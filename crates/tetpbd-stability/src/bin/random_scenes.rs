@@ -18,6 +18,7 @@ use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
 use tetpbd::generators::{self, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder, SolverSettings};
 use tetpbd_rapier::{CoupledWorld, CouplingSettings};
+use tetpbd_stability::Draws;
 
 /// Options of the command line.
 #[derive(clap::Parser, Debug)]
@@ -100,30 +101,6 @@ impl tetpbd::SubstepHook for SubstepTrace {
     }
 }
 
-/// A small deterministic generator (SplitMix64).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `[a, b)`.
-    fn range(&mut self, a: f32, b: f32) -> f32 {
-        a + (b - a) * ((self.next() >> 40) as f32 / (1u64 << 24) as f32)
-    }
-    /// Log-uniform in `[a, b)`.
-    fn log(&mut self, a: f32, b: f32) -> f32 {
-        (self.range(a.ln(), b.ln())).exp()
-    }
-    fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
-        xs[(self.next() % xs.len() as u64) as usize]
-    }
-}
-
 /// What a scene measured.
 #[derive(Debug, Default)]
 struct Outcome {
@@ -171,7 +148,7 @@ fn energy(s: &CoupledWorld) -> (f32, f32) {
 
 /// A soft body of random size, density, mesh and families.
 fn random_body(
-    rng: &mut Rng,
+    rng: &mut Draws,
     at: Vector3<f32>,
     v: Vector3<f32>,
     family: Option<u64>,
@@ -215,7 +192,7 @@ fn random_body(
 
 /// One random scene `k`: builds it, runs 4 s and measures.
 fn run_scene(k: u64, o: &Options) -> (String, Outcome) {
-    let mut rng = Rng(0x5EED_0000 + k);
+    let mut rng = Draws::from_seed(0x5EED_0000 + k);
     let substeps = rng.pick(&[2u32, 5, 10, 20, 40]);
     let substeps = std::env::var("SUBSTEPS")
         .ok()
