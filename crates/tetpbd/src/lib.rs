@@ -62,7 +62,8 @@ mod solver;
 mod stabilisation;
 
 pub use body::activation::{Activation, Asleep};
-pub use body::builder::{unique_edges, SoftBody, SoftBodyBuilder, TetMesh};
+pub use body::builder::{SoftBody, SoftBodyBuilder, TetMesh};
+pub use body::rest_families::unique_edges;
 pub use body::cutting::{cut, Blade};
 pub use body::elastic_energy::ElasticFamilies;
 pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};

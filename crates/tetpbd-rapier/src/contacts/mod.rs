@@ -4,7 +4,8 @@
 //! * [`particle`]: a soft surface particle against a collider (parry point projection).
 //! * [`approach`]: a fast body touching something immovable stopped as a whole, down to
 //!   what its constraints carry within a substep.
-//! * [`corner`]: a rigid corner or support point against a soft surface triangle.
+//! * [`corner`]: a rigid corner or support point against a soft surface triangle
+//!   ([`corner_friction`] its friction).
 //! * [`support`]: the rigid contacts of a body anchored by an attachment.
 //!
 //! The candidates come from [`crate::gather`] once per frame; friction is
@@ -13,5 +14,6 @@
 
 pub(crate) mod approach;
 pub(crate) mod corner;
+pub(crate) mod corner_friction;
 pub(crate) mod particle;
 pub(crate) mod support;

@@ -4,10 +4,11 @@ use hecs::{Entity, World};
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
+use crate::body::lumped_mass::{pinned_inverse_masses, rest_volumes_and_masses};
 use crate::body::mesh::{Surface, Tetrahedra};
 use crate::body::particles::Particles;
 use crate::body::placement::Placement;
-use crate::constraints::{bounded_height, signed_volume, VERTEX_FACE_KAPPA, VERTEX_FACE_ORDER};
+use crate::body::rest_families::{edge_constraints, vertex_face_constraints};
 use crate::error::BuildError;
 use crate::kernels::slots::{Slot, WorkCopy};
 use crate::ordering::partition::{auto_parts, longest_axis, part_order, slab_parts};
@@ -439,131 +440,4 @@ pub(crate) fn body_parts(
         p => p,
     };
     (parts, slab_parts(vertices, tets, axis, parts))
-}
-
-/// The signed rest volume of every tetrahedron (in input order) and the lumped mass of every
-/// vertex (a quarter of each incident tetrahedron's mass), checking indices and degeneracy.
-fn rest_volumes_and_masses(
-    mesh: &TetMesh,
-    density: f32,
-    epsilon: f32,
-) -> Result<(Vec<f32>, Vec<f32>), BuildError> {
-    let n = mesh.vertices.len();
-    let mut rest_volumes = Vec::with_capacity(mesh.tets.len());
-    let mut masses = vec![0.0f32; n];
-    for (t, tet) in mesh.tets.iter().enumerate() {
-        for (k, &i) in tet.iter().enumerate() {
-            if i as usize >= n {
-                return Err(BuildError::IndexOutOfRange {
-                    tet: t,
-                    index: i,
-                    vertex_count: n,
-                });
-            }
-            if tet[..k].contains(&i) {
-                return Err(BuildError::RepeatedVertex { tet: t, index: i });
-            }
-        }
-        let p = tet.map(|i| mesh.vertices[i as usize]);
-        let vol = signed_volume(&p[0], &p[1], &p[2], &p[3]);
-        let mut longest = 0.0f32;
-        for a in 0..4 {
-            for b in a + 1..4 {
-                longest = longest.max((p[a] - p[b]).norm());
-            }
-        }
-        let threshold = epsilon * longest * longest * longest;
-        // NaN-safe: anything not strictly above the threshold (overflow included) is rejected.
-        if vol.abs().partial_cmp(&threshold) != Some(std::cmp::Ordering::Greater) || vol == 0.0 {
-            return Err(BuildError::DegenerateTetrahedron {
-                tet: t,
-                volume: vol,
-                threshold,
-            });
-        }
-        rest_volumes.push(vol);
-        for &i in tet {
-            masses[i as usize] += density * vol.abs() / 4.0;
-        }
-    }
-    if let Some(vertex) = masses.iter().position(|m| *m <= 0.0) {
-        return Err(BuildError::UnreferencedVertex { vertex });
-    }
-    Ok((rest_volumes, masses))
-}
-
-/// Inverse masses, 0 for the pinned vertices.
-fn pinned_inverse_masses(masses: &[f32], pinned: &[u32]) -> Result<Vec<f32>, BuildError> {
-    let mut inv_masses: Vec<f32> = masses.iter().map(|m| 1.0 / m).collect();
-    for &i in pinned {
-        match inv_masses.get_mut(i as usize) {
-            Some(w) => *w = 0.0,
-            None => {
-                return Err(BuildError::PinnedOutOfRange {
-                    index: i,
-                    vertex_count: masses.len(),
-                })
-            }
-        }
-    }
-    Ok(inv_masses)
-}
-
-/// The edge family of a built mesh (particles and tetrahedra in solver order), its edges in
-/// the solver's order for the body's parts.
-pub(crate) fn edge_constraints(
-    mesh: &TetMesh,
-    part_of: &[u32],
-    parts: usize,
-    alpha: f32,
-) -> EdgeConstraints {
-    let sorted = unique_edges(&mesh.tets);
-    let (edge_order, classes) = part_order(&sorted, part_of, parts, mesh.vertices.len());
-    let list: Vec<[u32; 2]> = edge_order.iter().map(|&k| sorted[k]).collect();
-    let rest_lengths = list
-        .iter()
-        .map(|[a, b]| (mesh.vertices[*a as usize] - mesh.vertices[*b as usize]).norm())
-        .collect();
-    EdgeConstraints {
-        lambdas: vec![0.0; list.len()],
-        edges: list,
-        rest_lengths,
-        compliance: alpha,
-        classes,
-    }
-}
-
-/// The vertex–face family of a built mesh: the rest values of each tetrahedron's four
-/// constraints.
-fn vertex_face_constraints(mesh: &TetMesh, alpha: f32) -> VertexFaceConstraints {
-    VertexFaceConstraints {
-        rest_heights: mesh
-            .tets
-            .iter()
-            .map(|tet| {
-                VERTEX_FACE_ORDER.map(|o| {
-                    let [a, b, c, d] = o.map(|k| mesh.vertices[tet[k] as usize]);
-                    // The volume check guarantees a non-degenerate tetrahedron.
-                    bounded_height(&a, &b, &c, &d, VERTEX_FACE_KAPPA, 0.0).unwrap_or(0.0)
-                })
-            })
-            .collect(),
-        lambdas: vec![[0.0; 4]; mesh.tets.len()],
-        compliance: alpha,
-    }
-}
-
-/// The unique edges of `tets`, each `[low, high]`, sorted.
-pub fn unique_edges(tets: &[[u32; 4]]) -> Vec<[u32; 2]> {
-    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(tets.len() * 6);
-    for t in tets {
-        for a in 0..4 {
-            for b in a + 1..4 {
-                edges.push([t[a].min(t[b]), t[a].max(t[b])]);
-            }
-        }
-    }
-    edges.sort_unstable();
-    edges.dedup();
-    edges
 }

@@ -21,7 +21,8 @@
 
 use nalgebra::Vector3;
 
-use crate::body::builder::{body_parts, edge_constraints, SoftBody, TetMesh};
+use crate::body::builder::{body_parts, SoftBody, TetMesh};
+use crate::body::rest_families::edge_constraints;
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::body::forces::UserForces;
 use crate::body::mesh::{Surface, Tetrahedra};
