@@ -15,12 +15,12 @@ impl Draws {
     /// unrelated).
     pub fn stream(seed: u64, index: u64) -> Draws {
         let mut d = Draws(seed);
-        d.0 ^= d.next().wrapping_add(index);
+        d.0 ^= d.bits().wrapping_add(index);
         d
     }
 
     /// The next 64 random bits.
-    pub fn next(&mut self) -> u64 {
+    pub fn bits(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -30,7 +30,7 @@ impl Draws {
 
     /// Uniform in `[0, 1)`.
     pub fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+        (self.bits() >> 40) as f32 / (1u64 << 24) as f32
     }
 
     /// Uniform in `[a, b)`.
@@ -45,12 +45,12 @@ impl Draws {
 
     /// Uniform in `0..n` from the high bits (`n` > 0).
     pub fn below(&mut self, n: u64) -> u64 {
-        (self.next() >> 33) % n
+        (self.bits() >> 33) % n
     }
 
     /// One of `xs` (not empty), from the low bits.
     pub fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
-        xs[(self.next() % xs.len() as u64) as usize]
+        xs[(self.bits() % xs.len() as u64) as usize]
     }
 }
 
@@ -74,6 +74,6 @@ mod tests {
             b.log(0.1, 10.0);
             b.below(6);
         }
-        assert_ne!(Draws::stream(7, 3).next(), Draws::stream(7, 4).next());
+        assert_ne!(Draws::stream(7, 3).bits(), Draws::stream(7, 4).bits());
     }
 }

@@ -63,7 +63,6 @@ mod stabilisation;
 
 pub use body::activation::{Activation, Asleep};
 pub use body::builder::{SoftBody, SoftBodyBuilder, TetMesh};
-pub use body::rest_families::unique_edges;
 pub use body::cutting::{cut, Blade};
 pub use body::elastic_energy::ElasticFamilies;
 pub use body::families::{EdgeConstraints, Family, VertexFaceConstraints, VolumeConstraints};
@@ -81,6 +80,7 @@ pub use body::particles::{ExternalAcceleration, Particles};
 pub use body::pieces::{Piece, TearEvent};
 pub use body::placement::Placement;
 pub use body::plasticity::{Plasticity, PlasticitySettings, VOLUME_PRESERVING_TOLERANCE};
+pub use body::rest_families::unique_edges;
 pub use body::tearing::{Pieces, Tearing, TearingSettings};
 pub use error::{
     BuildError, CutError, PlasticityError, SettingsError, StateError, StepError, TearingError,

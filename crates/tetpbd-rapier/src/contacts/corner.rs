@@ -76,9 +76,9 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use rapier3d::geometry::ColliderSet;
 use tetpbd::{Particles, Surface};
 
+use crate::contacts::corner_friction::friction;
 use crate::contacts::particle::ParticleContact;
 use crate::convert::{to_glam, to_na};
-use crate::contacts::corner_friction::friction;
 use crate::rigid::body::{BodyKind, BodyProxy};
 use crate::rigid::collider::ColliderProxy;
 use tetpbd::ImpactReach;

@@ -178,7 +178,7 @@ fn random_body(
             rng.range(-5.0, 5.0),
             0.0,
         ));
-    let fam = rng.next() % 4;
+    let fam = rng.bits() % 4;
     let fam = family.unwrap_or(fam);
     let desc = format!("[{cells}³ {split:?} fam {fam} ρ {density:.0}]");
     b = match fam {
@@ -207,7 +207,7 @@ fn run_scene(k: u64, o: &Options) -> (String, Outcome) {
         RigidBodyBuilder::fixed().translation(Vector::new(0.0, -0.5, 0.0)),
         ColliderBuilder::cuboid(500.0, 0.5, 500.0),
     );
-    let kind = rng.next() % 4;
+    let kind = rng.bits() % 4;
     let mut what = format!("scene {k}: {substeps} substeps, ");
     let mut top = 0.0f32;
     let mut start_speed = 0.0f32;
@@ -224,7 +224,7 @@ fn run_scene(k: u64, o: &Options) -> (String, Outcome) {
         top = 2.0 * half;
         what += &format!("box {mass:.2} kg half {half:.2} m, ");
     }
-    let bodies = if kind == 2 { 2 + rng.next() % 3 } else { 1 };
+    let bodies = if kind == 2 { 2 + rng.bits() % 3 } else { 1 };
     let mut scale_size = 0.0f32;
     for i in 0..bodies {
         let speed = if kind == 2 {

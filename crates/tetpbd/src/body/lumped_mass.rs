@@ -57,7 +57,10 @@ pub(crate) fn rest_volumes_and_masses(
 }
 
 /// Inverse masses, 0 for the pinned vertices.
-pub(crate) fn pinned_inverse_masses(masses: &[f32], pinned: &[u32]) -> Result<Vec<f32>, BuildError> {
+pub(crate) fn pinned_inverse_masses(
+    masses: &[f32],
+    pinned: &[u32],
+) -> Result<Vec<f32>, BuildError> {
     let mut inv_masses: Vec<f32> = masses.iter().map(|m| 1.0 / m).collect();
     for &i in pinned {
         match inv_masses.get_mut(i as usize) {

@@ -22,7 +22,6 @@
 use nalgebra::Vector3;
 
 use crate::body::builder::{body_parts, SoftBody, TetMesh};
-use crate::body::rest_families::edge_constraints;
 use crate::body::families::{EdgeConstraints, VertexFaceConstraints, VolumeConstraints};
 use crate::body::forces::UserForces;
 use crate::body::mesh::{Surface, Tetrahedra};
@@ -30,6 +29,7 @@ use crate::body::neo_hookean::{NeoHookeanMaterial, ReleasedScratch};
 use crate::body::particles::Particles;
 use crate::body::plastic_rest::RestState;
 use crate::body::plasticity::Plasticity;
+use crate::body::rest_families::edge_constraints;
 use crate::body::tearing::{interior_faces, Tearing};
 use crate::kernels::slots::{Slot, WorkCopy};
 use crate::ordering::partition::part_order;

@@ -33,7 +33,7 @@
 //! takes part with its mass, except while its supports hold it against the soft load and
 //! against impulses pressing it into supports it stands on.
 
-use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
 
 mod anchored;
