@@ -12,22 +12,9 @@
 mod robust_common;
 
 use nalgebra::{UnitQuaternion, Vector3};
-use robust_common::{ground, scene_substeps};
+use robust_common::{cube_sweep_case, ground, mechanical_energy, scene_substeps, Draws};
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder};
-
-/// A small seeded generator (xorshift), for the sweep's draws.
-struct Draws(u64);
-
-impl Draws {
-    /// A uniform draw in `[lo, hi)`.
-    fn between(&mut self, lo: f32, hi: f32) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * ((self.0 >> 40) as f32 / (1u64 << 24) as f32)
-    }
-}
 
 /// What one release measured: the highest the lowest particle rose above the ground (m)
 /// after the first frame, and the largest growth of the mechanical energy over its start
@@ -36,16 +23,6 @@ struct Release {
     lift: f32,
     growth: f32,
     scale: f32,
-}
-
-fn mechanical_energy(p: &Particles) -> f32 {
-    let potential: f32 = p
-        .positions()
-        .iter()
-        .zip(p.masses())
-        .map(|(x, m)| m * 9.81 * x.y)
-        .sum();
-    p.kinetic_energy() + potential
 }
 
 fn release(
@@ -112,14 +89,7 @@ fn tilted_cubes_topple_onto_a_face_without_hopping() {
     let mut draws = Draws(0x5eed_7117);
     let mut failures = Vec::new();
     for case in 0..12 {
-        let size = [0.5, 1.0, 2.0][case % 3];
-        let substeps = [5, 10, 20][(case / 3) % 3];
-        let cells = 3 + (case % 2) as u32;
-        let split = if case % 4 < 2 {
-            CellSplit::Six
-        } else {
-            CellSplit::Five
-        };
+        let (size, substeps, cells, split) = cube_sweep_case(case);
         let heading = draws.between(0.0, std::f32::consts::TAU);
         let axis = Vector3::new(heading.cos(), 0.0, heading.sin());
         let roll = draws.between(10f32.to_radians(), 40f32.to_radians());

@@ -15,32 +15,9 @@
 mod robust_common;
 
 use nalgebra::{UnitQuaternion, Vector3};
-use robust_common::{ground, scene_substeps};
+use robust_common::{cube_sweep_case, ground, mechanical_energy, scene_substeps, Draws};
 use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{Particles, SoftBodyBuilder};
-
-/// A small seeded generator (xorshift), for the sweep's draws.
-struct Draws(u64);
-
-impl Draws {
-    /// A uniform draw in `[lo, hi)`.
-    fn between(&mut self, lo: f32, hi: f32) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * ((self.0 >> 40) as f32 / (1u64 << 24) as f32)
-    }
-}
-
-fn mechanical_energy(p: &Particles) -> f32 {
-    let potential: f32 = p
-        .positions()
-        .iter()
-        .zip(p.masses())
-        .map(|(x, m)| m * 9.81 * x.y)
-        .sum();
-    p.kinetic_energy() + potential
-}
 
 /// What one throw measured: the largest growth of the mechanical energy over its start
 /// (J), the deepest any particle went below the ground during the throw and at its end
@@ -110,14 +87,7 @@ fn tumbling_cubes_never_gain_energy_on_the_ground() {
     let mut draws = Draws(0x7b3b_1e5c_0be5);
     let mut failures = Vec::new();
     for case in 0..16 {
-        let size = [0.5, 1.0, 2.0][case % 3];
-        let substeps = [5, 10, 20][(case / 3) % 3];
-        let cells = 3 + (case % 2) as u32;
-        let split = if case % 4 < 2 {
-            CellSplit::Six
-        } else {
-            CellSplit::Five
-        };
+        let (size, substeps, cells, split) = cube_sweep_case(case);
         let rate = draws.between(5.0, 30.0) / size;
         let heading = draws.between(0.0, std::f32::consts::TAU);
         let axis = Vector3::new(heading.cos(), draws.between(-0.3, 0.3), heading.sin());

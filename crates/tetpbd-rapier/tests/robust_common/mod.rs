@@ -146,3 +146,40 @@ pub fn cube_on_box(s: &mut CoupledWorld, ratio: f32, vertex_face: bool) -> Entit
     };
     b.build().expect("cube").spawn(&mut s.soft)
 }
+
+/// A small seeded generator (xorshift) for the tests' sweeps.
+pub struct Draws(pub u64);
+
+impl Draws {
+    /// A uniform draw in `[lo, hi)`.
+    pub fn between(&mut self, lo: f32, hi: f32) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        lo + (hi - lo) * ((self.0 >> 40) as f32 / (1u64 << 24) as f32)
+    }
+}
+
+/// Kinetic plus gravitational energy (g = 9.81 m/s² along −y, zero at y = 0), J.
+pub fn mechanical_energy(p: &Particles) -> f32 {
+    let potential: f32 = p
+        .positions()
+        .iter()
+        .zip(p.masses())
+        .map(|(x, m)| m * 9.81 * x.y)
+        .sum();
+    p.kinetic_energy() + potential
+}
+
+/// Case `case` of the hard-cube sweeps: edge length (m), substeps, cells per axis, split.
+pub fn cube_sweep_case(case: usize) -> (f32, u32, u32, CellSplit) {
+    let size = [0.5, 1.0, 2.0][case % 3];
+    let substeps = [5, 10, 20][(case / 3) % 3];
+    let cells = 3 + (case % 2) as u32;
+    let split = if case % 4 < 2 {
+        CellSplit::Six
+    } else {
+        CellSplit::Five
+    };
+    (size, substeps, cells, split)
+}
