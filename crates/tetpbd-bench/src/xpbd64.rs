@@ -8,7 +8,7 @@
 //! and mirrors [`tetpbd::systems`]: prediction with `v ← (v + h g)·max(0, 1 − damping·h)`,
 //! multipliers reset every substep, `iterations` Gauss–Seidel sweeps over the families in
 //! [`SolverSettings::order`], each in the body's stored (colour) order, followed by the spin
-//! removal on a free body ([`SafetySettings::conserve_angular_momentum`]), then
+//! removal on a free body ([`tetpbd::SafetySettings::conserve_angular_momentum`]), then
 //! `v = (x − x_prev)/h` (with the correction-speed safety net's clamp and momentum
 //! restoration when it is set).
 //! Degenerate configurations get the core's fallbacks (edge: rest direction; vertex–face: rest

@@ -3,7 +3,7 @@
 //! * [`FrameExport`]: every frame's soft surfaces and rigid colliders as OBJ and the
 //!   tetrahedra as VTU with per-tetrahedron volume ratio and inverted flag (the writers of
 //!   [`tetpbd_io`]); collider shapes become triangles through parry's tessellations
-//!   ([`shape_mesh`]).
+//!   ([`shape_mesh()`]).
 //! * Headless pictures without a GPU: [`Raster`] (z-buffered triangles and lines over an RGB
 //!   buffer), [`Camera`] (look-at, perspective), [`View`] (a camera and a ground grid fitted to
 //!   a run, flat Lambert shading), written as PNG, frame strips or animated PNG ([`write_png`],

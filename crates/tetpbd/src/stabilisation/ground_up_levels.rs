@@ -1,4 +1,4 @@
-//! The order of a ground-up sweep ([`crate::project_stacked`]) within one family: items
+//! The order of a ground-up sweep ([`crate::stabilisation::ground_up::project_stacked`]) within one family: items
 //! (edges or tetrahedra) by level, each level in greedy colour classes so that the SIMD
 //! kernels run a class in lanes, the per-sweep copies of the items' data in that order, and
 //! the projections of one level.
