@@ -209,18 +209,32 @@ pub(crate) struct Applied {
     pub acceleration: Vector3<f64>,
     /// The damping factor `k = max(0, 1 − damping·h)` (dimensionless).
     pub keep: f64,
+    /// The mass the hook moved since the families' last pass, `Σ mᵢΔcᵢ` (kg m,
+    /// [`crate::stabilisation::hook_work`]).
+    pub hook_push: Vector3<f64>,
 }
 
 impl Applied {
-    /// `G = −a·Σ mᵢΔᵢ` and the credit `P = ½k²h²|a|²M_f + (1 − k) h a·Σ mᵢvᵢ` (free
-    /// particles, predicted velocities; at least 0), J, in a substep of `h` s.
+    /// The lift `G = −a·Σ mᵢΔᵢ` less the part of it that undoes the hook's move along `a`
+    /// (`min(G, a·Σ mᵢΔcᵢ)` where both are positive), and the credit `f P`, with
+    /// `P = ½k²h²|a|²M_f + (1 − k) h a·Σ mᵢvᵢ` (free particles, predicted velocities; at
+    /// least 0) and `f` the part of the prediction's step along `a` the rest of the lift
+    /// undoes, `G' / (k h²|a|²M_f)` clamped to `[0, 1]` (module docs), J, in a substep of `h` s.
     fn lift_and_credit(&self, sums: &Moments<f64>, h: f64) -> (f64, f64) {
         let (a, k) = (self.acceleration, self.keep);
-        let lift = -a.dot(&sums.push);
+        let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
+        let lift = finite(-a.dot(&sums.push));
+        let lowered = finite(a.dot(&self.hook_push)).max(0.0);
+        let lift = lift - lift.clamp(0.0, lowered);
         let credit = 0.5 * k * k * h * h * a.norm_squared() * sums.free_mass
             + (1.0 - k) * h * a.dot(&sums.free_momentum);
-        let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
-        (finite(lift), finite(credit).max(0.0))
+        let step = k * h * h * a.norm_squared() * sums.free_mass;
+        let undone = if step > 0.0 {
+            (lift / step).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (lift, (finite(undone) * finite(credit)).max(0.0))
     }
 }
 
@@ -379,6 +393,7 @@ pub(crate) fn store_bodies(
         }
         // What a hook's corrections handed this pass is external work, spent here.
         let hook = std::mem::take(&mut p.hook.energy);
+        let hook_push = std::mem::take(&mut p.hook.push);
         let budget = |w_max: f32, work: f64, gain: f64| {
             if !limit {
                 f64::INFINITY
@@ -392,6 +407,7 @@ pub(crate) fn store_bodies(
         let applied = Applied {
             acceleration: (gravity + extra.map_or(Vector3::zeros(), |x| x.0)).cast::<f64>(),
             keep,
+            hook_push,
         };
         if crate::stabilisation::angular_momentum::store_measured(p, (h, applied), spin, budget) {
             limited += 1;
