@@ -48,7 +48,8 @@
 //!
 //! **Work against the applied accelerations.** The positions keep all of `Δᵢ`, so they also
 //! move the body in its potential `U = −Σ mᵢ a·xᵢ` (`a` the body's gravity plus
-//! [`crate::ExternalAcceleration`], uniform over the body): by
+//! [`crate::ExternalAcceleration`] plus the mean acceleration its [`crate::UserForces`] give
+//! the free particles, uniform over the body): by
 //!
 //! ```text
 //! G = −Σ mᵢ a·Δᵢ = −a·Σ mᵢ Δᵢ      (J)
@@ -85,8 +86,19 @@
 //! ΔK(s) + G − P ≤ E     (E the budget below)
 //! ```
 //!
-//! the body ends no substep with more mechanical energy than it started with plus `E`
-//! (with more than one iteration each iteration is granted `P`: exact at the default of one).
+//! the body ends no substep with more mechanical energy than it started with plus `E`.
+//! The credit goes with the part of the prediction's step the corrections undo: an
+//! iteration is granted `f P` with `f = G/(k h²|a|²M_f)` clamped to `[0, 1]` (at rest
+//! `Δᵢ = −kh²a`, `f = 1`; a uniform partial undo by `f` gains `f²P ≤ fP`). A free body's
+//! corrections undo none of it (`Σ mᵢΔᵢ = 0`) and get no credit; iterations that undo the
+//! step once between them are credited `P` once.
+//!
+//! A hook's moves change the potential too: a contact pressing a resting body onto a pinned
+//! slab pushes the slab's free particles down by `δ` a substep and the slab's families lift
+//! them back, `G = m a·δ`, while the hook's measure ([`crate::stabilisation::hook_work`])
+//! counts only the kinetic `m|δ|²/2h²`. The part of `G` that undoes the hook's move along
+//! `a` since the last pass, `min(G, a·Σ mᵢΔcᵢ)` where both are positive, is not charged:
+//! the body ends where it was, and the descent the hook caused is given back, not created.
 //! The limit keeps the largest `s` with
 //! `ΔK(s) ≤ E − G + P`; where even the `s ∈ [0, 1]` that takes the most kinetic energy out
 //! (`−A/2Q`) leaves too much, the give-back pass scales the iteration's velocities down
@@ -205,7 +217,8 @@ fn largest_scale(a: f64, q: f64, e: f64) -> f32 {
 /// velocity it kept, for the work term and the credit of the module docs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Applied {
-    /// Gravity plus the body's [`crate::ExternalAcceleration`], m/s².
+    /// Gravity plus the body's [`crate::ExternalAcceleration`] and the mean acceleration of
+    /// its [`crate::UserForces`] ([`crate::applied_acceleration`]), m/s².
     pub acceleration: Vector3<f64>,
     /// The damping factor `k = max(0, 1 − damping·h)` (dimensionless).
     pub keep: f64,
@@ -371,7 +384,7 @@ pub(crate) fn store_bodies(
 ) -> u64 {
     let mut limited = 0;
     let keep = f64::from((1.0 - damping * h).max(0.0));
-    for (p, e, t, vf, vol, m, a, extra) in world
+    for (p, e, t, vf, vol, m, a, (extra, forces)) in world
         .query_mut::<(
             &mut crate::Particles,
             Option<&EdgeConstraints>,
@@ -380,7 +393,10 @@ pub(crate) fn store_bodies(
             Option<&VolumeConstraints>,
             Option<&crate::NeoHookeanMaterial>,
             Option<&mut crate::body::activation::Activation>,
-            Option<&crate::ExternalAcceleration>,
+            (
+                Option<&crate::ExternalAcceleration>,
+                Option<&crate::UserForces>,
+            ),
         )>()
         .without::<&crate::Asleep>()
     {
@@ -404,8 +420,15 @@ pub(crate) fn store_bodies(
                 hook + material + elastic_release([h, w_max], [work, gain - hook], e, t, vf, vol)
             }
         };
+        // The loads besides gravity, as the mean acceleration of the free particles: exact
+        // for loads proportional to mass, and one pass over the particles only for a body
+        // with user forces.
+        let loads = match forces {
+            Some(f) => crate::applied_acceleration(p, Some(f), None, extra),
+            None => extra.map_or(Vector3::zeros(), |x| x.0),
+        };
         let applied = Applied {
-            acceleration: (gravity + extra.map_or(Vector3::zeros(), |x| x.0)).cast::<f64>(),
+            acceleration: (gravity + loads).cast::<f64>(),
             keep,
             hook_push,
         };
