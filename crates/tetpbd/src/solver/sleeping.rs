@@ -201,6 +201,7 @@ fn put_to_sleep(world: &mut World, entity: Entity) {
         p.prev_positions.copy_from_slice(&p.positions);
         p.residuals.fill(Vector3::zeros());
         p.hook.energy = 0.0;
+        p.hook.push = Vector3::zeros();
         a.set_sleeping(true);
     }
     let _ = world.insert_one(entity, Asleep);

@@ -315,7 +315,7 @@ impl Solver {
         *hook_time += t.elapsed();
         let frac = (index + 1) as f32 / s.substeps as f32;
         for k in 0..s.iterations {
-            self.iteration(world, h, stats);
+            self.iteration(world, (h, frame.gravity()), stats);
             let t = Instant::now();
             measured(world, measure, Changed::Positions, |w| {
                 systems::project_grabs(w, h, frac);
@@ -340,7 +340,12 @@ impl Solver {
     /// One iteration: copy the particles into the working copy, project the families in
     /// order, copy back (removing the corrections' rigid rotation and limiting the kinetic
     /// energy they add, if asked).
-    fn iteration(&self, world: &mut World, h: f32, stats: &mut StepStats) {
+    fn iteration(
+        &self,
+        world: &mut World,
+        (h, gravity): (f32, Vector3<f32>),
+        stats: &mut StepStats,
+    ) {
         let s = &self.settings;
         let t = Instant::now();
         working_copy::load_bodies(world);
@@ -370,7 +375,8 @@ impl Solver {
                 s.safety.conserve_angular_momentum,
                 s.safety.limit_correction_energy,
             );
-            stats.energy_limited += correction_energy::store_bodies(world, h, spin, limit);
+            stats.energy_limited +=
+                correction_energy::store_bodies(world, (h, gravity, s.damping), spin, limit);
             stats.spin_time += t.elapsed();
         } else {
             working_copy::store_bodies(world);

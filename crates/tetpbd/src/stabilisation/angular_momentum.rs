@@ -66,7 +66,7 @@ use crate::stabilisation::rigid_fit::{FixUp, Moments, StoreRun, BLOCK};
 /// energy limit to apply, corrects.
 pub(crate) fn store_measured(
     p: &mut Particles,
-    h: f32,
+    (h, applied): (f32, crate::stabilisation::correction_energy::Applied),
     spin: bool,
     budget: impl FnOnce(f32, f64, f64) -> f64,
 ) -> bool {
@@ -147,12 +147,12 @@ pub(crate) fn store_measured(
     // The work was summed with velocities relative to `v0`: Σ m v·Δ = Σ m (v − v0)·Δ + v0·Σ m Δ
     // (the last term vanishes on a free body, not on a pinned one).
     sums.work += v0.cast::<f64>().dot(&sums.push);
+    sums.free_momentum += v0.cast::<f64>() * sums.free_mass;
     let limit = crate::stabilisation::correction_energy::velocity_scale(
         &sums,
         o.norm(),
-        c,
-        theta,
-        h,
+        [c, theta],
+        (h, applied),
         budget,
     );
     let scale = limit.scale;
@@ -166,6 +166,7 @@ pub(crate) fn store_measured(
         prev_positions,
         residuals,
         masses,
+        inv_masses,
         work,
         ..
     } = p;
@@ -195,6 +196,7 @@ pub(crate) fn store_measured(
         prev_positions,
         slots: &work.0,
         masses,
+        inv_masses,
     };
     let tau = give_back_within_budget(run, h, allowed, spin);
     scale < 1.0 || tau < 1.0

@@ -46,6 +46,67 @@
 //! the spin removal's ([`crate::stabilisation::angular_momentum`]), taken in the same pass; the limit costs a few
 //! multiply–adds per particle there and one more pass only in iterations where it acts.
 //!
+//! **Work against the applied accelerations.** The positions keep all of `Δᵢ`, so they also
+//! move the body in its potential `U = −Σ mᵢ a·xᵢ` (`a` the body's gravity plus
+//! [`crate::ExternalAcceleration`] plus the mean acceleration its [`crate::UserForces`] give
+//! the free particles, uniform over the body): by
+//!
+//! ```text
+//! G = −Σ mᵢ a·Δᵢ = −a·Σ mᵢ Δᵢ      (J)
+//! ```
+//!
+//! whatever `s` is. On a free body `Σ mᵢΔᵢ = 0` and `G = 0`; a body with pins exchanges
+//! momentum with them, and its corrections can lift it: a hard vertex–face cube hanging from
+//! its top face (a family that keeps finding violation) gained 0.3–0.9 J of `G` a substep
+//! with `ΔK ≤ 0` held, and its mechanical energy rose by the sum, 1e-3 × `M g L` in two
+//! seconds, as kinetic energy (the prediction turns the lifted height back into speed). So
+//! the limit bounds the whole mechanical gain `ΔK(s) + G`, not `ΔK(s)` alone.
+//!
+//! That alone would act on every resting substep: a body hanging at rest has `u = 0`, the
+//! prediction moves its free particles by `h²a` and the corrections take them back,
+//! `Δᵢ = −h²a`, so `A = −h²|a|² M_f`, `Q = ½h²|a|² M_f`, `G = h²|a|² M_f` and
+//! `ΔK + G = ½h²|a|² M_f > 0` (`M_f` the free particles' mass). That is the energy the
+//! prediction took out: with `vᵢ = k(uᵢ + h a)` (`k = max(0, 1 − damping·h)`), the prediction
+//! changes `K + U` by
+//!
+//! ```text
+//! ΔE_pred = ½Σ mᵢ(|vᵢ|² − |uᵢ|²) − h Σ mᵢ a·vᵢ
+//!         = −½(1 − k²) Σ mᵢ|uᵢ|²  −  [½k² h²|a|² M_f + (1 − k) h a·Σ mᵢ vᵢ]
+//! ```
+//!
+//! (sums over the free particles). The first term is the damping of the motion the body
+//! had: dissipation, not the constraints' to spend (a tangled body under damping would
+//! otherwise never calm down). The bracket is what the step along `a` took out of the
+//! discrete energy, the part the constraints' reaction to that step gives back; it is the
+//! credit `P`, taken from the predicted velocities (at rest it is exactly the `½h²|a|²M_f`
+//! above, with damping `(k − ½k²)h²|a|²M_f`). Over the substep the body's mechanical energy
+//! changes by `ΔE_pred + ΔK(s) + G`, so with
+//!
+//! ```text
+//! ΔK(s) + G − P ≤ E     (E the budget below)
+//! ```
+//!
+//! the body ends no substep with more mechanical energy than it started with plus `E`.
+//! The credit goes with the part of the prediction's step the corrections undo: an
+//! iteration is granted `f P` with `f = G/(k h²|a|²M_f)` clamped to `[0, 1]` (at rest
+//! `Δᵢ = −kh²a`, `f = 1`; a uniform partial undo by `f` gains `f²P ≤ fP`). A free body's
+//! corrections undo none of it (`Σ mᵢΔᵢ = 0`) and get no credit; iterations that undo the
+//! step once between them are credited `P` once.
+//!
+//! A hook's moves change the potential too: a contact pressing a resting body onto a pinned
+//! slab pushes the slab's free particles down by `δ` a substep and the slab's families lift
+//! them back, `G = m a·δ`, while the hook's measure ([`crate::stabilisation::hook_work`])
+//! counts only the kinetic `m|δ|²/2h²`. The part of `G` that undoes the hook's move along
+//! `a` since the last pass, `min(G, a·Σ mᵢΔcᵢ)` where both are positive, is not charged:
+//! the body ends where it was, and the descent the hook caused is given back, not created.
+//! The limit keeps the largest `s` with
+//! `ΔK(s) ≤ E − G + P`; where even the `s ∈ [0, 1]` that takes the most kinetic energy out
+//! (`−A/2Q`) leaves too much, the give-back pass scales the iteration's velocities down
+//! until the kinetic energy pays for the lift ([`crate::stabilisation::give_back`]). The
+//! limit acts only on a gain above a tolerance of the sums' uncertainty of `G` and
+//! [`REST_TOLERANCE`] of `P`: a body hanging at rest has `ΔK + G − P = 0` up to its
+//! discrete rest state's convergence and is left alone (and falls asleep).
+//!
 //! The budget: a compliant constraint `C` with compliance `α` (`α̃ = α/h²`) and multiplier
 //! step `Δλ` releases, to first order,
 //!
@@ -71,20 +132,22 @@ use nalgebra::Vector3;
 /// The fraction `s ∈ [0, 1]` of the families' corrections that may become velocity (see the
 /// module docs), from the store pass's sums (taken about a point at distance `origin`, m,
 /// from the world origin), the spin removal's centre `c` and rotation
-/// `θ` (zero when not removed), the substep `h` (s) and the budget (J, asked only when the
-/// corrections add energy at all; its arguments are the body's largest inverse mass, 1/kg,
-/// the work term `A` and the gain `ΔK(1)`, J: it may stop summing once it has reached the
-/// gain). Returns `s` and, where the sums cannot tell the gain from the budget, the budget
-/// the exact check ([`crate::stabilisation::give_back`]) holds the iteration to.
+/// `θ` (zero when not removed), the substep `h` (s), the acceleration the prediction applied
+/// and the budget (J, asked only when the corrections add energy at all; its arguments are
+/// the body's largest inverse mass, 1/kg, the work term `A` and the gain `ΔK(1) + G − P`, J:
+/// it may stop summing once it has reached the gain). Returns `s` and the kinetic-energy
+/// budget `E − G + P` (J, negative where the kinetic energy must pay for a lift) the exact
+/// check ([`crate::stabilisation::give_back`]) holds the iteration to.
 pub(crate) fn velocity_scale(
     sums: &Moments<f64>,
     origin: f32,
-    c: Vector3<f64>,
-    theta: Vector3<f64>,
-    h: f32,
+    [c, theta]: [Vector3<f64>; 2],
+    (h, applied): (f32, Applied),
     budget: impl FnOnce(f32, f64, f64) -> f64,
 ) -> Limit {
     let h = f64::from(h);
+    // The work against the applied acceleration and the prediction's credit (module docs), J.
+    let (lift, credit) = applied.lift_and_credit(sums, h);
     // The corrections after the spin removal, Δ' = Δ − θ × r with r = x̄ − o − c:
     // Σ m v·Δ' = Σ m v·Δ − θ·Σ m r × v and Σ m|Δ'|² = Σ m|Δ|² − θ·Σ m r × Δ (θ = I⁺ Σ m r × Δ).
     let r_cross_v = sums.momentum_moment - c.cross(&sums.momentum);
@@ -93,7 +156,7 @@ pub(crate) fn velocity_scale(
     let work = sums.work - spin_work;
     let square = (sums.square - spin_square).max(0.0);
     let (a, q) = (work / h, square / (2.0 * h * h));
-    let gain = a + q;
+    let gain = a + q + lift - credit;
     let none = Limit {
         scale: 1.0,
         check: None,
@@ -104,34 +167,87 @@ pub(crate) fn velocity_scale(
     let terms =
         (sums.work.abs() + spin_work.abs()) / h + (sums.square + spin_square.abs()) / (2.0 * h * h);
     let unsure = SUMS_UNCERTAINTY * terms;
+    // The tolerance on the lift: its sums' uncertainty and a small part of the credit, J.
+    // Within it the limit does not act (a body hanging at rest stays untouched and sleeps).
+    let tolerance = SUMS_UNCERTAINTY * lift.abs() + REST_TOLERANCE * credit;
     // No gain, or a NaN one, or one within rounding: nothing to limit.
-    let floor = rounding_floor(sums, origin, h);
+    let floor = rounding_floor(sums, origin, h) + tolerance;
     if (gain + unsure).partial_cmp(&floor) != Some(std::cmp::Ordering::Greater) {
         return none;
     }
     let e = budget(sums.inv_mass as f32, a, gain + unsure).max(0.0);
-    if gain + unsure <= e.max(floor) || !e.is_finite() {
+    if gain + unsure <= (e + tolerance).max(floor) || !e.is_finite() {
         return none;
     }
-    if gain <= e {
+    // What the kinetic energy may gain: the budget less the lift the positions keep, J
+    // (negative where the corrections lift the body more than the budget and the credit).
+    let e = e - lift + credit;
+    if a + q <= e {
         return Limit {
             scale: 1.0,
             check: Some(e),
         };
     }
-    // The larger root of q s² + a s − e = 0: ΔK(s) ≤ e on [0, s], and ΔK(1) > e.
-    let s = if q > 0.0 {
-        (-a + (a * a + 4.0 * q * e).sqrt()) / (2.0 * q)
+    Limit {
+        scale: largest_scale(a, q, e),
+        check: Some(e),
+    }
+}
+
+/// The largest `s ∈ [0, 1]` with `q s² + a s ≤ e` (J; `ΔK(1) = a + q > e`); where no `s`
+/// qualifies (`e` below the least `ΔK`), the `s` that adds the least, `−a/2q`.
+fn largest_scale(a: f64, q: f64, e: f64) -> f32 {
+    let disc = a * a + 4.0 * q * e;
+    let s = if q > 0.0 && disc >= 0.0 {
+        // The larger root of q s² + a s − e = 0: ΔK(s) ≤ e between the roots.
+        (-a + disc.sqrt()) / (2.0 * q)
+    } else if q > 0.0 {
+        -a / (2.0 * q)
     } else {
         e / a
     };
-    Limit {
-        scale: if s.is_finite() {
-            s.clamp(0.0, 1.0) as f32
+    if s.is_finite() {
+        s.clamp(0.0, 1.0) as f32
+    } else {
+        1.0
+    }
+}
+
+/// The acceleration the prediction applied to a body's free particles and how much of their
+/// velocity it kept, for the work term and the credit of the module docs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Applied {
+    /// Gravity plus the body's [`crate::ExternalAcceleration`] and the mean acceleration of
+    /// its [`crate::UserForces`] ([`crate::applied_acceleration`]), m/s².
+    pub acceleration: Vector3<f64>,
+    /// The damping factor `k = max(0, 1 − damping·h)` (dimensionless).
+    pub keep: f64,
+    /// The mass the hook moved since the families' last pass, `Σ mᵢΔcᵢ` (kg m,
+    /// [`crate::stabilisation::hook_work`]).
+    pub hook_push: Vector3<f64>,
+}
+
+impl Applied {
+    /// The lift `G = −a·Σ mᵢΔᵢ` less the part of it that undoes the hook's move along `a`
+    /// (`min(G, a·Σ mᵢΔcᵢ)` where both are positive), and the credit `f P`, with
+    /// `P = ½k²h²|a|²M_f + (1 − k) h a·Σ mᵢvᵢ` (free particles, predicted velocities; at
+    /// least 0) and `f` the part of the prediction's step along `a` the rest of the lift
+    /// undoes, `G' / (k h²|a|²M_f)` clamped to `[0, 1]` (module docs), J, in a substep of `h` s.
+    fn lift_and_credit(&self, sums: &Moments<f64>, h: f64) -> (f64, f64) {
+        let (a, k) = (self.acceleration, self.keep);
+        let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
+        let lift = finite(-a.dot(&sums.push));
+        let lowered = finite(a.dot(&self.hook_push)).max(0.0);
+        let lift = lift - lift.clamp(0.0, lowered);
+        let credit = 0.5 * k * k * h * h * a.norm_squared() * sums.free_mass
+            + (1.0 - k) * h * a.dot(&sums.free_momentum);
+        let step = k * h * h * a.norm_squared() * sums.free_mass;
+        let undone = if step > 0.0 {
+            (lift / step).clamp(0.0, 1.0)
         } else {
-            1.0
-        },
-        check: Some(e),
+            0.0
+        };
+        (lift, (finite(undone) * finite(credit)).max(0.0))
     }
 }
 
@@ -139,12 +255,19 @@ pub(crate) fn velocity_scale(
 /// blocks of 256 particles, a few times `256 ε`.
 const SUMS_UNCERTAINTY: f64 = 1e-4;
 
+/// The part of the credit `P` a body may gain in a substep without the limit acting
+/// (dimensionless): a body converging to its discrete rest state under gravity gains about
+/// 1e-3 `P` a substep; this bounds the gain let through to `10⁻² × ½h²|a|²M_f` a substep,
+/// `0.005 |a|² M_f h` per second of simulated time.
+const REST_TOLERANCE: f64 = 1e-2;
+
 /// What [`velocity_scale`] decided for one body and iteration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Limit {
     /// The fraction `s ∈ [0, 1]` of the corrections that becomes velocity.
     pub scale: f32,
-    /// The budget (J) the iteration's velocity change is then checked against, exactly,
+    /// The kinetic-energy budget (J, negative where the kinetic energy must pay for a lift)
+    /// the iteration's velocity change is then checked against, exactly,
     /// after the give-back; `None`: the sums show it within the budget.
     pub check: Option<f64>,
 }
@@ -155,18 +278,26 @@ pub(crate) struct Limit {
 /// physical but would make the limit act on every substep of a moving body. With `L` the
 /// body's distance plus its radius of gyration, the floor is `M (4 ε L)² / (2h²)`.
 fn rounding_floor(sums: &Moments<f64>, origin: f32, h: f64) -> f64 {
-    if sums.mass.is_nan() || sums.mass <= 0.0 {
+    let Some(d) = rounding_length(sums, origin) else {
         return 0.0;
-    }
-    let spread = (sums.second[0] + sums.second[1] + sums.second[2]) / sums.mass;
-    let l = f64::from(origin) + spread.max(0.0).sqrt();
-    let d = 4.0 * f64::from(f32::EPSILON) * l;
+    };
     let floor = sums.mass * d * d / (2.0 * h * h);
     if floor.is_finite() {
         floor
     } else {
         0.0
     }
+}
+
+/// The rounding of a body's positions, `4 ε L` (m), with `L` its distance from the world
+/// origin plus its radius of gyration; `None` without mass.
+fn rounding_length(sums: &Moments<f64>, origin: f32) -> Option<f64> {
+    if sums.mass.is_nan() || sums.mass <= 0.0 {
+        return None;
+    }
+    let spread = (sums.second[0] + sums.second[1] + sums.second[2]) / sums.mass;
+    let l = f64::from(origin) + spread.max(0.0).sqrt();
+    Some(4.0 * f64::from(f32::EPSILON) * l)
 }
 
 /// The elastic energy the compliant families of one body may have released in the current
@@ -243,11 +374,17 @@ pub(crate) fn elastic_release(
 }
 
 /// Stores every swept body's working copy back, removing the spin of the families'
-/// corrections when `spin` is set and limiting the kinetic energy they add when `limit`
-/// is set. Returns the number of bodies the limit acted on.
-pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: bool) -> u64 {
+/// corrections when `spin` is set and limiting the mechanical energy they add when `limit`
+/// is set, in a substep of `h` (s) under `gravity` (m/s²) and `damping` (1/s). Returns the number of bodies the limit acted on.
+pub(crate) fn store_bodies(
+    world: &mut hecs::World,
+    (h, gravity, damping): (f32, Vector3<f32>, f32),
+    spin: bool,
+    limit: bool,
+) -> u64 {
     let mut limited = 0;
-    for (p, e, t, vf, vol, m, a) in world
+    let keep = f64::from((1.0 - damping * h).max(0.0));
+    for (p, e, t, vf, vol, m, a, (extra, forces)) in world
         .query_mut::<(
             &mut crate::Particles,
             Option<&EdgeConstraints>,
@@ -256,6 +393,10 @@ pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: b
             Option<&VolumeConstraints>,
             Option<&crate::NeoHookeanMaterial>,
             Option<&mut crate::body::activation::Activation>,
+            (
+                Option<&crate::ExternalAcceleration>,
+                Option<&crate::UserForces>,
+            ),
         )>()
         .without::<&crate::Asleep>()
     {
@@ -268,6 +409,7 @@ pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: b
         }
         // What a hook's corrections handed this pass is external work, spent here.
         let hook = std::mem::take(&mut p.hook.energy);
+        let hook_push = std::mem::take(&mut p.hook.push);
         let budget = |w_max: f32, work: f64, gain: f64| {
             if !limit {
                 f64::INFINITY
@@ -278,7 +420,19 @@ pub(crate) fn store_bodies(world: &mut hecs::World, h: f32, spin: bool, limit: b
                 hook + material + elastic_release([h, w_max], [work, gain - hook], e, t, vf, vol)
             }
         };
-        if crate::stabilisation::angular_momentum::store_measured(p, h, spin, budget) {
+        // The loads besides gravity, as the mean acceleration of the free particles: exact
+        // for loads proportional to mass, and one pass over the particles only for a body
+        // with user forces.
+        let loads = match forces {
+            Some(f) => crate::applied_acceleration(p, Some(f), None, extra),
+            None => extra.map_or(Vector3::zeros(), |x| x.0),
+        };
+        let applied = Applied {
+            acceleration: (gravity + loads).cast::<f64>(),
+            keep,
+            hook_push,
+        };
+        if crate::stabilisation::angular_momentum::store_measured(p, (h, applied), spin, budget) {
             limited += 1;
             // Corrections held back from the velocities still moved the positions: the
             // body is not at rest, whatever its particles' speeds say.

@@ -32,6 +32,16 @@
 //! all of `Δᵢ` either way. This also absorbs what the limit's sums (f32 blocks, a rotation
 //! removed in closed form) miss.
 //!
+//! On a body with pins the budget can be negative: its corrections lifted it against the
+//! applied acceleration by more than the budget and the prediction's credit allow
+//! ([`crate::stabilisation::correction_energy`], work against the applied accelerations), and
+//! the kinetic energy has to pay for the lift. Where the `τ`s cannot take that much out (at
+//! best `τ = −w/s` of the change alone), the free particles' velocities after the change are
+//! scaled by one `σ ∈ [0, 1]` with `σ² K' = K + E` (`K`, `K'` the kinetic energies before and
+//! after the iteration's change): of all velocity fields with that kinetic energy the
+//! nearest one, in the mass-weighted norm, to the velocities the update would produce. A
+//! free body never gets there (its corrections carry no momentum, so they lift nothing).
+//!
 //! Cost: in iterations where the limit acts, four passes over the body's particles (two
 //! fits, measure, apply), serial, in particle order (the same for any thread count).
 
@@ -53,13 +63,16 @@ pub(crate) struct GiveBack<'a> {
     pub slots: &'a [Slot],
     /// Lumped masses, kg.
     pub masses: &'a [f32],
+    /// Inverse masses, 1/kg (0: pinned).
+    pub inv_masses: &'a [f32],
 }
 
 /// Gives back the rigid fit of the held-back displacements (only with `free`: a body with
 /// pins exchanges momentum with them), then holds the iteration's velocity change to
-/// `budget` (J) of added kinetic energy (module docs): its non-rigid part is scaled first,
-/// the rigid part only where that alone would exceed the budget; `h` the substep (s).
-/// Returns the smaller of the two scales.
+/// `budget` (J) of added kinetic energy, negative where the kinetic energy must pay for a lift
+/// (module docs): its non-rigid part is scaled first, the rigid part only where that alone
+/// would exceed the budget, the whole velocity where both cannot meet it; `h` the substep
+/// (s). Returns the smallest of the scales.
 pub(crate) fn give_back_within_budget(run: GiveBack<'_>, h: f32, budget: f64, free: bool) -> f32 {
     let GiveBack {
         positions,
@@ -67,6 +80,7 @@ pub(crate) fn give_back_within_budget(run: GiveBack<'_>, h: f32, budget: f64, fr
         prev_positions,
         slots,
         masses,
+        inv_masses,
     } = run;
     let held = |s: &Slot| lanes(s.xw);
     let kept = |s: &Slot| lanes(s.r);
@@ -90,6 +104,8 @@ pub(crate) fn give_back_within_budget(run: GiveBack<'_>, h: f32, budget: f64, fr
     };
     let hf = f64::from(h);
     let (mut wr, mut sr, mut wn, mut sn, mut x) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    // Twice the free particles' kinetic energy before the change, J.
+    let mut before_k = 0.0f64;
     for i in 0..positions.len() {
         let (r, n) = parts(i);
         let (r, n) = (r.cast::<f64>() / hf, n.cast::<f64>() / hf);
@@ -101,21 +117,81 @@ pub(crate) fn give_back_within_budget(run: GiveBack<'_>, h: f32, budget: f64, fr
         wn += m * before.dot(&n);
         sn += m * n.norm_squared();
         x += m * r.dot(&n);
+        if inv_masses[i] > 0.0 {
+            before_k += m * before.norm_squared();
+        }
     }
     // ΔK = τR wr + ½τR² sr + τN (wn + τR x) + ½τN² sn.
-    let budget = budget.max(0.0);
+    let budget = if budget.is_nan() { 0.0 } else { budget };
     let rigid = wr + 0.5 * sr;
-    let (tau_r, tau_n) = if rigid <= budget {
+    let (tau_r, tau_n) = if rigid <= budget.max(0.0) {
         (1.0, largest_within(wn + x, sn, budget - rigid))
     } else {
-        (largest_within(wr, sr, budget), 0.0)
+        (largest_within(wr, sr, budget.max(0.0)), 0.0)
     };
     for i in 0..positions.len() {
         let (r, n) = parts(i);
         residuals[i] += at(back, &positions[i]);
         residuals[i] -= r * (1.0 - tau_r) + n * (1.0 - tau_n);
     }
-    tau_r.min(tau_n)
+    let (tr, tn) = (f64::from(tau_r), f64::from(tau_n));
+    let added = tr * wr + 0.5 * tr * tr * sr + tn * (wn + tr * x) + 0.5 * tn * tn * sn;
+    let sigma = if added > budget {
+        let run = Lift {
+            positions,
+            residuals,
+            prev_positions,
+            inv_masses,
+            masses,
+        };
+        pay_for_lift(run, hf, [0.5 * before_k, budget])
+    } else {
+        1.0
+    };
+    tau_r.min(tau_n).min(sigma)
+}
+
+/// Scales the free particles' velocities (as the update will produce them from positions and
+/// residuals, over the substep `h`, s) by `σ ∈ [0, 1]` with `σ² K' = max(0, K + budget)`,
+/// `K'` their kinetic energy now and `[K, budget]` the kinetic energy before the iteration's
+/// change and the (negative) budget, J. Returns `σ`.
+fn pay_for_lift(run: Lift<'_>, h: f64, [before, budget]: [f64; 2]) -> f32 {
+    let Lift {
+        positions,
+        residuals,
+        prev_positions,
+        inv_masses,
+        masses,
+    } = run;
+    let moved = |i: usize, r: &[Vector3<f32>]| (positions[i] - prev_positions[i]) + r[i];
+    let mut now = 0.0f64;
+    for i in 0..positions.len() {
+        if inv_masses[i] > 0.0 {
+            let v = moved(i, residuals).cast::<f64>() / h;
+            now += 0.5 * f64::from(masses[i]) * v.norm_squared();
+        }
+    }
+    let target = (before + budget).max(0.0);
+    if !(now > target && now.is_finite()) {
+        return 1.0;
+    }
+    let sigma = (target / now).sqrt().clamp(0.0, 1.0) as f32;
+    for i in 0..positions.len() {
+        if inv_masses[i] > 0.0 {
+            let d = moved(i, residuals);
+            residuals[i] -= d * (1.0 - sigma);
+        }
+    }
+    sigma
+}
+
+/// The arrays [`pay_for_lift`] reads and writes.
+struct Lift<'a> {
+    positions: &'a [Vector3<f32>],
+    residuals: &'a mut [Vector3<f32>],
+    prev_positions: &'a [Vector3<f32>],
+    inv_masses: &'a [f32],
+    masses: &'a [f32],
 }
 
 /// The first three lanes of a slot's vector.
@@ -138,8 +214,9 @@ fn at(fit: Option<RigidField>, x: &Vector3<f32>) -> Vector3<f32> {
     }
 }
 
-/// The largest `τ ∈ [0, 1]` with `τ work + ½ τ² square ≤ budget` (`budget ≥ 0`, so `τ = 0`
-/// always qualifies). 1 when the sums are not finite (nothing measured to act on).
+/// The largest `τ ∈ [0, 1]` with `τ work + ½ τ² square ≤ budget` (J); where none qualifies
+/// (a negative budget below the least the change can add), the `τ` that adds the least,
+/// `−work/square`. 1 when the sums are not finite (nothing measured to act on).
 fn largest_within(work: f64, square: f64, budget: f64) -> f32 {
     if !(work.is_finite() && square.is_finite() && budget.is_finite()) {
         return 1.0;
@@ -147,10 +224,12 @@ fn largest_within(work: f64, square: f64, budget: f64) -> f32 {
     if work + 0.5 * square <= budget {
         return 1.0;
     }
-    // ½ square τ² + work τ − budget = 0, larger root; square > 0 here (else work > budget
-    // and τ = budget / work).
-    let tau = if square > 0.0 {
-        (-work + (work * work + 2.0 * square * budget).sqrt()) / square
+    // ½ square τ² + work τ − budget = 0, larger root; with square = 0, work > budget here.
+    let disc = work * work + 2.0 * square * budget;
+    let tau = if square > 0.0 && disc >= 0.0 {
+        (-work + disc.sqrt()) / square
+    } else if square > 0.0 {
+        -work / square
     } else {
         budget / work
     };

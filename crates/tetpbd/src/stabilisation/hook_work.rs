@@ -41,11 +41,17 @@ pub(crate) struct HookWork {
     pub(crate) start: Vec<Vector3<f32>>,
     /// `Σ mᵢ|Δcᵢ|²/(2h²)` of the hook calls since the families' last pass (J).
     pub(crate) energy: f64,
+    /// `Σ mᵢΔcᵢ` of the same calls (kg m; `Δcᵢ = hΔvᵢ` for a velocity change): how far the
+    /// hook moved the body's mass, for the work against the applied acceleration
+    /// ([`crate::stabilisation::correction_energy`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub(crate) push: Vector3<f64>,
 }
 
 impl PartialEq for HookWork {
     fn eq(&self, o: &HookWork) -> bool {
         self.energy.to_bits() == o.energy.to_bits()
+            && self.push.map(f64::to_bits) == o.push.map(f64::to_bits)
     }
 }
 
@@ -86,11 +92,12 @@ pub(crate) fn before_hook(world: &mut hecs::World, changed: Changed) {
 }
 
 /// Adds the energy of the impulses of the hook call since [`before_hook`] to every body's
-/// hook work: `Σ mᵢ|Δcᵢ|²/(2h²)` for positions, `Σ mᵢ|Δvᵢ|²/2` for velocities.
+/// hook work: `Σ mᵢ|Δcᵢ|²/(2h²)` for positions, `Σ mᵢ|Δvᵢ|²/2` for velocities; and the
+/// mass moved, `Σ mᵢΔcᵢ` (`Σ mᵢ hΔvᵢ`).
 pub(crate) fn after_hook(world: &mut hecs::World, h: f32, changed: Changed) {
-    let factor = match changed {
-        Changed::Positions => 0.5 / (f64::from(h) * f64::from(h)),
-        Changed::Velocities => 0.5,
+    let (factor, length) = match changed {
+        Changed::Positions => (0.5 / (f64::from(h) * f64::from(h)), 1.0),
+        Changed::Velocities => (0.5, f64::from(h)),
     };
     for p in world
         .query_mut::<&mut Particles>()
@@ -100,13 +107,16 @@ pub(crate) fn after_hook(world: &mut hecs::World, h: f32, changed: Changed) {
         if hook.start.len() != now.len() {
             continue;
         }
-        let mut sum = 0.0f64;
+        let (mut sum, mut moved) = (0.0f64, Vector3::<f64>::zeros());
         for ((x, s), m) in now.iter().zip(&hook.start).zip(masses) {
-            sum += f64::from(*m) * f64::from((x - s).norm_squared());
+            let d = x - s;
+            sum += f64::from(*m) * f64::from(d.norm_squared());
+            moved += d.cast::<f64>() * f64::from(*m);
         }
         // A non-finite state is the non-finite check's business, not the budget's.
-        if sum.is_finite() {
+        if sum.is_finite() && moved.iter().all(|c| c.is_finite()) {
             hook.energy += sum * factor;
+            hook.push += moved * length;
         }
     }
 }

@@ -42,6 +42,10 @@ pub(crate) struct Moments<T: nalgebra::Scalar + Copy> {
     pub(crate) momentum: Vector3<T>,
     /// The largest inverse mass, 1/kg.
     pub(crate) inv_mass: T,
+    /// Σ m over the free particles (inverse mass > 0), kg: those the prediction accelerates.
+    pub(crate) free_mass: T,
+    /// Σ m v over the free particles (`v` relative to the first particle's), kg m/s.
+    pub(crate) free_momentum: Vector3<T>,
 }
 
 impl Moments<f32> {
@@ -86,6 +90,8 @@ impl Moments<f64> {
         self.momentum_moment += b.momentum_moment.cast::<f64>();
         self.momentum += b.momentum.cast::<f64>();
         self.inv_mass = self.inv_mass.max(f64::from(b.inv_mass));
+        self.free_mass += f64::from(b.free_mass);
+        self.free_momentum += b.free_momentum.cast::<f64>();
     }
 
     /// [`rigid_fit`] of the corrections these sums measured: the centre of mass and `θ`.
@@ -369,7 +375,8 @@ impl StoreRun<'_> {
     /// Copies the slots back, leaves the state before the families in them (for the second
     /// pass of [`crate::stabilisation::angular_momentum::store_measured`]) and returns the moments of the corrections (one block:
     /// f32, in particle order), `x̄` taken about `o` and `v` relative to `v0`.
-    /// Without `SPIN` only the energy sums (`work`, `square`, `push`, `inv_mass`) are taken.
+    /// Without `SPIN` only the energy sums (`work`, `square`, `push`, `inv_mass`, the free
+    /// particles' mass and momentum) are taken.
     pub(crate) fn store_measuring<const SPIN: bool>(
         self,
         [o, v0]: [Vector3<f32>; 2],
@@ -390,6 +397,10 @@ impl StoreRun<'_> {
                 self.velocities[i] - v0,
             );
             m.inv_mass = m.inv_mass.max(w);
+            if w > 0.0 {
+                m.free_mass += self.masses[i];
+                m.free_momentum += (self.velocities[i] - v0) * self.masses[i];
+            }
             self.positions[i] = x;
             self.residuals[i] = r;
             slot.xw = f32x4::new([x0.x, x0.y, x0.z, w]);
