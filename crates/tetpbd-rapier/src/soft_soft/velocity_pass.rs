@@ -119,7 +119,7 @@ impl ContactFrame {
                 .sum();
             let vn = n.dot(&(v[p] - vq));
             let floor = c.vn_held.min(n.dot(&(momentum / mass - vq))) - release_speed;
-            if !(vn < floor) {
+            if vn.partial_cmp(&floor) != Some(std::cmp::Ordering::Less) {
                 continue;
             }
             let dv = floor - vn;
