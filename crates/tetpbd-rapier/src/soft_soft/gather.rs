@@ -33,6 +33,12 @@ pub(crate) struct Candidate {
     /// Projected in the current substep / in the frame.
     pub active: bool,
     pub ever: bool,
+    /// Projected in the previous substep of the frame (`project::ContactFrame::velocity_pass`:
+    /// a contact that lets go releases no held-back correction as speed).
+    pub held_before: bool,
+    /// Relative normal velocity `(v_p − v_q)·n` the contact left after its last velocity
+    /// pass, m/s (≤ 0: approaching or resting).
+    pub vn_held: f32,
     /// Limited by the separation speed in the current substep.
     pub clamped: bool,
     /// The particle projected inside the triangle at the substep start.
@@ -63,6 +69,8 @@ pub(crate) struct ContactFrame {
     pub w: Vec<f32>,
     pub motion: Vec<f32>,
     pub candidates: Vec<Candidate>,
+    /// Scratch of the velocity pass: each body's surface momentum (kg·m/s) and mass (kg).
+    pub body_motion: Vec<(Vector3<f32>, f32)>,
 }
 
 impl ContactFrame {
@@ -457,6 +465,8 @@ fn candidate(p: u32, tri: [u32; 3], props: SoftPair, depth_limit: f32) -> Candid
         lambda_t: 0.0,
         active: false,
         ever: false,
+        held_before: false,
+        vn_held: 0.0,
         clamped: false,
         prism_prev: false,
         group: [0, 0],

@@ -20,7 +20,9 @@
 //! (an inequality), every iteration of every substep. Friction is positional (Müller et al.
 //! 2020): the relative tangential displacement of `p` against `q` over the substep is removed
 //! while the tangential multiplier stays under `μ_s λ`, otherwise only up to `μ_d λ`. After
-//! each substep the separating normal velocity a contact's projection created is removed,
+//! each substep the separating normal velocity a contact's projection created is removed, a
+//! contact that let go in the substep keeps its particle at the relative normal velocity it
+//! had while held (the correction it held back is not released as speed; `velocity_pass`),
 //! and the separating velocity of the two bodies' centres of mass is capped at `e` times
 //! their approach speed (`restitution` module; `e` = 0 by default), so impacts do not turn
 //! into bounces.
@@ -94,6 +96,7 @@ pub(crate) mod project;
 pub(crate) mod restitution;
 pub(crate) mod separation;
 pub(crate) mod settings;
+pub(crate) mod velocity_pass;
 
 use hecs::World;
 use tetpbd::{FrameContext, SubstepContext, SubstepHook};
@@ -270,7 +273,8 @@ impl SubstepHook for SoftContacts {
     fn end_substep(&mut self, world: &mut World, substep: SubstepContext) {
         self.separation
             .remove_velocity(world, &self.gather.bodies, substep.h());
-        self.frame.velocity_pass(world, &self.gather);
+        self.frame
+            .velocity_pass(world, &self.gather, self.settings.max_separation_speed);
         let a_max = self.settings.max_acceleration;
         self.restitution.apply(
             world,

@@ -1,6 +1,7 @@
 //! Per-substep work of soft–soft contacts: the XPBD vertex–triangle projection with
 //! friction (and, for a particle grazing a side face, which face catches it:
-//! `flush_beside`), the velocity pass and the end-of-frame statistics (see
+//! `flush_beside`) and the end-of-frame statistics (the velocity pass is in
+//! `velocity_pass`) (see
 //! [`crate::SoftContacts`] for the equations).
 
 use hecs::World;
@@ -26,7 +27,7 @@ const CREASE_COS: f32 = 0.7;
 
 /// Which per-particle array a load or store touches.
 #[derive(Clone, Copy)]
-enum Field {
+pub(super) enum Field {
     Position,
     SubstepStart,
     Velocity,
@@ -34,7 +35,7 @@ enum Field {
 
 impl ContactFrame {
     /// Copies `field` of every involved body's surface particles into the slots.
-    fn load(&mut self, world: &mut World, g: &Gather, field: Field) {
+    pub(super) fn load(&mut self, world: &mut World, g: &Gather, field: Field) {
         for b in g.bodies.iter().filter(|b| b.involved) {
             let Ok(p) = world.query_one_mut::<&Particles>(b.entity) else {
                 continue;
@@ -58,7 +59,7 @@ impl ContactFrame {
     }
 
     /// Writes the slots back (finite values only) into positions or velocities.
-    fn store(&self, world: &mut World, g: &Gather, field: Field) -> u64 {
+    pub(super) fn store(&self, world: &mut World, g: &Gather, field: Field) -> u64 {
         let mut rejected = 0;
         for b in g.bodies.iter().filter(|b| b.involved) {
             let Ok(p) = world.query_one_mut::<&mut Particles>(b.entity) else {
@@ -101,6 +102,7 @@ impl ContactFrame {
             };
             c.lambda_n = 0.0;
             c.lambda_t = 0.0;
+            c.held_before = c.active;
             c.active = false;
             c.clamped = false;
         }
@@ -175,39 +177,6 @@ impl ContactFrame {
             }
         }
         stats.degenerate += self.store(world, g, Field::Position);
-    }
-
-    /// After the velocity update: removes the separating normal velocity of every contact
-    /// projected in the substep (restitution 0).
-    pub fn velocity_pass(&mut self, world: &mut World, g: &Gather) {
-        if !self.candidates.iter().any(|c| c.active) {
-            return;
-        }
-        self.load(world, g, Field::Velocity);
-        let ContactFrame { v, candidates, .. } = self;
-        for c in candidates.iter().filter(|c| c.active) {
-            let (p, n, bary, w) = (c.p as usize, c.n, c.bary, c.weights);
-            let tri = c.tri.map(|i| i as usize);
-            let vq: Vector3<f32> = (0..3).map(|k| v[tri[k]] * bary[k]).sum();
-            // A held side moves the other one no faster than the support it rests on
-            // (at rest): its own separating normal velocity is not handed on.
-            let (vp_n, vq_n) = match c.held {
-                1 => (n.dot(&v[p]).max(0.0), n.dot(&vq)),
-                2 => (n.dot(&v[p]), n.dot(&vq).min(0.0)),
-                _ => (n.dot(&v[p]), n.dot(&vq)),
-            };
-            let vn = vp_n - vq_n;
-            let wsum = w[0] + (0..3).map(|k| bary[k] * bary[k] * w[k + 1]).sum::<f32>();
-            if !(vn > 0.0 && wsum > 0.0) {
-                continue;
-            }
-            let j = -vn / wsum;
-            v[p] += n * (w[0] * j);
-            for k in 0..3 {
-                v[tri[k]] -= n * (w[k + 1] * bary[k] * j);
-            }
-        }
-        self.store(world, g, Field::Velocity);
     }
 
     /// End of frame: contact count and the largest penetration at the final positions.
