@@ -11,7 +11,9 @@ use tetpbd::{
 
 use crate::attachments::{anchor_of, project_attachments, Attachments};
 use crate::contacts::approach::limit_approach;
+use crate::contacts::corner::CornerContact;
 use crate::contacts::corner::{project_corners, CornerPass};
+use crate::contacts::particle::ParticleContact;
 use crate::contacts::particle::{
     finish_substep, friction_on_pivoting, project_contacts, velocity_pass,
 };
@@ -23,8 +25,12 @@ use crate::gather::{Frame, GatherInput};
 use crate::heavy_loads::{immovable, stacked_velocity_pass, stacking_pass, Stacking};
 use crate::joints::project_joints;
 use crate::report::{ContactReport, SoftFeature};
+use crate::response::passivity::{only_immovable_contacts, stop_approach, Passivity};
+use crate::response::restitution::active_colliders;
 use crate::response::restitution::restitution_pass;
 use crate::response::rolling::rolling_pass;
+use crate::rigid::body::BodyProxy;
+use crate::rigid::collider::ColliderProxy;
 use crate::rigid::shape_query::surface_point;
 use crate::soft_collider::SoftCollider;
 use crate::soft_soft::SoftContacts;
@@ -114,6 +120,40 @@ impl SubstepHook for CoupledHooks<'_, '_, '_> {
         }
         self.extra.touching(world, touching);
     }
+}
+
+/// Runs the passivity episode of soft body `s` (`response::passivity`) when its contacts are
+/// all immovable and nothing else acts on its rigid motion (no pinned particle, attachment,
+/// grab or user force, no soft body within reach); `accel` is gravity plus the applied
+/// uniform acceleration (m/s²), `given` the energy restitution gave it (J). Returns the
+/// body's rigid fit when it took one.
+#[allow(clippy::too_many_arguments)]
+fn passivity_pass(
+    passivity: &mut Passivity,
+    active: &mut Vec<usize>,
+    s: &crate::gather::SoftEntry,
+    (contacts, corners): (&[ParticleContact], &[CornerContact]),
+    p: &mut Particles,
+    (bodies, colliders): (&[BodyProxy], &[ColliderProxy]),
+    (forces, grab, attached): (Option<&UserForces>, Option<&Grab>, bool),
+    (accel, given): (&nalgebra::Vector3<f32>, f32),
+) -> Option<tetpbd::RigidFit> {
+    let pushed =
+        forces.is_some_and(|f| f.forces().iter().any(|f| *f != nalgebra::Vector3::zeros()));
+    if s.near_soft
+        || attached
+        || grab.is_some()
+        || pushed
+        || !only_immovable_contacts(contacts, corners, bodies, colliders)
+        || p.inv_masses().contains(&0.0)
+    {
+        return None;
+    }
+    let mut fit = p.rigid_fit()?;
+    active_colliders(active, contacts, corners);
+    stop_approach(active, contacts, corners, p, &mut fit);
+    passivity.run(s.entity.to_bits().get(), p, &mut fit, accel, given);
+    Some(fit)
 }
 
 /// The fraction of the frame elapsed at the end of `substep`: where the rigid bodies stand
@@ -273,6 +313,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             contacts,
             corners,
             episodes,
+            passivity,
             active_colliders,
             supports,
             stats,
@@ -314,7 +355,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 stats.stacking_time += t.elapsed();
             }
             velocity_pass(&mut contacts[range.clone()], p, bodies, colliders);
-            restitution_pass(
+            let given = restitution_pass(
                 episodes,
                 active_colliders,
                 s.entity,
@@ -328,6 +369,16 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 &attachments[s.attachments.clone()],
                 threshold,
             );
+            let fit = passivity_pass(
+                passivity,
+                active_colliders,
+                s,
+                (&contacts[range.clone()], &corners[s.corners.clone()]),
+                p,
+                (bodies, colliders),
+                (forces, grab, !attachments[s.attachments.clone()].is_empty()),
+                (&(pull / h), given),
+            );
             rolling_pass(
                 active_colliders,
                 &contacts[range.clone()],
@@ -337,6 +388,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
                 colliders,
                 rolling,
                 h,
+                fit,
             );
             cap_depenetration(
                 depenetrating,
@@ -349,6 +401,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
             finish_substep(&mut contacts[range], h, self.max_depenetration_speed * h);
         }
         episodes.end_substep();
+        passivity.end_substep();
         let max_push = self.max_depenetration_speed * h;
         for k in corners.iter_mut() {
             k.allowance = (k.allowance - max_push).max(0.0);

@@ -332,7 +332,8 @@ fn rolling_resistance_steps_without_allocating() {
             p.set_velocity(i, v).expect("velocity");
         }
     }
-    for _ in 0..20 {
+    // A few frames only: the face it tips onto stops it soon (`response::passivity`).
+    for _ in 0..2 {
         scene.step().expect("step");
     }
     let spin = |scene: &CoupledWorld| {

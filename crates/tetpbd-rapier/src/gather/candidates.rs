@@ -70,8 +70,10 @@ impl Frame {
             let c0 = self.contacts.len();
             let k0 = self.corners.len();
             let a0 = self.attachments.len();
+            let travel = p.max_speed() * dt + fall;
+            let mut bounds = None;
             if sc.enabled && !surface.vertices().is_empty() {
-                let reach = input.margin + sc.thickness + p.max_speed() * dt + fall;
+                let reach = input.margin + sc.thickness + travel;
                 let body = SoftInFrame {
                     entity,
                     p,
@@ -80,7 +82,12 @@ impl Frame {
                     c0,
                     reach,
                 };
-                self.gather_contacts(&body, input);
+                let (lo, hi) = surface_bounds(p, surface);
+                self.gather_contacts(&body, input, (&lo, &hi));
+                bounds = input.soft_margin.map(|m| {
+                    let grow = Vector3::repeat(m + sc.thickness + travel);
+                    (lo - grow, hi + grow)
+                });
             }
             if let Some(att) = att {
                 self.gather_attachments(att, p, input);
@@ -93,6 +100,8 @@ impl Frame {
                 attachments: a0..self.attachments.len(),
                 stacked: false,
                 reach: tetpbd::local_reach(p, surface),
+                bounds,
+                near_soft: false,
                 wave_speed: if self.contacts.len() > c0 {
                     wave_speed(p, families)
                 } else {
@@ -100,6 +109,7 @@ impl Frame {
                 },
             });
         }
+        self.mark_near_soft();
         self.anchor_supported_bodies(input);
         self.weld_jointed_bodies(input);
         self.gather_joints(input);
@@ -108,12 +118,34 @@ impl Frame {
         self.stats.attachments = self.attachments.len();
     }
 
-    /// The colliders near one soft body and its candidates against each.
-    fn gather_contacts(&mut self, body: &SoftInFrame<'_>, input: &GatherInput<'_, '_>) {
+    /// Marks the soft bodies whose bounds, grown by how far they may move in the frame and
+    /// the soft–soft margin, meet another's: they may touch another soft body within the
+    /// frame (`response::passivity`). All pairs of the frame's bodies, once per frame.
+    fn mark_near_soft(&mut self) {
+        for a in 0..self.soft.len() {
+            let Some((lo, hi)) = self.soft[a].bounds else {
+                continue;
+            };
+            let near = self.soft.iter().enumerate().any(|(b, o)| {
+                b != a
+                    && o.bounds
+                        .is_some_and(|(l, h)| (0..3).all(|k| lo[k] <= h[k] && l[k] <= hi[k]))
+            });
+            self.soft[a].near_soft = near;
+        }
+    }
+
+    /// The colliders near one soft body (surface bounds `lo`, `hi`, m) and its candidates
+    /// against each.
+    fn gather_contacts(
+        &mut self,
+        body: &SoftInFrame<'_>,
+        input: &GatherInput<'_, '_>,
+        (lo, hi): (&Vector3<f32>, &Vector3<f32>),
+    ) {
         let qp = input.qp;
         let sc = &body.sc;
-        let (lo, hi) = surface_bounds(body.p, body.surface);
-        let aabb = Aabb::new(to_glam(&lo), to_glam(&hi)).loosened(body.reach);
+        let aabb = Aabb::new(to_glam(lo), to_glam(hi)).loosened(body.reach);
         let mut near = std::mem::take(&mut self.near);
         near.clear();
         let keep = |co: &Collider| {

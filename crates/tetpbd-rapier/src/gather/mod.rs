@@ -50,6 +50,11 @@ pub(crate) struct SoftEntry {
     /// rest data each frame for a body with contact candidates, `f32::INFINITY` otherwise):
     /// with `reach`, how fast it may approach something immovable (`contacts::approach`).
     pub wave_speed: f32,
+    /// Its surface bounds grown by the soft–soft margin and how far it may move in the
+    /// frame, m (`None` with soft–soft contacts off or its collider disabled).
+    pub bounds: Option<(Vector3<f32>, Vector3<f32>)>,
+    /// Whether those bounds meet another soft body's: it may touch a soft body this frame.
+    pub near_soft: bool,
 }
 
 /// A particle–collider pair: `(entity bits, collider handle (index, generation), particle)`.
@@ -107,6 +112,8 @@ pub(crate) struct Frame {
     pub active_colliders: Vec<usize>,
     /// Impact episodes in progress (kept across frames).
     pub episodes: Episodes,
+    /// Passivity episodes in progress (kept across frames, `response::passivity`).
+    pub passivity: crate::response::passivity::Passivity,
     /// Scratch of the waking pass (`sleeping` module docs).
     pub waking: crate::sleeping::Waking,
     /// Frame length, s (the solver's, `begin_frame`).

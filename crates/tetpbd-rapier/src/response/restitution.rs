@@ -150,7 +150,8 @@ impl Episodes {
 /// body's contacts (contiguous per collider), `v_cm_pre` its centre-of-mass velocity before
 /// the substep, `pull` the change of its velocity the applied loads and gravity gave in the
 /// substep (m/s, module docs), `attached` its attachment runs. `active` is scratch space
-/// (its capacity is reused across calls).
+/// (its capacity is reused across calls). Returns the kinetic energy the bounces gave the
+/// body (J, the rises only: `response::passivity` counts it as work done on purpose).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn restitution_pass(
     episodes: &mut Episodes,
@@ -165,10 +166,11 @@ pub(crate) fn restitution_pass(
     colliders: &[ColliderProxy],
     attached: &[AttachRun],
     threshold: f32,
-) {
+) -> f32 {
     let Some((v_cm, mass)) = p.free_velocity() else {
-        return;
+        return 0.0;
     };
+    let (mut given, mut v_now) = (0.0f32, v_cm);
     // A body with pinned particles is anchored to the world: its centre of mass takes no
     // share of the restitution impulse.
     let anchored = p.inv_masses().contains(&0.0);
@@ -202,6 +204,9 @@ pub(crate) fn restitution_pass(
         let Some(j) = bounce(p, w_soft, bodies, cp.body, (&n, &q), dv) else {
             continue;
         };
+        let dv_soft = n * (j * w_soft);
+        given += (mass * (v_now.dot(&dv_soft) + 0.5 * dv_soft.norm_squared())).max(0.0);
+        v_now += dv_soft;
         let share = n * (j / count as f32);
         for c in contacts
             .iter_mut()
@@ -213,6 +218,7 @@ pub(crate) fn restitution_pass(
             k.impulse += share;
         }
     }
+    given
 }
 
 /// Changes the relative normal velocity at the patch (unit normal `n` towards the soft
@@ -242,7 +248,7 @@ fn bounce(
 /// The active contacts of a soft body with collider `ci`, as one patch: unit mean normal,
 /// mean point (world, m), number of contacts and the largest restitution coefficient.
 /// `None` without contacts or without a usable normal.
-fn contact_patch(
+pub(crate) fn contact_patch(
     ci: usize,
     contacts: &[ParticleContact],
     corners: &[CornerContact],

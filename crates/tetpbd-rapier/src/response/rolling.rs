@@ -55,7 +55,8 @@ use crate::rigid::body::BodyProxy;
 use crate::rigid::collider::ColliderProxy;
 
 /// Applies the rolling resistance of one soft body for a substep of length `h`. `active` is
-/// scratch space (its capacity is reused).
+/// scratch space (its capacity is reused); `fit` the body's rigid fit when the substep
+/// already took it (`response::passivity`), else it is taken here.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn rolling_pass(
     active: &mut Vec<usize>,
@@ -66,6 +67,7 @@ pub(crate) fn rolling_pass(
     colliders: &[ColliderProxy],
     coefficient: f32,
     h: f32,
+    fit: Option<RigidFit>,
 ) {
     if coefficient <= 0.0 || p.inv_masses().contains(&0.0) {
         return;
@@ -74,7 +76,7 @@ pub(crate) fn rolling_pass(
     if active.is_empty() {
         return;
     }
-    let Some(mut fit) = p.rigid_fit() else {
+    let Some(mut fit) = fit.or_else(|| p.rigid_fit()) else {
         return;
     };
     for &ci in active.iter() {
