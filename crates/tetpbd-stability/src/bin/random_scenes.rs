@@ -194,10 +194,7 @@ fn random_body(
 fn run_scene(k: u64, o: &Options) -> (String, Outcome) {
     let mut rng = Draws::from_seed(0x5EED_0000 + k);
     let substeps = rng.pick(&[2u32, 5, 10, 20, 40]);
-    let substeps = std::env::var("SUBSTEPS")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(substeps);
+    let substeps = o.substeps.unwrap_or(substeps);
     let solver = SolverSettings {
         substeps,
         ..SolverSettings::default()
