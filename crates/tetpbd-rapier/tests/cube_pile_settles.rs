@@ -1,6 +1,10 @@
 //! The pile of nine soft cubes (rapier's `fem_bench` "jelly pile" on
 //! rigid ground, as `tetpbd-bench` builds it) comes to rest at 10 substeps, undamped and with
-//! `DeformationDamping` 5/s.
+//! `DeformationDamping` 5/s: every particle slower than 0.02 m/s over the last 30 frames of
+//! 8 s. The last cube lands at about 2.5 s; a cube that lands perched on a neighbour's edge
+//! rocks on it with a period of about 0.3 s, its speed halving every half second (0.8 m/s at
+//! 3 s, 0.02 m/s at 6 s): a weakly damped mode, but one that dies out. A rocking that does not
+//! decay fails here.
 //!
 //! What it guards: the cubes are placed face to face, so a falling cube's bottom edge passes
 //! a landed neighbour's top edge flush with it. A landed cube bulges by a few millimetres, so the
@@ -102,7 +106,7 @@ fn run_pile(substeps: u32, damping: f32, at: &[Vector3<f32>]) -> Rest {
         bodies.iter().map(|e| get(e).expect("body")).collect()
     };
     let mut prev = positions(&w);
-    let (frames, rest_from) = (300, 180);
+    let (frames, rest_from) = (480, 180);
     let mut r = Rest {
         settled: 0.0,
         ground: 0.0,
@@ -186,18 +190,18 @@ fn pile_comes_to_rest_at_10_substeps() {
 /// Which pile comes to rest is chaotic (a millimetre moves where the cubes end up), so one
 /// run proves little: eight layouts with every cube moved by up to 2 mm, undamped and damped,
 /// at 10 and 5 substeps (the thresholds are in the test). A pile that does not settle is
-/// mostly a cube perched off-centre on another, swaying on its edge at 0.03–0.25 m/s (a
-/// weakly damped mode of the soft pair, left open). At 5 substeps a particle of a loaded cube
+/// mostly a cube perched off-centre on another, still rocking on its edge (the weakly damped
+/// mode above; how slowly it dies out is open work). At 5 substeps a particle of a loaded cube
 /// also ends up to 2.4 mm below the rigid ground (the coupling's ground contact, not the
 /// soft–soft contacts), so only the speed and the interpenetration are asserted there.
 #[test]
-#[ignore = "32 pile runs, about 20 s in release"]
+#[ignore = "32 pile runs, about 50 s in release"]
 fn jittered_piles_come_to_rest() {
     let mut counts = Vec::new();
-    // At 5 substeps 11 of 16 piles settle (8 before contacts that are no impact were capped:
-    // `docs/decisions/contacts-that-are-no-impact-are-capped.md`); settling piles at few
-    // substeps is open work.
-    for (substeps, needed) in [(10, 12), (5, 10)] {
+    // By 8 s all 16 piles settle at 10 and at 5 substeps; by 5 s, 16 and 14 (at 5 substeps
+    // 8 of 16 before contacts that are no impact were capped:
+    // `docs/decisions/contacts-that-are-no-impact-are-capped.md`). The margin is for chaos.
+    for (substeps, needed) in [(10, 14), (5, 13)] {
         let mut rested = 0;
         for seed in 1..=8 {
             for damping in [0.0, 5.0] {

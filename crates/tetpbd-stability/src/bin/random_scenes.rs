@@ -328,17 +328,24 @@ fn run_scene(k: u64, o: &Options) -> (String, Outcome) {
                 .iter()
                 .map(|&h| {
                     let b = &s.physics.bodies[h];
-                    format!("{:.2}@{:.2}", b.linvel().length(), b.translation().y)
+                    format!(
+                        "{:.2}@{:.2} w {:.1}",
+                        b.linvel().length(),
+                        b.translation().y,
+                        b.angvel().length()
+                    )
                 })
                 .collect();
             let c = &stats.soft_contacts;
             println!(
-                "frame {f}: E {:.1} soft {speeds:?} rigid {rigid:?} soft contacts {} deep {} clamps {} pen {:.3}, rigid pen {:.3}",
+                "frame {f}: E {:.1} soft {speeds:?} rigid {rigid:?} soft contacts {} deep {} clamps {} pen {:.3}, rigid contacts {} written {} pen {:.3}",
                 e - e0,
                 c.contacts,
                 c.deep,
                 c.clamps,
                 c.max_penetration,
+                stats.contacts,
+                stats.bodies_written,
                 stats.max_penetration
             );
         }
