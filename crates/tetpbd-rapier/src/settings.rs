@@ -22,7 +22,9 @@ pub struct CouplingSettings {
     /// resolved over several substeps and frames instead of in one substep, and the body
     /// does not keep the speed of the push (`depenetration` module docs), so separation does
     /// not turn into an explosion or a hop. Impacts and ongoing contacts are resolved fully.
-    /// A rigid body created inside a soft one is not covered.
+    /// The same speed bounds how fast a dynamic body a soft body touches leaves an overlap
+    /// with its rigid supports that it started the frame with (`contacts::support` module
+    /// docs). A rigid body created inside a soft one is not covered.
     pub max_depenetration_speed: f32,
     /// The stacking pass for bodies under heavy loads (shock propagation, `heavy_loads`
     /// module docs) and soft–soft carrying, with the mass ratio that turns them on; `None`

@@ -193,7 +193,13 @@ impl SubstepHook for CouplingHook<'_, '_> {
             b.begin_substep(frac, h);
         }
         let slop = self.frame.rigid_slop;
-        hold_supported(&self.frame.supports, &mut self.frame.bodies, slop);
+        let max_push = self.max_depenetration_speed * h;
+        hold_supported(
+            &mut self.frame.supports,
+            &mut self.frame.bodies,
+            slop,
+            max_push,
+        );
         for a in &mut self.frame.attachments {
             a.lambda = 0.0;
         }
@@ -324,7 +330,7 @@ impl SubstepHook for CouplingHook<'_, '_> {
         for b in bodies.iter_mut() {
             b.end_substep(h);
         }
-        end_substep_supports(supports, h);
+        end_substep_supports(supports, h, self.max_depenetration_speed * h);
         for s in soft.iter() {
             let Ok((p, surface, sc, loads)) = world.query_one_mut::<(
                 &mut Particles,
