@@ -108,11 +108,12 @@ use crate::substep::{CoupledHooks, CouplingHook};
 /// [`crate::SoftCollider::rolling_resistance`]).
 ///
 /// Why rolling resistance: sticking friction does no work on a rolling body and the
-/// deformation damping leaves rigid rotation alone, so without it a rounded soft body rocks
-/// on its belly for tens of seconds: the contacts do not pump energy into it, they only
-/// fail to take it out. A small coefficient (0.01) brings it to rest within seconds; the
-/// default is 0, off (`response::rolling` module docs;
-/// `tests/rolling_blob_comes_to_rest.rs` at the workspace root).
+/// deformation damping leaves rigid rotation alone. On immovable colliders the passivity of
+/// the contacts takes a rocking body's energy out (`response::passivity` module docs: a
+/// rounded soft body rests on the ground at default settings,
+/// `tests/rolling_blob_comes_to_rest.rs` at the workspace root); on a dynamic or moving
+/// collider nothing else does, and a small coefficient (0.01) brings a rolling body to rest
+/// within seconds. The default is 0, off (`response::rolling` module docs).
 ///
 /// # Known limits
 ///

@@ -4,8 +4,10 @@
 //! Why: a soft body is stiff enough to roll like a rigid one, and rolling with sticking
 //! friction does no work, so nothing in the contacts takes the energy of a rocking or
 //! rolling body; [`tetpbd::DeformationDamping`] only damps deformation, not the rigid
-//! rotation. A blob dropped on its rounded belly then rocks for tens of seconds (0.01–0.07
-//! m/s after 10–15 s in the `asset_drop` example, see [`crate::Coupling`]). Real bodies stop
+//! rotation. On immovable colliders the passivity of the contacts takes that energy out
+//! (`response::passivity`: a blob dropped on its rounded belly on the ground rests within
+//! 7 s without rolling resistance, `tests/rolling_blob_comes_to_rest.rs`); on a dynamic or
+//! moving collider, where passivity does not act, nothing else does. Real bodies stop
 //! because the contact patch deforms with hysteresis, which moves the normal force ahead of
 //! the contact point: a resisting couple of at most `c_rr · N · R` (`c_rr` the rolling
 //! resistance coefficient, `N` the normal force, `R` the lever from the centre of mass to the
