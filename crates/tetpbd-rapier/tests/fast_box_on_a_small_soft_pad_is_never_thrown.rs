@@ -86,7 +86,7 @@ fn throw(draws: &mut Draws, substeps: u32) -> Result<(), String> {
     for f in 0..90 {
         s.step().map_err(|e| format!("{what}: frame {f}: {e}"))?;
         let (e, fastest) = energy(&s, bx);
-        if !(e <= e0 + 0.02 * scale) {
+        if e.is_nan() || e > e0 + 0.02 * scale {
             return Err(format!("{what}: frame {f}: energy {e:.1} J from {e0:.1} J"));
         }
         if fastest > limit {
