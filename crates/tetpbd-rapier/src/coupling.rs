@@ -9,7 +9,7 @@ use rapier3d::dynamics::{MultibodyJointSet, RigidBodySet};
 use rapier3d::pipeline::QueryFilter;
 use tetpbd::{Solver, SolverSettings, SubstepHook};
 
-use crate::contacts::support::{apply_reaction, support_reaction};
+use crate::contacts::support::{apply_reaction, support_reaction, Reaction};
 use crate::context::RapierContext;
 use crate::convert::{to_glam, to_na};
 use crate::error::CouplingError;
@@ -130,12 +130,12 @@ use crate::substep::{CoupledHooks, CouplingHook};
 ///   `tetpbd-bench --bin stacking`).
 /// * The soft load pressing an anchored body onto its supports does not reach rapier: it
 ///   neither tips the body over nor weighs on a dynamic support below it (only the body's
-///   own motion into a support is handed to that support, as an impulse). Whether its
-///   supports hold it is decided from the load of the previous substep, for the whole body
-///   (one friction cone, the load's moment ignored: `contacts::support` module docs, Limits). A
-///   100 kg soft cube attached with 1e-5 m/N to the top of a 0.125 kg box on the ground
-///   stays on it with the cube moved by up to 3 mm, rocking the box up to 1 cm off its
-///   place in 10 s (`contacts::support` module docs).
+///   own motion into a support is handed to that support, as a force for rapier's next
+///   step). Whether its supports hold it is decided from the load of the previous substep,
+///   for the whole body (one friction cone, the load's moment ignored: `contacts::support`
+///   module docs, Limits). A 100 kg soft cube attached with 1e-5 m/N to the top of a
+///   0.125 kg box on the ground stays on it with the cube moved by up to 3 mm, rocking the
+///   box up to 1 cm off its place in 10 s (`contacts::support` module docs).
 /// * Rolling resistance is off by default and acts on the rigid fit of a whole body (its
 ///   centre of mass and mean angular velocity): a body with pinned particles is skipped,
 ///   a soft body lying over several colliders gets one couple per collider, and a dynamic
@@ -372,8 +372,12 @@ impl Coupling {
         // The reaction of the anchored bodies' pushes on their dynamic supports.
         for (handle, j, l) in self.frame.supports.iter().filter_map(support_reaction) {
             if let Some(rb) = bodies.get_mut(handle) {
-                if !apply_reaction(rb, &j, &l) {
-                    stats.non_finite_bodies += 1;
+                match apply_reaction(rb, &j, &l, self.frame.dt) {
+                    Reaction::Added(force, torque) => {
+                        self.frame.loads.push((handle, force, torque));
+                    }
+                    Reaction::Asleep => {}
+                    Reaction::NonFinite => stats.non_finite_bodies += 1,
                 }
             }
         }

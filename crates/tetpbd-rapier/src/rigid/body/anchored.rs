@@ -80,10 +80,26 @@ impl BodyProxy {
         self.support_normal.dot(push) < -0.5 * push.norm()
     }
 
-    /// Whether a soft impulse along `push` moves the body: not on an anchored body that is
-    /// held, nor when it presses an anchored body that stands on its supports.
-    pub(super) fn moves(&self, push: &Vector3<f32>) -> bool {
-        !self.is_anchored() || !(self.held || (self.presses(push) && self.clearance() <= TOUCH))
+    /// Whether a soft impulse along `push` at the world point `q` moves the body: not on an
+    /// anchored body that is held, nor when it presses an anchored body that stands on its
+    /// supports — unless the body's point `q` comes at what pushes it ([`Self::rams`]).
+    pub(super) fn moves(&self, push: &Vector3<f32>, q: &Vector3<f32>) -> bool {
+        !self.is_anchored()
+            || !(self.held
+                || (self.presses(push) && self.clearance() <= TOUCH && !self.rams(push, q)))
+    }
+
+    /// Whether the body's material point at `q` comes at what pushes it back along `push`
+    /// faster than a body at rest on its supports moves (its resting reach per substep,
+    /// velocity taken at the substep's start). Such a body is not standing still: left
+    /// immovable, it would push the soft side away at its own speed with infinite mass and
+    /// give it energy no load explains (`contacts::support` module docs, *Only a body at
+    /// rest is immovable*).
+    fn rams(&self, push: &Vector3<f32>, q: &Vector3<f32>) -> bool {
+        let Some(dir) = push.try_normalize(1e-12) else {
+            return false;
+        };
+        -self.velocity_at_pre(q).dot(&dir) * self.h > self.reach
     }
 
     /// How far from its supports (m) an anchored body still rests on them when a substep
@@ -95,18 +111,23 @@ impl BodyProxy {
     }
 
     /// Starts a substep of an anchored body, its clearance measured at its new pose: it is
-    /// *held* when it rests on its supports (its clearance within its resting reach, `slop`
-    /// rapier's allowed linear error, m)
-    /// and the soft impulses of the previous substep, summed, lie in their friction cone
-    /// (pressing it into them, their tangential part at most μ times their normal part). A
-    /// held body keeps its offset from the previous substep (it moves along rapier's path
+    /// *held* when it rests on its supports — its clearance within its resting reach (`slop`
+    /// rapier's allowed linear error, m), and no point within `radius` (m) of its centre of
+    /// mass (the farthest of its support points) moving by more than that reach in the
+    /// substep — and the soft impulses of the previous substep, summed, lie in their friction
+    /// cone (pressing it into them, their tangential part at most μ times their normal part).
+    /// A held body keeps its offset from the previous substep (it moves along rapier's path
     /// only) and soft impulses do not move it.
-    pub fn hold(&mut self, slop: f32) {
+    pub fn hold(&mut self, slop: f32, radius: f32) {
+        self.reach = self.resting_reach(slop);
         let n = self.support_normal;
         let load = self.soft_load.1;
         let press = -n.dot(&load);
+        let (v, w, _) = self.pre;
+        let speed = v.norm() + w.norm() * radius;
         self.held = self.is_anchored()
-            && self.clearance() <= self.resting_reach(slop)
+            && self.clearance() <= self.reach
+            && speed * self.h <= self.reach
             && press >= 0.0
             && (load + n * press).norm() <= self.friction * press;
         if self.held {

@@ -59,7 +59,7 @@ impl BodyProxy {
     pub fn apply_position_impulse(&mut self, p: &Vector3<f32>, q: &Vector3<f32>) {
         if self.is_anchored() {
             self.soft_load.0 += p;
-            if !self.moves(p) {
+            if !self.moves(p, q) {
                 return;
             }
             let sink = -self.support_normal.dot(&(self.inv_mass * p));
@@ -96,7 +96,7 @@ impl BodyProxy {
     /// Applies a velocity impulse `j` (N·s) at the world point `q` (an anchored body ignores
     /// one that does not move it, [`Self::moves`]).
     pub fn apply_velocity_impulse(&mut self, j: &Vector3<f32>, q: &Vector3<f32>) {
-        if !self.moves(j) {
+        if !self.moves(j, q) {
             return;
         }
         if self.kind == BodyKind::Supported {

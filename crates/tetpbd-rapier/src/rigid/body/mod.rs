@@ -115,6 +115,8 @@ pub(crate) struct BodyProxy {
     friction: f32,
     /// Whether an anchored body is held on its supports in this substep ([`Self::hold`]).
     held: bool,
+    /// An anchored body's resting reach in this substep, m ([`Self::hold`]).
+    reach: f32,
     /// Linear and angular velocity at the start of the current substep (before any soft
     /// correction), and the centre of mass they refer to.
     pre: (Vector3<f32>, Vector3<f32>, Vector3<f32>),
@@ -235,6 +237,7 @@ impl BodyProxy {
             soft_load: (Vector3::zeros(), Vector3::zeros()),
             friction: 0.0,
             held: false,
+            reach: TOUCH,
             pre: (Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
             smooth_accel,
             ends_at_rapier: false,
@@ -245,7 +248,7 @@ impl BodyProxy {
     /// [`Self::inv_mass_at`] for a constraint that pushes the body along `push`: 0 when the
     /// push does not move it.
     pub fn inv_mass_pushed(&self, q: &Vector3<f32>, push: &Vector3<f32>) -> f32 {
-        if !self.moves(push) {
+        if !self.moves(push, q) {
             return 0.0;
         }
         self.inv_mass_at(q, &push.try_normalize(1e-12).unwrap_or_default())
@@ -353,6 +356,16 @@ impl BodyProxy {
             at(self.com_start, self.rot_start),
             at(self.com_end, self.rot_end),
         )
+    }
+
+    /// The pose on the base path (no soft offsets) at the end of the current substep.
+    pub fn base_pose(&self) -> Isometry3<f32> {
+        if self.kind == BodyKind::Fixed {
+            return self.frame_poses().1;
+        }
+        let rot = self.rot_start.nlerp(&self.rot_end, self.frac);
+        let com = self.base_com(self.frac * self.dt);
+        Isometry3::from_parts(Translation3::from(com - rot * self.com_local), rot)
     }
 
     /// Current world centre of mass, m.
