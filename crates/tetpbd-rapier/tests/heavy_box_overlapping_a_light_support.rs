@@ -73,8 +73,8 @@ fn heavy_box_overlapping_a_light_support_is_not_thrown() {
     sweep(&[(10, 0.04, 0.5, 50.0, 10.0), (40, 0.04, 0.5, 50.0, 10.0)]);
 }
 
-/// A 50 kg box resting on a 1 kg one at 20 substeps (the reaction handed as a velocity gave
-/// the 1 kg box up to 9.6 m/s into the ground).
+/// A 50 kg box resting on a 1 kg one at 20 substeps (the 1 kg box was thrown at 400 m/s;
+/// with the reaction handed as a velocity it still got up to 9.6 m/s into the ground).
 #[test]
 fn heavy_box_on_a_light_support_is_not_thrown() {
     sweep(&[(20, 0.0, 0.5, 50.0, 1.0)]);

@@ -40,7 +40,11 @@
 //! that much every substep, so it is pushed out at the depenetration speed. (A draped soft
 //! body whose bottom triangle slid over a box corner 15 cm inside it otherwise took the
 //! whole depth at once, most of it as the whole body's motion ([`tetpbd::ImpactReach`]), and
-//! jumped off the box at 5 m/s.)
+//! jumped off the box at 5 m/s.) The depth at the start is looked at in every substep the
+//! point is found behind, not only in the first: a pair that met shallow can later stand
+//! deep (a body crushed over a box corner slides a triangle on whose plane the corner lies
+//! 14 cm behind), and pushing that out in one substep of 0.4 ms threw a 51.6 kg body thrown
+//! at 40 m/s onto a 0.95 kg box off at 109 m/s (its kinetic energy 41 → 380 kJ in one pass).
 //!
 //! A support point over a triangle with a vertex that *holds* the collider is skipped in the
 //! ordinary pass: a vertex in contact with the collider (in the same iteration) whose contact
@@ -114,11 +118,10 @@ pub(crate) struct CornerContact {
     pub point: Vector3<f32>,
     /// Barycentric weights of `point` on the triangle at its last projection.
     pub beta: [f32; 3],
-    /// Depth (m) this contact tolerates: an overlap found at its first evaluation in the
-    /// frame, less one substep's push, shrinking by that push every substep (module docs).
+    /// Depth (m) this contact tolerates: the overlap the point had at the start of any
+    /// substep it was found behind its triangle in, less one substep's push, shrinking by
+    /// that push every substep (module docs).
     pub allowance: f32,
-    /// Whether `allowance` was decided for the frame.
-    pub allowance_fresh: bool,
     pub sub_impulse: Vector3<f32>,
     pub impulse: Vector3<f32>,
 }
@@ -271,12 +274,9 @@ fn sweep_corners(
         } else if s >= -0.5 * shortest && !crossing_only {
             // Found behind the plane, not crossing it now: an overlap already there at the
             // substep start is pushed out at the depenetration speed (module docs).
-            if !k.allowance_fresh {
-                k.allowance_fresh = true;
-                let v_start = (cp.prev_pose(bodies) * Point3::from(local)).coords;
-                let s_start = (v_start - p.prev_positions()[idx[0]]).dot(&n);
-                k.allowance = (k.thickness - s_start - max_push).max(0.0);
-            }
+            let v_start = (cp.prev_pose(bodies) * Point3::from(local)).coords;
+            let s_start = (v_start - p.prev_positions()[idx[0]]).dot(&n);
+            k.allowance = k.allowance.max(k.thickness - s_start - max_push);
             let c_val = c_val + k.allowance;
             if c_val >= 0.0 {
                 continue;

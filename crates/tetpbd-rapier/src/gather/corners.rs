@@ -140,7 +140,6 @@ impl CornerContact {
             point: Vector3::zeros(),
             beta: [0.0; 3],
             allowance: 0.0,
-            allowance_fresh: false,
             sub_impulse: Vector3::zeros(),
             impulse: Vector3::zeros(),
         }
