@@ -16,8 +16,9 @@
 //! against an immovable other side: `C = n·(x − y) − min(0, C₁) ≥ 0` for the body's material
 //! point `x` of each contact point, `y` the other collider's point and `n` the contact normal
 //! towards the body; `C₁` is the value at the body's pose on rapier's path (below), so an
-//! overlap rapier left is neither pushed out nor deepened here. The body is then written back like any body that
-//! took part (pose and velocity), without being pushed into its supports.
+//! overlap rapier left is neither pushed out nor deepened here. The body is then written
+//! back like any body that took part (pose and velocity), without being pushed into its
+//! supports.
 //!
 //! *Overlaps at the frame's start.* The body's path `P₀ → P₁` starts where the previous frame
 //! left it, which may overlap a support by more than rapier's end pose does (a fast-spinning
@@ -222,6 +223,11 @@ pub(crate) fn gather_supports(
 }
 
 impl Support {
+    /// The contact point on the body, in the body's frame, m.
+    pub fn local(&self) -> &Vector3<f32> {
+        &self.local
+    }
+
     /// The constraint value (m) at the body's pose `pose`: `n·(x − y) − min(0, C₁)` plus
     /// the allowance (module docs); negative where the point is too deep.
     fn value(&self, pose: &nalgebra::Isometry3<f32>) -> f32 {
@@ -260,8 +266,12 @@ pub(crate) fn hold_supported(
     slop: f32,
     max_push: f32,
 ) {
+    let mut base = (usize::MAX, nalgebra::Isometry3::identity());
     for s in supports.iter_mut() {
-        let floor = s.separation(&bodies[s.body].base_pose()).min(0.0);
+        if base.0 != s.body {
+            base = (s.body, bodies[s.body].base_pose());
+        }
+        let floor = s.separation(&base.1).min(0.0);
         if floor.is_finite() {
             s.floor = floor;
         }
@@ -274,18 +284,12 @@ pub(crate) fn hold_supported(
         }
     }
     measure_clearance(supports, bodies);
-    let mut i = 0;
-    while i < supports.len() {
-        let b = supports[i].body;
-        let n = supports[i..].iter().take_while(|s| s.body == b).count();
-        let body = &mut bodies[b];
-        let com = body.com();
-        let radius = supports[i..i + n]
-            .iter()
-            .map(|s| ((body.pose * Point3::from(s.local)).coords - com).norm())
-            .fold(0.0, f32::max);
-        body.hold(slop, radius);
-        i += n;
+    let mut last = usize::MAX;
+    for s in supports {
+        if s.body != last {
+            bodies[s.body].hold(slop);
+            last = s.body;
+        }
     }
 }
 

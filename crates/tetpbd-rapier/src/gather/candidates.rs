@@ -346,7 +346,11 @@ impl Frame {
                     .iter()
                     .map(|s| s.friction)
                     .fold(f32::INFINITY, f32::min);
-                self.bodies[b].anchor(normal, friction);
+                let radius = self.supports[first..]
+                    .iter()
+                    .map(|s| self.bodies[b].distance_from_com(s.local()))
+                    .fold(0.0, f32::max);
+                self.bodies[b].anchor(normal, friction, radius);
             }
         }
     }

@@ -9,12 +9,14 @@ impl BodyProxy {
     /// Makes a supported body *anchored* (`contacts::support` module docs): it takes part with its
     /// generalized inverse mass, except while its supports hold it ([`Self::hold`]) and
     /// against impulses pressing it into supports it stands on; `normal` is their mean
-    /// contact normal (towards the body), `friction` their smallest friction coefficient.
+    /// contact normal (towards the body), `friction` their smallest friction coefficient,
+    /// `radius` the distance of the farthest support point from the centre of mass (m).
     /// It is written back every frame, which also keeps rapier from putting it to sleep:
     /// left at rapier's result in a frame where the soft body only pressed it into its
     /// supports, a light box holding a heavy soft body diverges within seconds.
-    pub fn anchor(&mut self, normal: Vector3<f32>, friction: f32) {
+    pub fn anchor(&mut self, normal: Vector3<f32>, friction: f32, radius: f32) {
         if self.kind == BodyKind::Supported {
+            self.support_radius = radius;
             self.friction = friction;
             self.kind = BodyKind::Dynamic;
             self.touched = true;
@@ -112,19 +114,19 @@ impl BodyProxy {
 
     /// Starts a substep of an anchored body, its clearance measured at its new pose: it is
     /// *held* when it rests on its supports — its clearance within its resting reach (`slop`
-    /// rapier's allowed linear error, m), and no point within `radius` (m) of its centre of
-    /// mass (the farthest of its support points) moving by more than that reach in the
+    /// rapier's allowed linear error, m), and no point as far from its centre of mass as its
+    /// farthest support point ([`Self::anchor`]) moving by more than that reach in the
     /// substep — and the soft impulses of the previous substep, summed, lie in their friction
     /// cone (pressing it into them, their tangential part at most μ times their normal part).
     /// A held body keeps its offset from the previous substep (it moves along rapier's path
     /// only) and soft impulses do not move it.
-    pub fn hold(&mut self, slop: f32, radius: f32) {
+    pub fn hold(&mut self, slop: f32) {
         self.reach = self.resting_reach(slop);
         let n = self.support_normal;
         let load = self.soft_load.1;
         let press = -n.dot(&load);
         let (v, w, _) = self.pre;
-        let speed = v.norm() + w.norm() * radius;
+        let speed = v.norm() + w.norm() * self.support_radius;
         self.held = self.is_anchored()
             && self.clearance() <= self.reach
             && speed * self.h <= self.reach

@@ -117,6 +117,8 @@ pub(crate) struct BodyProxy {
     held: bool,
     /// An anchored body's resting reach in this substep, m ([`Self::hold`]).
     reach: f32,
+    /// How far an anchored body's farthest support point lies from its centre of mass, m.
+    support_radius: f32,
     /// Linear and angular velocity at the start of the current substep (before any soft
     /// correction), and the centre of mass they refer to.
     pre: (Vector3<f32>, Vector3<f32>, Vector3<f32>),
@@ -238,6 +240,7 @@ impl BodyProxy {
             friction: 0.0,
             held: false,
             reach: TOUCH,
+            support_radius: 0.0,
             pre: (Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
             smooth_accel,
             ends_at_rapier: false,
@@ -314,8 +317,7 @@ impl BodyProxy {
             return;
         }
         self.frac = frac;
-        let base_rot = self.rot_start.nlerp(&self.rot_end, frac);
-        let base_com = self.base_com(frac * self.dt);
+        let (base_com, base_rot) = self.base_at(frac);
         if let Some(com) = self.pivot_com(frac, &base_rot) {
             self.dx = com - base_com;
         }
@@ -358,14 +360,26 @@ impl BodyProxy {
         )
     }
 
+    /// Centre of mass (m) and rotation on the base path at `frac` of the frame.
+    fn base_at(&self, frac: f32) -> (Vector3<f32>, UnitQuaternion<f32>) {
+        (
+            self.base_com(frac * self.dt),
+            self.rot_start.nlerp(&self.rot_end, frac),
+        )
+    }
+
     /// The pose on the base path (no soft offsets) at the end of the current substep.
     pub fn base_pose(&self) -> Isometry3<f32> {
         if self.kind == BodyKind::Fixed {
             return self.frame_poses().1;
         }
-        let rot = self.rot_start.nlerp(&self.rot_end, self.frac);
-        let com = self.base_com(self.frac * self.dt);
+        let (com, rot) = self.base_at(self.frac);
         Isometry3::from_parts(Translation3::from(com - rot * self.com_local), rot)
+    }
+
+    /// Distance (m) of the body-frame point `local` from the centre of mass.
+    pub fn distance_from_com(&self, local: &Vector3<f32>) -> f32 {
+        (local - self.com_local).norm()
     }
 
     /// Current world centre of mass, m.
