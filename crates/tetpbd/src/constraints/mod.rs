@@ -61,6 +61,7 @@ pub use neo_hookean_recovery::{
 };
 pub use vertex_face::{
     signed_height, vertex_face, vertex_face_step_bound, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER,
+    VERTEX_FACE_SLIVER,
 };
 pub use vertex_face_bounded::{bounded_height, vertex_face_bounded, VERTEX_FACE_KAPPA};
 pub use volume::{signed_volume, volume, volume_recovering, VOLUME_GATE};

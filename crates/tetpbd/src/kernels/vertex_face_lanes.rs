@@ -6,7 +6,9 @@
 
 use wide::f32x4;
 
-use crate::constraints::{VERTEX_FACE_KAPPA, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER};
+use crate::constraints::{
+    VERTEX_FACE_KAPPA, VERTEX_FACE_MAX_STEP, VERTEX_FACE_ORDER, VERTEX_FACE_SLIVER,
+};
 use crate::kernels::count::ProjectionCount;
 use crate::kernels::lane_types::Lane;
 use crate::kernels::lanes::{
@@ -53,9 +55,14 @@ pub(crate) fn vertex_faces<L: Lane, A: ParticleAccess>(
     } else {
         [L::ONE; 4]
     };
-    // The move bound, as in `constraints::vertex_face_step_bound`: a fraction of max_k |d_k|
-    // (`√(d²) = |d|` exactly in IEEE arithmetic).
-    let size = h.iter().fold(L::ZERO, |m, &d| m.vmax(d * d)).vsqrt();
+    // The move bound, as in `constraints::vertex_face_step_bound`: a multiple of max_k |d_k|,
+    // or of min_k |d_k| on a sliver (`√(d²) = |d|` exactly in IEEE arithmetic).
+    let largest = h.iter().fold(L::ZERO, |m, &d| m.vmax(d * d));
+    let smallest = h
+        .iter()
+        .fold(L::splat(f32::INFINITY), |m, &d| m.vgt(d * d).vsel(d * d, m));
+    let sliver = (largest * L::splat(VERTEX_FACE_SLIVER * VERTEX_FACE_SLIVER)).vgt(smallest);
+    let size = sliver.vsel(smallest, largest).vsqrt();
     let max_step = L::splat(VERTEX_FACE_MAX_STEP) * size;
     let w_max = w.iter().fold(L::ZERO, |m, &x| m.vmax(x));
     // All four pinned (w_max = 0): the limit is infinite (or NaN), no lane is over.
