@@ -9,12 +9,27 @@ mod common;
 use nalgebra::Vector3;
 use tetpbd::constraints::{bounded_step, vertex_face_step_bound, VERTEX_FACE_MAX_STEP};
 use tetpbd::generators::{box_grid, CellSplit};
-use tetpbd::{hecs, Particles, SoftBodyBuilder, Solver, SolverSettings};
+use tetpbd::{hecs, Particles, SoftBody, SoftBodyBuilder, Solver, SolverSettings};
 
 /// Peak kinetic energy allowed, as a multiple of the reference `M · 9.81 m/s² · L` (L the rest
 /// bounding-box diagonal; the stability matrix's reference). With the bound the peak is about
 /// 20; without it 7.9e15.
 const PEAK_KE_BOUND: f32 = 100.0;
+
+/// A plate of `dims` (m; one cell thick along y, `cells` along x and z) under the vertex–face
+/// family alone with compliance `alpha` (m/N), 1000 kg/m³, its x = −dims.x/2 edge pinned.
+fn pinned_plate(dims: Vector3<f32>, cells: [u32; 2], split: CellSplit, alpha: f32) -> SoftBody {
+    let mesh = box_grid(dims, [cells[0], 1, cells[1]], split).unwrap();
+    let pinned: Vec<u32> = (0..mesh.vertices.len() as u32)
+        .filter(|&i| mesh.vertices[i as usize].x < -0.499 * dims.x)
+        .collect();
+    SoftBodyBuilder::new(mesh)
+        .density(1000.0)
+        .pinned(pinned)
+        .vertex_face(alpha)
+        .build()
+        .unwrap()
+}
 
 /// Hard vertex–face alone on a 1 m × 1 mm × 1 m plate of one cell thickness (every
 /// tetrahedron a sliver of aspect about 1000), one edge pinned, 2 s under gravity at the
@@ -22,16 +37,7 @@ const PEAK_KE_BOUND: f32 = 100.0;
 /// bounded.
 #[test]
 fn hard_vertex_face_sliver_plate_stays_bounded() {
-    let mesh = box_grid(Vector3::new(1.0, 1e-3, 1.0), [3, 1, 3], CellSplit::Six).unwrap();
-    let pinned: Vec<u32> = (0..mesh.vertices.len() as u32)
-        .filter(|&i| mesh.vertices[i as usize].x < -0.49)
-        .collect();
-    let body = SoftBodyBuilder::new(mesh)
-        .density(1000.0)
-        .pinned(pinned)
-        .vertex_face(0.0)
-        .build()
-        .unwrap();
+    let body = pinned_plate(Vector3::new(1.0, 1e-3, 1.0), [3, 3], CellSplit::Six, 0.0);
     let (lo, hi) = body.particles.aabb();
     let reference = body.particles.total_mass() * 9.81 * (hi - lo).norm();
     let mut world = hecs::World::new();
@@ -90,16 +96,7 @@ fn plate_rise(
     (substeps, frames): (u32, u32),
 ) -> Result<f64, String> {
     let dims = Vector3::new(size, thickness, size);
-    let mesh = box_grid(dims, [cells[0], 1, cells[1]], split).unwrap();
-    let pinned: Vec<u32> = (0..mesh.vertices.len() as u32)
-        .filter(|&i| mesh.vertices[i as usize].x < -0.499 * size)
-        .collect();
-    let body = SoftBodyBuilder::new(mesh)
-        .density(1000.0)
-        .pinned(pinned)
-        .vertex_face(alpha)
-        .build()
-        .unwrap();
+    let body = pinned_plate(dims, cells, split, alpha);
     let reference = f64::from(body.particles.total_mass() * 9.81 * dims.norm());
     let mut world = hecs::World::new();
     let e = body.spawn(&mut world);
