@@ -16,6 +16,7 @@ mod coupled_robust;
 mod draws;
 pub mod energy;
 mod ground;
+pub mod random_scenes;
 mod report;
 mod run;
 pub mod settle;
