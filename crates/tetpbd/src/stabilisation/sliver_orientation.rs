@@ -122,28 +122,8 @@ pub(crate) fn project_slivers(world: &mut World, h: f32) {
             for _ in 0..SLIVER_SWEEPS {
                 let mut projected = false;
                 for &k in &tets.slivers {
-                    let k = k as usize;
-                    let (Some(&tet), Some(&rest)) = (tets.indices.get(k), tets.rest_volumes.get(k))
-                    else {
-                        continue;
-                    };
-                    let x = tet.map(|i| acc.x(i as usize));
-                    if crate::constraints::signed_volume(&x[0], &x[1], &x[2], &x[3]) * rest > 0.0 {
-                        continue;
-                    }
-                    projected = true;
-                    if let Some(v) = volume.as_deref_mut() {
-                        let at = v.compliance / h2;
-                        if let Some(l) = v.lambdas.get_mut(k) {
-                            scalar::volume(acc, tet, rest, l, at);
-                        }
-                    }
-                    if let Some(v) = vertex_face.as_deref_mut() {
-                        let at = v.compliance / h2;
-                        if let (Some(hs), Some(l)) = (v.rest_heights.get(k), v.lambdas.get_mut(k)) {
-                            scalar::vertex_face_held(acc, tet, hs, l, at, [true; 4]);
-                        }
-                    }
+                    let families = (volume.as_deref_mut(), vertex_face.as_deref_mut());
+                    projected |= project_if_inverted(acc, tets, k as usize, families, h2);
                 }
                 if !projected {
                     break;
@@ -151,4 +131,38 @@ pub(crate) fn project_slivers(world: &mut World, h: f32) {
             }
         });
     }
+}
+
+/// Projects the volume and vertex–face constraints (of the families given) of tetrahedron
+/// `k` once more if it is inverted, substep `h2` = h² (s²). Returns whether it was.
+fn project_if_inverted(
+    acc: &mut impl ParticleAccess,
+    tets: &Tetrahedra,
+    k: usize,
+    (volume, vertex_face): (
+        Option<&mut VolumeConstraints>,
+        Option<&mut VertexFaceConstraints>,
+    ),
+    h2: f32,
+) -> bool {
+    let (Some(&tet), Some(&rest)) = (tets.indices.get(k), tets.rest_volumes.get(k)) else {
+        return false;
+    };
+    let x = tet.map(|i| acc.x(i as usize));
+    if crate::constraints::signed_volume(&x[0], &x[1], &x[2], &x[3]) * rest > 0.0 {
+        return false;
+    }
+    if let Some(v) = volume {
+        let at = v.compliance / h2;
+        if let Some(l) = v.lambdas.get_mut(k) {
+            scalar::volume(acc, tet, rest, l, at);
+        }
+    }
+    if let Some(v) = vertex_face {
+        let at = v.compliance / h2;
+        if let (Some(hs), Some(l)) = (v.rest_heights.get(k), v.lambdas.get_mut(k)) {
+            scalar::vertex_face_held(acc, tet, hs, l, at, [true; 4]);
+        }
+    }
+    true
 }
