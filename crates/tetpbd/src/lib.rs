@@ -81,6 +81,7 @@ pub use body::pieces::{Piece, TearEvent};
 pub use body::placement::Placement;
 pub use body::plasticity::{Plasticity, PlasticitySettings, VOLUME_PRESERVING_TOLERANCE};
 pub use body::rest_families::unique_edges;
+pub use body::tear_relaxation::{TearRelaxation, RELAXATION_TIME};
 pub use body::tearing::{Pieces, Tearing, TearingSettings};
 pub use error::{
     BuildError, CutError, PlasticityError, SettingsError, StateError, StepError, TearingError,

@@ -202,3 +202,84 @@ fn a_frame_without_tearing_allocates_nothing() {
         assert!(force > 0.1, "the force was not read: {force} N");
     }
 }
+
+/// Counts the allocations of the substep loop (from the frame's start to its end, before
+/// the tearing pass).
+#[derive(Default)]
+struct SubstepAllocations {
+    start: u64,
+    inside: u64,
+}
+
+impl tetpbd::SubstepHook for SubstepAllocations {
+    fn begin_frame(&mut self, _: &mut hecs::World, _: tetpbd::FrameContext) {
+        self.start = allocations();
+    }
+    fn end_frame(&mut self, _: &mut hecs::World, _: tetpbd::FrameContext) {
+        self.inside += allocations() - self.start;
+    }
+    fn moves_particles(&self) -> bool {
+        false
+    }
+}
+
+/// A frame that tears allocates only in its tearing pass, and the frames after a split
+/// (the new pieces' first frames included) allocate nothing: bars of each family pulled
+/// apart until they fall into pieces.
+#[test]
+fn a_frame_that_tears_allocates_only_in_the_tearing_pass() {
+    for family in 0..3 {
+        let mut world = hecs::World::new();
+        let mesh = box_grid(Vector3::new(2.0, 0.3, 0.3), [8, 1, 1], CellSplit::Six).unwrap();
+        let ends: Vec<u32> = (0..mesh.vertices.len() as u32)
+            .filter(|&i| mesh.vertices[i as usize].x.abs() > 0.999)
+            .collect();
+        let b = SoftBodyBuilder::new(mesh)
+            .tearing(tetpbd::TearingSettings {
+                strain: Some(0.2),
+                smoothing_time: 0.02,
+                ..Default::default()
+            })
+            .pinned(ends);
+        let b = match family {
+            0 => b.material(tetpbd::Material::new(1e6, 0.3).unwrap()),
+            1 => b.edges(1e-6).vertex_face(1e-6),
+            _ => b.edges(0.0).volume(0.0),
+        };
+        b.build().unwrap().spawn(&mut world);
+        let mut solver = Solver::new(SolverSettings::default()).unwrap();
+        let mut hook = SubstepAllocations::default();
+        let (mut tearing_frames, mut quiet_after_split) = (0, 0);
+        for frame in 0..90 {
+            for p in world.query_mut::<&mut tetpbd::Particles>() {
+                for i in 0..p.len() {
+                    if p.is_pinned(i) {
+                        let dx = (2.0f32 / 60.0).copysign(p.rest_positions()[i].x);
+                        let x = p.positions()[i] + Vector3::new(dx, 0.0, 0.0);
+                        p.set_position(i, x).unwrap();
+                    }
+                }
+            }
+            let split = world.len() > 1;
+            let before = allocations();
+            let stats = solver.step_with(&mut world, &mut hook).unwrap();
+            let all = allocations() - before;
+            if frame == 0 {
+                hook.inside = 0;
+                continue;
+            }
+            if stats.faces_torn > 0 {
+                tearing_frames += 1;
+            } else if split {
+                quiet_after_split += 1;
+                assert_eq!(all, 0, "family {family}, frame {frame} after a split");
+            }
+        }
+        assert_eq!(hook.inside, 0, "family {family}: the substeps allocated");
+        assert!(tearing_frames > 0, "family {family}: nothing tore");
+        assert!(
+            quiet_after_split > 10 && world.len() > 1,
+            "family {family}: the bar never split ({quiet_after_split} frames after)"
+        );
+    }
+}

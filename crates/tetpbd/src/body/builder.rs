@@ -72,6 +72,9 @@ impl SoftBody {
         }
         if let Some(t) = self.tearing {
             b.add(t);
+            // Present from the start, so a split puts its pieces in the body's own archetype
+            // (a new archetype would grow the world's query caches in the next frame).
+            b.add(crate::TearRelaxation::default());
         }
         world.spawn(b.build())
     }

@@ -55,14 +55,28 @@ use nalgebra::Vector3;
 /// How long after a split a piece's mechanical energy is held to its value at the split, s.
 pub const RELAXATION_TIME: f32 = 0.25;
 
-/// A piece of a recent split (a hecs component): its kinetic plus elastic energy (J) and
-/// centre of mass (m) at the split, and how long the bound still holds (s).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct TearRelaxation {
+/// A piece of a recent split (a hecs component the tearing pass adds): its kinetic plus
+/// elastic energy (J) and centre of mass (m) at the split, and how long the bound still
+/// holds (s). It is part of the body's state: a snapshot taken within [`RELAXATION_TIME`] of
+/// a split must keep it for the restored body to continue exactly (with the `serde`
+/// feature it serialises like the other components).
+///
+/// A body built with tearing carries it from the start, inactive ([`Default`]: no time
+/// left), so that its pieces share the body's components.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct TearRelaxation {
     kinetic: f64,
     held: f64,
     centre: Vector3<f32>,
     time_left: f32,
+}
+
+impl TearRelaxation {
+    /// How long the bound still holds, s (0 once it has run out, or before any split).
+    pub fn time_left(&self) -> f32 {
+        self.time_left.max(0.0)
+    }
 }
 
 /// The families whose compliant constraints store energy.
