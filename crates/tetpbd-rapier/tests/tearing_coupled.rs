@@ -1,7 +1,9 @@
 //! A soft slab lying on the ground, its two ends attached to two rigid bodies that move
 //! apart, tears in two: the coupling keeps working as the body's particle and surface
 //! counts change (contacts, soft–soft structures, scene queries), each attachment follows
-//! the piece holding its particle, and the pieces stay finite and on the ground.
+//! the piece holding its particle, and the pieces stay finite and on the ground. A cube cut
+//! in two on the ground: its pieces rest against each other at the cut and, thrown together,
+//! do not pass through each other.
 
 mod coupling_common;
 
@@ -12,7 +14,7 @@ use rapier3d::math::Vector;
 use rapier3d::parry::query::Ray;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
 use tetpbd::generators::{box_grid, CellSplit};
-use tetpbd::{Blade, Particles, SoftBodyBuilder, TearingSettings};
+use tetpbd::{Blade, Particles, SoftBodyBuilder, Surface, TearingSettings};
 use tetpbd_rapier::{follow_pieces, Attachments, CoupledWorld, SoftCollider, SoftQueryFilter};
 
 const HALF: f32 = 0.5;
@@ -92,6 +94,23 @@ fn holders(s: &CoupledWorld, handle: RigidBodyHandle, tol: f32) -> (Vec<Entity>,
     (out, count, close)
 }
 
+/// The centroid of the highest upward-facing surface triangle of the newest soft body, m.
+fn newest_piece_top(s: &CoupledWorld) -> Vector3<f32> {
+    let mut q = s.soft.query::<(Entity, &Particles, &Surface)>();
+    let (_, p, surface) = q.iter().max_by_key(|(e, _, _)| *e).unwrap();
+    let x = p.positions();
+    surface
+        .triangles()
+        .iter()
+        .filter_map(|&[a, b, c]| {
+            let [a, b, c] = [a, b, c].map(|i| x[i as usize]);
+            let up = (b - a).cross(&(c - a)).y > 0.0;
+            up.then(|| (a + b + c) / 3.0)
+        })
+        .max_by(|u, v| u.y.total_cmp(&v.y))
+        .unwrap()
+}
+
 #[test]
 fn a_slab_pulled_apart_by_two_bodies_tears_and_each_piece_keeps_its_body() {
     for speed in [1.0f32, 5.0, 20.0] {
@@ -109,12 +128,22 @@ fn a_slab_pulled_apart_by_two_bodies_tears_and_each_piece_keeps_its_body() {
             }
             s.step().unwrap();
             events += s.coupling.tear_events().len();
-            // The scene queries rebuild what changed.
-            let (q, qp) = s.queries();
-            let _ = qp;
-            let ray = Ray::new(Vector::new(0.0, 1.0, 0.0), Vector::new(0.0, -1.0, 0.0));
-            q.cast_ray(&ray, 2.0, true, SoftQueryFilter::default())
+            // The scene queries rebuild what changed: a ray cast down onto the top triangle
+            // of the newest piece meets it (or something above it) a metre down.
+            let top = newest_piece_top(&s);
+            let (q, _) = s.queries();
+            let ray = Ray::new(
+                Vector::new(top.x, top.y + 1.0, top.z),
+                Vector::new(0.0, -1.0, 0.0),
+            );
+            let hit = q
+                .cast_ray(&ray, 2.0, true, SoftQueryFilter::default())
                 .unwrap();
+            let toi = hit.map_or(f32::INFINITY, |h| h.time_of_impact);
+            assert!(
+                toi <= 1.0 + 1e-3,
+                "speed {speed}, frame {frame}: the ray missed the piece's top ({toi})"
+            );
         }
         assert!(events > 0, "speed {speed}: the slab never tore");
         // Every attachment is still there, once, on the piece holding its particle, and no
@@ -181,4 +210,106 @@ fn a_cut_body_keeps_its_attachments_on_the_right_piece() {
     assert!(l_close && r_close);
     let colliders = s.soft.query::<&SoftCollider>().iter().count();
     assert_eq!(colliders, 2, "the new piece has no collider");
+}
+
+/// A cube resting on the ground cut in two: the pieces meet at the cut, face to face, and
+/// their soft–soft contacts hold them there without pushing them apart or through each
+/// other; thrown back against each other, they do not pass through.
+#[test]
+fn the_pieces_of_a_cut_cube_rest_against_each_other() {
+    for split in [CellSplit::Five, CellSplit::Six] {
+        let mut s = scene(10);
+        ground(&mut s);
+        let mesh = box_grid(Vector3::new(0.4, 0.4, 0.4), [4, 4, 4], split).unwrap();
+        let body = SoftBodyBuilder::new(mesh)
+            .edges(0.0)
+            .volume(0.0)
+            .translation(Vector3::new(0.0, 0.2, 0.0))
+            .build()
+            .unwrap();
+        let e = body.spawn(&mut s.soft);
+        s.soft.insert_one(e, SoftCollider::default()).unwrap();
+        for _ in 0..60 {
+            s.step().unwrap();
+        }
+        let blade = Blade::Plane {
+            point: Vector3::new(0.0, 0.0, 0.0),
+            normal: Vector3::x(),
+        };
+        let event = tetpbd::cut(&mut s.soft, e, &blade).unwrap().unwrap();
+        follow_pieces(&mut s.soft, &event);
+        assert_eq!(event.pieces.len(), 2);
+        let centre = |s: &CoupledWorld, e: Entity| {
+            let p = s.soft.get::<&Particles>(e).unwrap();
+            let m: f32 = p.masses().iter().sum();
+            p.positions()
+                .iter()
+                .zip(p.masses())
+                .fold(Vector3::zeros(), |c, (x, &w)| c + x * w)
+                / m
+        };
+        let pieces: Vec<Entity> = event.pieces.iter().map(|p| p.entity).collect();
+        let start: Vec<Vector3<f32>> = pieces.iter().map(|&e| centre(&s, e)).collect();
+        // A gap between the pieces: the left piece's largest x and the right one's smallest.
+        let gap = |s: &CoupledWorld| {
+            let xs: Vec<(f32, f32)> = pieces
+                .iter()
+                .map(|&e| {
+                    let p = s.soft.get::<&Particles>(e).unwrap();
+                    let lo = p
+                        .positions()
+                        .iter()
+                        .map(|x| x.x)
+                        .fold(f32::INFINITY, f32::min);
+                    let hi = p
+                        .positions()
+                        .iter()
+                        .map(|x| x.x)
+                        .fold(f32::NEG_INFINITY, f32::max);
+                    (lo, hi)
+                })
+                .collect();
+            let (left, right) = if xs[0].0 < xs[1].0 {
+                (xs[0], xs[1])
+            } else {
+                (xs[1], xs[0])
+            };
+            right.0 - left.1
+        };
+        for _ in 0..120 {
+            s.step().unwrap();
+        }
+        for (k, &e) in pieces.iter().enumerate() {
+            let moved = (centre(&s, e) - start[k]).norm();
+            let speed = s.soft.get::<&Particles>(e).unwrap().max_speed();
+            assert!(moved < 0.01, "{split:?}: piece {k} moved {moved} m");
+            assert!(speed < 0.05, "{split:?}: piece {k} still at {speed} m/s");
+        }
+        assert!(
+            gap(&s) > -0.01,
+            "{split:?}: the pieces overlap by {}",
+            -gap(&s)
+        );
+        // Thrown at each other at 3 m/s: they meet and stop, not through.
+        for &e in &pieces {
+            let mut p = s.soft.get::<&mut Particles>(e).unwrap();
+            let c = centre_x(&p);
+            for i in 0..p.len() {
+                p.set_velocity(i, Vector3::new(-3.0f32.copysign(c), 0.0, 0.0))
+                    .unwrap();
+            }
+        }
+        for _ in 0..60 {
+            s.step().unwrap();
+            assert!(
+                gap(&s) > -0.05,
+                "{split:?}: the thrown pieces passed through each other"
+            );
+        }
+    }
+}
+
+/// The mean x of a body's particles, m.
+fn centre_x(p: &Particles) -> f32 {
+    p.positions().iter().map(|x| x.x).sum::<f32>() / p.len() as f32
 }
