@@ -1,7 +1,8 @@
-//! The stability suite's bounds, asserted at default settings (the seed's families on every
-//! fast case; the material on the stiff and large-step cases). `docs/stability.md` shows the
-//! whole matrix, including the cells that still fail (slivers) and the vertex–face-alone
-//! shape cells.
+//! The stability suite's bounds, asserted at default settings: the seed's families on every
+//! fast case, the material on the stiff and large-step cases, and (long, in release) every
+//! cell of the uncoupled matrix — recovery and impact sweeps and the material's columns
+//! included — but the known limits listed here. `docs/stability.md` shows the whole matrix,
+//! the vertex–face-alone shape cells included.
 
 use tetpbd_stability::{
     all_cases, run_scene, verdict, CaseKind, Config, ConstraintSet, Outcome, Verdict,
@@ -52,38 +53,78 @@ fn every_fast_case_stays_finite_with_safety_net() {
 /// heights per tetrahedron) expands.
 const KNOWN_LIMITS: &[(&str, &str)] = &[("flattened", "vertex-face, soft")];
 
-fn known_limit(case: &tetpbd_stability::Case, config: &Config) -> bool {
+/// The cells of the whole matrix (every case, the recovery and impact sweeps included, and
+/// the material's columns) that fail at default settings, as [`KNOWN_LIMITS`]: the flattened
+/// soft vertex–face body at 20 substeps too, and soft tissue dragged by one vertex on the
+/// six-tetrahedra grid at 40 substeps, still ringing at 5 s (1.0 % off its volume; within
+/// 0.02 % at 7 s).
+const MATRIX_KNOWN_LIMITS: &[(&str, &str)] = &[
+    ("flattened", "vertex-face, soft"),
+    ("flattened, 6 tets/cell, 20 substeps", "vertex-face, soft"),
+    (
+        "one vertex dragged 100 cells, 6 tets/cell, 40 substeps",
+        "material, soft tissue",
+    ),
+];
+
+fn known_limit(known: &[(&str, &str)], case: &tetpbd_stability::Case, config: &Config) -> bool {
     let label = config.label();
-    KNOWN_LIMITS
+    known
         .iter()
         .any(|&(name, c)| case.name == name && (c == "*" || c == label))
 }
 
-/// Every cell of `cases` at default settings passes, but the vertex–face-alone shape cells
-/// (expected: four heights fix four of six shape degrees of freedom) and the known limits;
-/// a known limit that passes now is reported too (remove it from [`KNOWN_LIMITS`]).
-fn assert_pass_at_defaults(cases: Vec<tetpbd_stability::Case>) {
-    let mut failed = Vec::new();
-    for case in cases {
-        for config in Config::families() {
-            let o = run_scene(&case.scene, &config);
-            let fails = verdict(&config, &o) == Verdict::Fail;
-            if fails != known_limit(&case, &config) {
-                let what = if fails {
-                    "fails"
-                } else {
-                    "known limit passes now"
-                };
-                failed.push(format!("{what}: {}", describe(&case, &config, &o)));
-            }
-        }
-    }
+/// Every cell of `cases` under `configs` at default settings passes, but the
+/// vertex–face-alone shape cells (expected: four heights fix four of six shape degrees of
+/// freedom) and the `known` limits; a known limit that passes now is reported too (remove it
+/// from the list). One thread per configuration.
+fn assert_pass_at_defaults(
+    cases: Vec<tetpbd_stability::Case>,
+    configs: Vec<Config>,
+    known: &[(&str, &str)],
+) {
+    let cases = &cases;
+    let failed: Vec<String> = std::thread::scope(|scope| {
+        let runs: Vec<_> = configs
+            .into_iter()
+            .map(|config| {
+                scope.spawn(move || {
+                    let mut failed = Vec::new();
+                    for case in cases {
+                        let o = run_scene(&case.scene, &config);
+                        let fails = verdict(&config, &o) == Verdict::Fail;
+                        if fails != known_limit(known, case, &config) {
+                            let what = if fails {
+                                "fails"
+                            } else {
+                                "known limit passes now"
+                            };
+                            failed.push(format!("{what}: {}", describe(case, &config, &o)));
+                        }
+                    }
+                    failed
+                })
+            })
+            .collect();
+        runs.into_iter()
+            .flat_map(|r| r.join().expect("a run panicked"))
+            .collect()
+    });
     assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
 
 #[test]
 fn every_fast_cell_passes_at_defaults_but_known_limits() {
-    assert_pass_at_defaults(fast_cases(None));
+    assert_pass_at_defaults(fast_cases(None), Config::families(), KNOWN_LIMITS);
+}
+
+/// The whole uncoupled matrix without the net, as `docs/stability.md` shows it: every case,
+/// the recovery and impact sweeps at 1–80 substeps, the seed's six configurations and the
+/// material's two presets.
+#[test]
+#[ignore = "long: the whole uncoupled matrix, a few minutes in release (CI runs it)"]
+fn every_cell_of_the_matrix_passes_at_defaults_but_known_limits() {
+    assert_pass_at_defaults(all_cases(None), Config::all(), MATRIX_KNOWN_LIMITS);
 }
 
 /// The Neo-Hookean material (rubber and soft tissue), at default settings with substeps from
