@@ -1,6 +1,7 @@
 //! The Neo-Hookean material against its analytic response: a body at rest stays there, a
 //! bar under uniform tension stretches as the Neo-Hookean law says and contracts laterally by
-//! Poisson's ratio, and homogeneous stretch and shear are reproduced inside a patch.
+//! Poisson's ratio, a cube under shear tractions shears as the law says, and homogeneous
+//! stretch and shear are reproduced inside a patch.
 
 mod common;
 
@@ -224,6 +225,123 @@ fn bar_in_small_tension_contracts_laterally_by_poisson_ratio() {
         assert!(
             (measured - f64::from(poisson)).abs() < 0.05 * f64::from(poisson),
             "ν {poisson}: measured {measured}"
+        );
+    }
+}
+
+/// The first Piola–Kirchhoff stress (Pa) of the material at `f`:
+/// `P = μ F + λ' (det F − γ) cof F`, `λ' = λ + μ`, `γ = 1 + μ/λ'`.
+fn piola(material: &Material, f: &nalgebra::Matrix3<f64>) -> nalgebra::Matrix3<f64> {
+    let (mu, lambda) = material.lame();
+    let (mu, lp) = (f64::from(mu), f64::from(lambda) + f64::from(mu));
+    let j = f.determinant();
+    let cof = j * f.try_inverse().unwrap().transpose();
+    f * mu + cof * (lp * (j - (1.0 + mu / lp)))
+}
+
+/// A cube held by its mid-plane `y = 0` (which simple shear along x leaves in place) and
+/// loaded on its faces by the tractions `P N` of simple shear `F = I + g eₓ e_yᵀ` (consistent
+/// nodal forces of each face triangle): it settles on that shear, so the stress at the
+/// measured deformation (its least-squares fit over every particle) is the traction applied,
+/// as the Neo-Hookean law says, within 1 %.
+#[test]
+fn cube_under_shear_tractions_shears_as_neo_hookean() {
+    let mut rng = Rng::new(272);
+    for _ in 0..3 {
+        let material =
+            Material::new(rng.range(2e4, 2e5) as f32, rng.range(0.0, 0.45) as f32).unwrap();
+        let g = rng.range(0.05, 0.25);
+        let mut target = nalgebra::Matrix3::<f64>::identity();
+        target[(0, 1)] = g;
+        let traction = piola(&material, &target);
+        let mesh = box_grid(Vector3::new(0.4, 0.4, 0.4), [4, 4, 4], CellSplit::Six).unwrap();
+        let mid: Vec<u32> = (0..mesh.vertices.len() as u32)
+            .filter(|&i| mesh.vertices[i as usize].y.abs() < 1e-4)
+            .collect();
+        let mut world = World::new();
+        let e = spawn(
+            &mut world,
+            SoftBodyBuilder::new(mesh)
+                .density(1000.0)
+                .material(material)
+                .pinned(mid),
+            20.0,
+        );
+        {
+            let p = world.get::<&Particles>(e).unwrap();
+            let surface = world.get::<&Surface>(e).unwrap();
+            let tets = world.get::<&Tetrahedra>(e).unwrap();
+            let mut forces = UserForces::new(&p);
+            for tri in surface.triangles() {
+                let x = tri.map(|i| p.positions()[i as usize]);
+                let n = (x[1] - x[0]).cross(&(x[2] - x[0]));
+                let area = 0.5 * n.norm();
+                let f = (traction * n.normalize().cast::<f64>() * f64::from(area) / 3.0).cast();
+                for v in &x {
+                    // A corner on the held mid-plane passes its share to the hold.
+                    match forces.add_force_at_point(&p, &tets, f, *v) {
+                        Ok(_) | Err(tetpbd::StateError::AllPinned) => {}
+                        Err(e) => panic!("{e}"),
+                    }
+                }
+            }
+            drop((p, surface, tets));
+            world.insert_one(e, forces).unwrap();
+        }
+        let substeps = 2 * substeps_for(&world, e, 20);
+        let mut solver = Solver::new(SolverSettings {
+            substeps,
+            ..no_gravity()
+        })
+        .unwrap();
+        // The least-squares deformation gradient of every particle about the centre.
+        let fit = |p: &Particles| {
+            let n = p.len() as f64;
+            let c = p
+                .positions()
+                .iter()
+                .map(|x| x.cast::<f64>())
+                .sum::<Vector3<f64>>()
+                / n;
+            let c0 = p
+                .rest_positions()
+                .iter()
+                .map(|x| x.cast::<f64>())
+                .sum::<Vector3<f64>>()
+                / n;
+            let (mut a, mut b) = (nalgebra::Matrix3::zeros(), nalgebra::Matrix3::zeros());
+            for (x, r) in p.positions().iter().zip(p.rest_positions()) {
+                let (x, r) = (x.cast::<f64>() - c, r.cast::<f64>() - c0);
+                a += x * r.transpose();
+                b += r * r.transpose();
+            }
+            a * b.try_inverse().unwrap()
+        };
+        let mut last = nalgebra::Matrix3::zeros();
+        for frame in 0..900 {
+            solver.step(&mut world).unwrap();
+            if frame % 60 == 59 {
+                let now = fit(&world.get::<&Particles>(e).unwrap());
+                if (now - last).norm() < 1e-7 {
+                    break;
+                }
+                last = now;
+            }
+        }
+        let measured = fit(&world.get::<&Particles>(e).unwrap());
+        let stress = piola(&material, &measured);
+        let err = (stress - traction).norm() / traction.norm();
+        let off = (measured - target).norm() / g;
+        eprintln!(
+            "E {:.0} Pa, ν {:.3}, shear {g:.3}: stress at the measured F off the traction by {:.3} %, F off by {:.3} % of the shear",
+            material.young_modulus(),
+            material.poisson_ratio(),
+            100.0 * err,
+            100.0 * off
+        );
+        assert!(
+            err < 0.01,
+            "stress {stress} at the measured {measured}, traction {traction}"
         );
     }
 }
