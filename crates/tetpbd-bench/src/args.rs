@@ -31,6 +31,9 @@ pub enum FamilySet {
     EdgesVolume,
     /// Vertex–face alone.
     VertexFace,
+    /// The Neo-Hookean material alone (`Material::SOFT_TISSUE`; measured at the benchmark's
+    /// substeps whether or not they are stable for it: a cost, not a motion).
+    Material,
 }
 
 impl FamilySet {
@@ -39,15 +42,17 @@ impl FamilySet {
         match self {
             FamilySet::EdgesVolume => "edges+volume",
             FamilySet::VertexFace => "vertex-face",
+            FamilySet::Material => "material",
         }
     }
 
     /// `b` with this set's families at the cost benchmarks' compliances: edges 1e-6 m/N +
-    /// volume 1e-9 m⁵/N, or vertex–face 1e-6 m/N.
+    /// volume 1e-9 m⁵/N, vertex–face 1e-6 m/N, or the soft-tissue material.
     pub fn add_to(self, b: tetpbd::SoftBodyBuilder) -> tetpbd::SoftBodyBuilder {
         match self {
             FamilySet::EdgesVolume => b.edges(1e-6).volume(1e-9),
             FamilySet::VertexFace => b.vertex_face(1e-6),
+            FamilySet::Material => b.material(tetpbd::Material::SOFT_TISSUE),
         }
     }
 }

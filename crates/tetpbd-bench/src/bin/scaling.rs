@@ -1,8 +1,9 @@
 //! ms per frame for bodies of about 1k, 10k, 100k and 1M tetrahedra (10 substeps of a
-//! 1/60 s frame), for edges + volume and for vertex–face, on 1 and 2 threads.
+//! 1/60 s frame), for edges + volume, for vertex–face and for the Neo-Hookean material (soft
+//! tissue), on 1 and 2 threads.
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face --sequential --shuffle --spatial-order on|off|both --breakdown --per-frame --no-energy-limit --keep-helpers-awake --move-helpers-off --given-pool]
+//! cargo run --release -p tetpbd-bench --features parallel --bin scaling [-- --min-cells N --max-cells N --frames F --parts P --set edges+volume|vertex-face|material --sequential --shuffle --spatial-order on|off|both --breakdown --per-frame --no-energy-limit --keep-helpers-awake --move-helpers-off --given-pool]
 //! ```
 //!
 //! `--keep-helpers-awake` and `--move-helpers-off` turn on
@@ -28,7 +29,7 @@
 //! (one more frame with [`tetpbd::DiagnosticSettings::measure_error`]): how well the sweep
 //! order converges, e.g. to compare `--parts 1` with a partitioned order.
 //!
-//! `--set` measures one family set only (default both).
+//! `--set` measures one family set only (default all three).
 //!
 //! `--no-energy-limit` turns [`tetpbd::SafetySettings::limit_correction_energy`] off (to
 //! measure its cost).
@@ -82,7 +83,7 @@ struct Args {
     /// Slabs of the sweep order (`SoftBodyBuilder::parts`; 0: the builder's choice).
     #[arg(long, default_value_t = 0)]
     parts: usize,
-    /// One family set only (default both).
+    /// One family set only (default all three).
     #[arg(long, value_enum)]
     set: Option<FamilySet>,
     /// All 1-thread frames first, then all 2-thread ones (instead of interleaved).
@@ -157,10 +158,10 @@ fn body(
         .spatial_order(spatial)
         .parts(parts)
         .pinned(top);
-    let b = if set == FamilySet::EdgesVolume {
-        b.edges(1e-7).volume(1e-10)
-    } else {
-        b.vertex_face(1e-7)
+    let b = match set {
+        FamilySet::EdgesVolume => b.edges(1e-7).volume(1e-10),
+        FamilySet::VertexFace => b.vertex_face(1e-7),
+        FamilySet::Material => set.add_to(b),
     };
     let built = b.build()?;
     let sweep_phases = (
@@ -389,10 +390,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if shuffle {
             mesh = shuffled(&mesh, 1).0;
         }
-        for (set, spatial) in [FamilySet::EdgesVolume, FamilySet::VertexFace]
-            .into_iter()
-            .filter(|s| only.is_none_or(|o| o == *s))
-            .flat_map(|s| orders(a.spatial_order).into_iter().map(move |o| (s, o)))
+        for (set, spatial) in [
+            FamilySet::EdgesVolume,
+            FamilySet::VertexFace,
+            FamilySet::Material,
+        ]
+        .into_iter()
+        .filter(|s| only.is_none_or(|o| o == *s))
+        .flat_map(|s| orders(a.spatial_order).into_iter().map(move |o| (s, o)))
         {
             let mut one = body(&mesh, set, spatial, parts)?;
             let mut two = if parallel {

@@ -6,7 +6,7 @@
 //! over ([`tetpbd::StepStats::spin_time`]).
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --bin spin_cost [-- --frames F --set edges+volume|vertex-face]
+//! cargo run --release -p tetpbd-bench --bin spin_cost [-- --frames F --set edges+volume|vertex-face|material]
 //! ```
 
 use clap::Parser;

@@ -7,7 +7,7 @@
 //! the recovery moved the body (0: it found it untangled, as it should).
 //!
 //! ```text
-//! cargo run --release -p tetpbd-bench --bin untangle_cost [-- --frames F --set edges+volume|vertex-face]
+//! cargo run --release -p tetpbd-bench --bin untangle_cost [-- --frames F --set edges+volume|vertex-face|material]
 //! ```
 
 use clap::Parser;
