@@ -468,3 +468,78 @@ fn jointed_bodies_step_without_allocating() {
     assert!(written > 0, "the jointed bodies get the soft reaction");
     check("jointed", &tally, frames as u64);
 }
+
+/// A slab on the ground torn apart by two kinematic boxes holding its ends, then left to
+/// settle: once the pieces have had their first frames, the coupled step allocates nothing of
+/// ours. (A frame that tears allocates — the split, the attachments following the pieces —
+/// and so does the pieces' first frame, in which the coupling builds their contact caches
+/// (soft–soft bounding volumes, corner and candidate buffers grown for the new bodies) as for
+/// any body spawned into the scene; while the fragments fly, a buffer may still grow to a new
+/// largest contact count.)
+#[test]
+fn a_torn_coupled_slab_settles_without_allocating() {
+    let mut scene = scene();
+    let mesh = generators::box_grid(Vector3::new(1.0, 0.1, 0.4), [10, 1, 4], CellSplit::Six)
+        .expect("mesh");
+    let body = SoftBodyBuilder::new(mesh)
+        .edges(1e-6)
+        .volume(1e-8)
+        .tearing(tetpbd::TearingSettings {
+            strain: Some(0.3),
+            ..Default::default()
+        })
+        .translation(Vector3::new(0.0, 0.06, 0.0))
+        .build()
+        .expect("body");
+    let mut att = tetpbd_rapier::Attachments::new();
+    let mut boxes = Vec::new();
+    for side in [-1.0f32, 1.0] {
+        let (h, _) = scene.physics.insert(
+            RigidBodyBuilder::kinematic_velocity_based()
+                .translation(Vector::new(side * 0.55, 0.3, 0.0))
+                .linvel(Vector::new(side * 2.0, 0.0, 0.0)),
+            ColliderBuilder::cuboid(0.05, 0.05, 0.05),
+        );
+        boxes.push(h);
+        for i in 0..body.particles.len() {
+            if (body.particles.positions()[i].x - side * 0.5).abs() < 1e-4 {
+                att.attach_to_body(&body.particles, i as u32, &scene.physics.bodies, h, 0.0)
+                    .expect("attachment");
+            }
+        }
+    }
+    let e = body.spawn(&mut scene.soft);
+    scene
+        .soft
+        .insert(
+            e,
+            (
+                att,
+                tetpbd_rapier::SoftCollider::default(),
+                tetpbd::Activation::never_sleeps(),
+            ),
+        )
+        .expect("entity");
+    for _ in 0..3 {
+        scene.step().expect("step");
+    }
+    let mut tearing = 0;
+    for frame in 0..60 {
+        if frame == 30 {
+            for &h in &boxes {
+                scene.physics.bodies[h].set_linvel(Vector::ZERO, true);
+            }
+        }
+        scene.step().expect("step");
+        tearing += scene.coupling.tear_events().len();
+    }
+    assert!(tearing > 0, "the slab never tore");
+    assert!(scene.soft.len() > 1, "the slab never split");
+    let mut torn = 0;
+    let tally = counted(60, || {
+        scene.step().expect("step");
+        torn += scene.coupling.tear_events().len();
+    });
+    assert_eq!(torn, 0, "it tore again while settling");
+    check("the torn slab settling", &tally, 60);
+}
