@@ -1,8 +1,11 @@
 //! A step allocates nothing once the scene has run its first frame.
 
+mod common;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
+use common::tearing::{pinned_bar, pull_ends};
 use nalgebra::Vector3;
 use tetpbd::generators::{ball, box_grid, CellSplit};
 use tetpbd::{SoftBodyBuilder, Solver, SolverSettings};
@@ -230,36 +233,22 @@ impl tetpbd::SubstepHook for SubstepAllocations {
 fn a_frame_that_tears_allocates_only_in_the_tearing_pass() {
     for family in 0..3 {
         let mut world = hecs::World::new();
-        let mesh = box_grid(Vector3::new(2.0, 0.3, 0.3), [8, 1, 1], CellSplit::Six).unwrap();
-        let ends: Vec<u32> = (0..mesh.vertices.len() as u32)
-            .filter(|&i| mesh.vertices[i as usize].x.abs() > 0.999)
-            .collect();
-        let b = SoftBodyBuilder::new(mesh)
-            .tearing(tetpbd::TearingSettings {
-                strain: Some(0.2),
-                smoothing_time: 0.02,
-                ..Default::default()
-            })
-            .pinned(ends);
-        let b = match family {
+        let settings = tetpbd::TearingSettings {
+            strain: Some(0.2),
+            smoothing_time: 0.02,
+            ..Default::default()
+        };
+        let size = Vector3::new(2.0, 0.3, 0.3);
+        pinned_bar(&mut world, size, [8, 1, 1], settings, |b| match family {
             0 => b.material(tetpbd::Material::new(1e6, 0.3).unwrap()),
             1 => b.edges(1e-6).vertex_face(1e-6),
             _ => b.edges(0.0).volume(0.0),
-        };
-        b.build().unwrap().spawn(&mut world);
+        });
         let mut solver = Solver::new(SolverSettings::default()).unwrap();
         let mut hook = SubstepAllocations::default();
         let (mut tearing_frames, mut quiet_after_split) = (0, 0);
         for frame in 0..90 {
-            for p in world.query_mut::<&mut tetpbd::Particles>() {
-                for i in 0..p.len() {
-                    if p.is_pinned(i) {
-                        let dx = (2.0f32 / 60.0).copysign(p.rest_positions()[i].x);
-                        let x = p.positions()[i] + Vector3::new(dx, 0.0, 0.0);
-                        p.set_position(i, x).unwrap();
-                    }
-                }
-            }
+            pull_ends(&mut world, 2.0 / 60.0);
             let split = world.len() > 1;
             let before = allocations();
             let stats = solver.step_with(&mut world, &mut hook).unwrap();

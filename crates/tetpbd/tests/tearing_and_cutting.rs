@@ -3,6 +3,9 @@
 //! finite, massive, upright at rest and gain no energy; a cut splits a cube into two pieces
 //! with the right particle counts; the events list the pieces; everything repeats exactly.
 
+mod common;
+
+use common::tearing::{pinned_bar, pull_ends};
 use hecs::{Entity, World};
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
@@ -13,46 +16,12 @@ use tetpbd::{
 
 const LENGTH: f32 = 2.0;
 
-/// A bar along x with its end cross-sections pinned, tearing at `strain`.
+/// A bar along x with its end cross-sections pinned, tearing by `settings`.
 fn spawn_bar(world: &mut World, settings: TearingSettings, cells: u32) -> Entity {
-    let mesh = box_grid(
-        Vector3::new(LENGTH, 0.4, 0.4),
-        [cells, 2, 2],
-        CellSplit::Six,
-    )
-    .unwrap();
-    let ends = mesh
-        .vertices
-        .iter()
-        .enumerate()
-        .filter(|(_, v)| (v.x.abs() - LENGTH / 2.0).abs() < 1e-4)
-        .map(|(i, _)| i as u32)
-        .collect::<Vec<_>>();
-    SoftBodyBuilder::new(mesh)
-        .edges(1e-6)
-        .volume(1e-8)
-        .tearing(settings)
-        .pinned(ends)
-        .build()
-        .unwrap()
-        .spawn(world)
-}
-
-/// Moves every pinned particle of every body along x, away from the middle, by `dx` (m).
-fn pull_ends(world: &mut World, dx: f32) {
-    for p in world.query_mut::<&mut Particles>() {
-        for i in 0..p.len() {
-            if p.is_pinned(i) {
-                let x = p.positions()[i];
-                let step = if p.rest_positions()[i].x > 0.0 {
-                    dx
-                } else {
-                    -dx
-                };
-                p.set_position(i, x + Vector3::new(step, 0.0, 0.0)).unwrap();
-            }
-        }
-    }
+    let size = Vector3::new(LENGTH, 0.4, 0.4);
+    pinned_bar(world, size, [cells, 2, 2], settings, |b| {
+        b.edges(1e-6).volume(1e-8)
+    })
 }
 
 fn solver() -> Solver {

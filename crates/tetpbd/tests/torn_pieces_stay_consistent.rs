@@ -8,13 +8,13 @@ mod common;
 use std::collections::BTreeMap;
 
 use common::plastic::{solver, spawn_bar, Bar, Families};
+use common::tearing::{pinned_bar, pull_ends};
 use hecs::{Entity, World};
 use nalgebra::{Matrix3, Vector3};
-use tetpbd::generators::{box_grid, CellSplit};
 use tetpbd::{
     cut, unique_edges, Blade, ColourClasses, EdgeConstraints, Material, Particles, Plasticity,
-    PlasticitySettings, SoftBodyBuilder, Solver, SolverSettings, Surface, TearingSettings,
-    Tetrahedra, VertexFaceConstraints, VolumeConstraints,
+    PlasticitySettings, Solver, SolverSettings, Surface, TearingSettings, Tetrahedra,
+    VertexFaceConstraints, VolumeConstraints,
 };
 
 /// No two items of an independent class share a particle.
@@ -105,35 +105,21 @@ fn assert_consistent(world: &World, e: Entity) {
 fn torn_pieces_keep_consistent_meshes_and_families() {
     for family in 0..3 {
         let mut world = World::new();
-        let mesh = box_grid(Vector3::new(2.0, 0.4, 0.4), [8, 2, 2], CellSplit::Six).unwrap();
-        let ends: Vec<u32> = (0..mesh.vertices.len() as u32)
-            .filter(|&i| mesh.vertices[i as usize].x.abs() > 0.999)
-            .collect();
-        let b = SoftBodyBuilder::new(mesh)
-            .tearing(TearingSettings {
-                strain: Some(0.15),
-                smoothing_time: 0.02,
-                ..Default::default()
-            })
-            .pinned(ends);
-        let b = match family {
+        let settings = TearingSettings {
+            strain: Some(0.15),
+            smoothing_time: 0.02,
+            ..Default::default()
+        };
+        let size = Vector3::new(2.0, 0.4, 0.4);
+        pinned_bar(&mut world, size, [8, 2, 2], settings, |b| match family {
             0 => b.material(Material::new(1e6, 0.3).unwrap()),
             1 => b.edges(1e-6).vertex_face(1e-6),
             _ => b.edges(0.0).volume(0.0),
-        };
-        b.build().unwrap().spawn(&mut world);
+        });
         let mut solver = Solver::new(SolverSettings::default()).unwrap();
         let mut tears = 0;
         for _ in 0..90 {
-            for p in world.query_mut::<&mut Particles>() {
-                for i in 0..p.len() {
-                    if p.is_pinned(i) {
-                        let dx = (2.0f32 / 60.0).copysign(p.rest_positions()[i].x);
-                        let x = p.positions()[i] + Vector3::new(dx, 0.0, 0.0);
-                        p.set_position(i, x).unwrap();
-                    }
-                }
-            }
+            pull_ends(&mut world, 2.0 / 60.0);
             solver.step(&mut world).unwrap();
             if !solver.tear_events().is_empty() {
                 tears += 1;

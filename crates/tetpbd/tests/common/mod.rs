@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod plastic;
+pub mod tearing;
 
 use nalgebra::Vector3;
 use tetpbd::generators::{box_grid, CellSplit};
