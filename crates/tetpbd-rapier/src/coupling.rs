@@ -164,6 +164,9 @@ pub struct Coupling {
     frame: Frame,
     reports: Vec<ContactReport>,
     soft_contacts: SoftContacts,
+    /// Scratch: the attached particles of the soft bodies (sorted `(body, particle)`), which
+    /// untangling keeps in place.
+    held: Vec<(hecs::Entity, u32)>,
 }
 
 impl Coupling {
@@ -177,6 +180,7 @@ impl Coupling {
             frame: Frame::default(),
             reports: Vec::new(),
             soft_contacts: SoftContacts::new(SoftContactSettings::default())?,
+            held: Vec::new(),
         })
     }
 
@@ -312,7 +316,19 @@ impl Coupling {
             for event in self.solver.tear_events() {
                 crate::pieces::follow_pieces(world, event);
             }
-            out?
+            let mut out = out?;
+            // The step leaves bodies touched by a hook's contacts tangled; here they are
+            // untangled with the ground below them in mind (`tetpbd::Untangle`), their
+            // attached particles kept in place.
+            self.held.clear();
+            for (e, a) in world.query_mut::<(hecs::Entity, &crate::Attachments)>() {
+                self.held
+                    .extend(a.items().iter().map(|item| (e, item.particle)));
+            }
+            self.held.sort_unstable();
+            out.bodies_untangled +=
+                tetpbd::systems::untangle_touched_bodies(world, dt, gravity, &self.held);
+            out
         };
         let mut stats = std::mem::take(&mut self.frame.stats);
         self.write_back(world, (ctx.bodies, ctx.multibody_joints), &mut stats);

@@ -94,21 +94,23 @@ fn holders(s: &CoupledWorld, handle: RigidBodyHandle, tol: f32) -> (Vec<Entity>,
     (out, count, close)
 }
 
-/// The centroid of the highest upward-facing surface triangle of the newest soft body, m.
+/// The centroid of the newest soft body's most upward-facing surface triangle (the largest
+/// upward component of its unit normal: a ray straight down meets it square, not grazing), m.
 fn newest_piece_top(s: &CoupledWorld) -> Vector3<f32> {
     let mut q = s.soft.query::<(Entity, &Particles, &Surface)>();
     let (_, p, surface) = q.iter().max_by_key(|(e, _, _)| *e).unwrap();
     let x = p.positions();
-    surface
+    let (_, centroid) = surface
         .triangles()
         .iter()
-        .filter_map(|&[a, b, c]| {
+        .map(|&[a, b, c]| {
             let [a, b, c] = [a, b, c].map(|i| x[i as usize]);
-            let up = (b - a).cross(&(c - a)).y > 0.0;
-            up.then(|| (a + b + c) / 3.0)
+            let up = (b - a).cross(&(c - a)).normalize().y;
+            (up, (a + b + c) / 3.0)
         })
-        .max_by(|u, v| u.y.total_cmp(&v.y))
-        .unwrap()
+        .max_by(|u, v| u.0.total_cmp(&v.0))
+        .unwrap();
+    centroid
 }
 
 #[test]

@@ -18,15 +18,10 @@ use tetpbd_stability::{pull_apart_in, Config, ConstraintSet, PullFigures, PULL_S
 const KNOWN_FAST: &[(&str, f32)] = &[("vertex-face, α=0", 5.0), ("vertex-face, α=0", 20.0)];
 
 /// Tetrahedra left inverted at the end, at the scene's substeps: (configuration, pull
-/// speed). Compliant edges and volumes hold an inverted fragment inverted (3 tetrahedra at
-/// 20 m/s).
-const KNOWN_INVERTED: &[(&str, f32)] = &[
-    ("stiff", 1.0),
-    ("stiff", 5.0),
-    ("stiff", 20.0),
-    ("edges+volume, soft", 5.0),
-    ("edges+volume, soft", 20.0),
-];
+/// speed). The scene's own compliant families hold an inverted fragment inverted where the
+/// coupling's untangling does not reach it (a fragment still moving, or one whose lift the
+/// released energy does not pay for).
+const KNOWN_INVERTED: &[(&str, f32)] = &[("stiff", 1.0), ("stiff", 5.0), ("stiff", 20.0)];
 
 /// Every configuration: the scene's own families (`stiff`) and the suite's six.
 fn configurations() -> Vec<(String, Option<Config>)> {
@@ -118,10 +113,7 @@ const KNOWN_FAST_AT: &[(u32, &str, f32)] = &[
 
 /// [`KNOWN_INVERTED`] at other substeps: (substeps, configuration, pull speed in m/s).
 const KNOWN_INVERTED_AT: &[(u32, &str, f32)] = &[
-    (5, "stiff", 1.0),
-    (5, "stiff", 5.0),
     (5, "stiff", 20.0),
-    (5, "edges+volume, soft", 20.0),
     (20, "stiff", 1.0),
     (20, "stiff", 5.0),
     (20, "stiff", 20.0),

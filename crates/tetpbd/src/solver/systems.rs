@@ -34,6 +34,25 @@ use crate::solver::stats::{ErrorAccumulator, ErrorStats};
 pub use crate::solver::tearing_pass::tear_faces;
 pub use crate::stabilisation::deformation_damping::damp_deformation;
 
+/// Untangles the bodies a hook's contacts may touch ([`crate::Untangle`]; its module docs,
+/// "Bodies a hook touches"): the step leaves them alone when its hook moves particles
+/// ([`crate::SubstepHook::moves_particles`]), so an integrator with such a hook calls this
+/// once per frame after the step, with the frame's length `dt` (s) and gravity (m/s²). A
+/// calm body with an inverted tetrahedron is moved towards its rest shape's best fit,
+/// lifted against gravity so that nothing of it ends lower than its lowest particle now, and
+/// only as far as the elastic energy released pays for the lift. `held` (sorted) lists the
+/// `(body, particle)` pairs the hook holds at points of its own (attachments): a held body's
+/// goal is fitted to them, and a move that would carry one off is not made. Returns the
+/// bodies moved.
+pub fn untangle_touched_bodies(
+    world: &mut World,
+    dt: f32,
+    gravity: Vector3<f32>,
+    held: &[(hecs::Entity, u32)],
+) -> usize {
+    crate::stabilisation::untangle::untangle_touched_bodies(world, dt, gravity, held)
+}
+
 /// Saves `x` as the substep start, applies gravity plus each body's
 /// [`ExternalAcceleration`] and [`crate::UserForces`] ([`integrate_user_forces`]) and the
 /// linear damping `v ← v · max(0, 1 − damping·h)` to free

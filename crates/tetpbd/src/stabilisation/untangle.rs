@@ -53,6 +53,28 @@
 //! energy the slab's weight does not explain), not with a pinned particle, a
 //! [`crate::Grab`], [`crate::UserForces`], [`crate::Plasticity`] (its rest shape flows) or
 //! [`crate::Tearing`] (torn pieces have no common rest shape); not asleep.
+//!
+//! # Bodies a hook touches
+//!
+//! A coupled body lies on the ground, on rigid bodies, on other soft bodies: loads the core
+//! does not see. [`crate::systems::untangle_touched_bodies`], run by the integrator after the
+//! step, treats such bodies with two changes to the rule above:
+//!
+//! * only an **inverted tetrahedron** makes a calm body tangled (stored energy proves nothing
+//!   when the loads are unknown: a soft slab under a heavy box stores what its own weight does
+//!   not explain);
+//! * the goal is **lifted** along `−(g + a)` until no particle of it is lower than the body's
+//!   lowest particle now, since what holds the body up lies below that point (a goal that
+//!   reaches into the ground would be pushed out again by the contacts). The lift's work
+//!   against the load,
+//!   `M |g + a| s` for a lift `s`, is charged to the move: `U(x') + β M |g + a| s ≤ U(x)`;
+//!   where not even the goal pays for it the body stays as it is.
+//!
+//! Particles a hook holds at points the core does not see (a coupling's attachments) stay
+//! where they are held: the goal is fitted to them (each weighted 10⁶ times its mass), and a
+//! move that would carry one off by more than 10⁻³ of the body's size is not made. A
+//! [`crate::Tearing`] body whose pieces stay one entity ([`crate::Pieces::KeepOne`]) is left
+//! alone (no one rest shape); a torn body's pieces split into entities each have theirs.
 
 use hecs::World;
 use nalgebra::{Matrix3, Vector3};
@@ -72,6 +94,10 @@ const KINETIC_FRACTION: f64 = 0.1;
 /// The smallest distance from the goal, as a fraction of the rest bounding-box diagonal, at
 /// which stored energy counts as a tangle.
 const DISTANCE_FLOOR: f32 = 1e-3;
+/// How much more than its mass a held particle weighs in the fit of a held body's goal.
+const HELD_WEIGHT: f64 = 1e6;
+/// How far a move may carry a held particle, as a fraction of the rest bounding-box diagonal.
+const HELD_TOLERANCE: f32 = 1e-3;
 
 /// A body's tangle recovery (a hecs component, spawned with every body by
 /// [`crate::SoftBody::spawn`]; a body without it is never untangled). Rule in the module
@@ -165,21 +191,115 @@ pub(crate) fn untangle_bodies(world: &mut World, dt: f32, gravity: Vector3<f32>)
             &mut Untangle,
             Option<&mut Activation>,
             Option<&ExternalAcceleration>,
-            (
-                Option<&EdgeConstraints>,
-                Option<&VolumeConstraints>,
-                Option<&VertexFaceConstraints>,
-                Option<&NeoHookeanMaterial>,
-            ),
+            Families,
         )>()
         .without::<&Asleep>()
         .without::<&crate::Grab>()
         .without::<&crate::UserForces>()
         .without::<&crate::Plasticity>()
         .without::<&crate::Tearing>();
-    for (p, t, u, act, accel, (edges, volume, vertex_face, material)) in query {
-        if u.disabled || p.inv_masses.iter().any(|&w| w <= 0.0) {
+    for (p, t, u, act, accel, families) in query {
+        let body = Body {
+            p,
+            t,
+            u,
+            act,
+            accel,
+            families,
+        };
+        moved += usize::from(body.untangle(dt, gravity, Reach::Free));
+    }
+    moved
+}
+
+/// Moves every tangled body a hook's contacts may touch towards its goal, lifted so that no
+/// particle ends lower (along `gravity`) than the body's lowest one now (module docs, "Bodies
+/// a hook touches"), at the end of a frame of length `dt` (s) under `gravity` (m/s²). `held`
+/// (sorted) lists the `(body, particle)` pairs a hook holds at points the core does not see
+/// (a coupling's attachments): the goal is fitted to them, and a move that would carry one of
+/// them off its place is not made. Returns the bodies moved.
+pub(crate) fn untangle_touched_bodies(
+    world: &mut World,
+    dt: f32,
+    gravity: Vector3<f32>,
+    held: &[(hecs::Entity, u32)],
+) -> usize {
+    let mut moved = 0;
+    let query = world
+        .query_mut::<(
+            hecs::Entity,
+            (&mut Particles, &Tetrahedra, &mut Untangle),
+            Option<&mut Activation>,
+            Option<&ExternalAcceleration>,
+            Families,
+            Option<&crate::Tearing>,
+        )>()
+        .without::<&Asleep>()
+        .without::<&crate::Grab>()
+        .without::<&crate::UserForces>()
+        .without::<&crate::Plasticity>();
+    for (e, (p, t, u), act, accel, families, tearing) in query {
+        // One entity holding several pieces has no one rest shape to fit.
+        let one_piece = tearing.is_none_or(|t| t.settings().pieces == crate::Pieces::Split);
+        if !one_piece {
             continue;
+        }
+        let from = held.partition_point(|&(b, _)| b < e);
+        let to = held.partition_point(|&(b, _)| b <= e);
+        let body = Body {
+            p,
+            t,
+            u,
+            act,
+            accel,
+            families,
+        };
+        moved += usize::from(body.untangle(dt, gravity, Reach::Touched(&held[from..to])));
+    }
+    moved
+}
+
+/// The families a body's elastic energy comes from.
+type Families<'a> = (
+    Option<&'a EdgeConstraints>,
+    Option<&'a VolumeConstraints>,
+    Option<&'a VertexFaceConstraints>,
+    Option<&'a NeoHookeanMaterial>,
+);
+
+/// Which bodies a pass moves: free ones (no hook moves particles), or ones a hook's
+/// contacts may touch, whose loads the core does not see.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Reach<'a> {
+    Free,
+    /// With the `(body, particle)` pairs the hook holds.
+    Touched(&'a [(hecs::Entity, u32)]),
+}
+
+/// One body's part in a pass.
+struct Body<'a> {
+    p: &'a mut Particles,
+    t: &'a Tetrahedra,
+    u: &'a mut Untangle,
+    act: Option<&'a mut Activation>,
+    accel: Option<&'a ExternalAcceleration>,
+    families: Families<'a>,
+}
+
+impl Body<'_> {
+    /// Watches the body over its window and moves it if it is tangled; returns whether it
+    /// moved.
+    fn untangle(self, dt: f32, gravity: Vector3<f32>, reach: Reach<'_>) -> bool {
+        let Body {
+            p,
+            t,
+            u,
+            act,
+            accel,
+            families: (edges, volume, vertex_face, material),
+        } = self;
+        if u.disabled || p.inv_masses.iter().any(|&w| w <= 0.0) {
+            return false;
         }
         let (threshold, calm_after) = act.as_ref().map_or(
             (
@@ -193,7 +313,7 @@ pub(crate) fn untangle_bodies(world: &mut World, dt: f32, gravity: Vector3<f32>)
         u.slow &= speed < threshold;
         u.kinetic_peak = u.kinetic_peak.max(kinetic);
         if u.moves == 0 && u.window < 0.5 * calm_after {
-            continue;
+            return false;
         }
         let calm = Calm {
             slow: u.slow,
@@ -207,17 +327,16 @@ pub(crate) fn untangle_bodies(world: &mut World, dt: f32, gravity: Vector3<f32>)
             vertex_face,
             material,
         };
-        let load = (gravity + accel.map_or(Vector3::zeros(), |a| a.0)).norm();
-        if !move_if_tangled(p, t, u, &families, load, calm) {
+        let load = gravity + accel.map_or(Vector3::zeros(), |a| a.0);
+        if !move_if_tangled(p, t, u, &families, load, calm, reach) {
             u.moves = 0;
-            continue;
+            return false;
         }
-        moved += 1;
         if let Some(a) = act {
             a.restart();
         }
+        true
     }
-    moved
 }
 
 /// The largest particle speed (m/s) and the kinetic energy (J) relative to the
@@ -243,16 +362,23 @@ fn internal_motion(p: &Particles) -> (f32, f64) {
 }
 
 /// Checks whether the calm body `p` is tangled and, if so, moves it towards its goal
-/// (module docs); `load` is |g + a| (m/s²). Returns whether it moved.
+/// (module docs); `load` is `g + a` (m/s²). Returns whether it moved.
 fn move_if_tangled(
     p: &mut Particles,
     t: &Tetrahedra,
     u: &mut Untangle,
     families: &ElasticFamilies<'_>,
-    load: f32,
+    load: Vector3<f32>,
     calm: Calm,
+    reach: Reach<'_>,
 ) -> bool {
-    let Some((c, xc, r)) = best_fit(p) else {
+    let held = match reach {
+        Reach::Free => &[][..],
+        // Only inverted tetrahedra tell a touched body tangled (below): none, no fit.
+        Reach::Touched(_) if t.count_inverted(&p.positions) == 0 => return false,
+        Reach::Touched(h) => h,
+    };
+    let Some((c, xc, r)) = best_fit(p, held) else {
         return false;
     };
     let goal = |x: &Vector3<f32>| (c + r * (x.cast::<f64>() - xc)).cast::<f32>();
@@ -269,14 +395,32 @@ fn move_if_tangled(
     let size = (hi - lo).norm();
     let mass: f64 = p.masses.iter().map(|&m| f64::from(m)).sum();
     let energy = families.energy(t, &p.positions);
-    let unexplained =
-        u_max > DISTANCE_FLOOR * size && energy > 2.0 * mass * f64::from(load) * f64::from(u_max);
+    // A hook's loads are not known here: only inverted tetrahedra say a touched body is
+    // tangled.
+    let unexplained = reach == Reach::Free
+        && u_max > DISTANCE_FLOOR * size
+        && energy > 2.0 * mass * f64::from(load.norm()) * f64::from(u_max);
     if !calm.holds(energy) || (!unexplained && t.count_inverted(&p.positions) == 0) {
         return false;
     }
     // Only a tangled body fills the scratch: ordinary frames allocate nothing.
     u.goals.clear();
     u.goals.extend(p.rest_positions.iter().map(goal));
+    // A touched body's goal is lifted against the load until no particle of it is lower than
+    // the body's lowest now: what holds the body up is below that point. The lift's work
+    // against the load is paid from the elastic energy the move releases.
+    let mut lift_work = 0.0f64;
+    if reach != Reach::Free && load.norm() > 0.0 {
+        let down = load.normalize();
+        let lowest = |xs: &[Vector3<f32>]| xs.iter().map(|x| x.dot(&down)).fold(f32::MIN, f32::max);
+        let sink = lowest(&u.goals) - lowest(&p.positions);
+        if sink > 0.0 {
+            for g in &mut u.goals {
+                *g -= down * sink;
+            }
+            lift_work = mass * f64::from(load.norm()) * f64::from(sink);
+        }
+    }
     let mut beta = (FIRST_STEP * 2f32.powi(u.moves.min(8) as i32)).min(1.0);
     loop {
         u.trial.clear();
@@ -286,12 +430,29 @@ fn move_if_tangled(
                 .zip(&u.goals)
                 .map(|(x, g)| x + (g - x) * beta),
         );
-        if beta >= 1.0 || families.energy(t, &u.trial) <= energy {
+        // The goal itself stores no elastic energy: a free body always reaches it.
+        if beta >= 1.0 && reach == Reach::Free {
             break;
+        }
+        let cost = families.energy(t, &u.trial) + f64::from(beta) * lift_work;
+        if cost <= energy {
+            break;
+        }
+        if beta >= 1.0 {
+            // Not even the goal releases what the lift costs: stay.
+            return false;
         }
         beta = (2.0 * beta).min(1.0);
     }
     let to = if beta >= 1.0 { &u.goals } else { &u.trial };
+    // A held particle stays where the hook holds it.
+    let off = held
+        .iter()
+        .filter_map(|&(_, i)| Some((to.get(i as usize)? - p.positions[i as usize]).norm()))
+        .fold(0.0f32, f32::max);
+    if off > HELD_TOLERANCE * size {
+        return false;
+    }
     p.positions.copy_from_slice(to);
     u.moves += 1;
     true
@@ -299,21 +460,34 @@ fn move_if_tangled(
 
 /// The best-fit rigid transform of the rest shape onto the current positions: current and
 /// rest centres of mass and the rotation (polar decomposition by SVD, reflection removed).
-fn best_fit(p: &Particles) -> Option<(Vector3<f64>, Vector3<f64>, Matrix3<f64>)> {
-    let mass: f64 = p.masses.iter().map(|&m| f64::from(m)).sum();
+/// With `held` particles (`(body, particle)` pairs of this body) the fit is theirs, each
+/// weighted [`HELD_WEIGHT`] times its mass: a goal that keeps them where they are held.
+fn best_fit(
+    p: &Particles,
+    held: &[(hecs::Entity, u32)],
+) -> Option<(Vector3<f64>, Vector3<f64>, Matrix3<f64>)> {
+    let w = |i: usize| {
+        let m = f64::from(p.masses[i]);
+        if held.iter().any(|&(_, k)| k as usize == i) {
+            HELD_WEIGHT * m
+        } else {
+            m
+        }
+    };
+    let mass: f64 = (0..p.len()).map(w).sum();
     if mass <= 0.0 {
         return None;
     }
     let (mut c, mut xc) = (Vector3::zeros(), Vector3::zeros());
-    for ((x, r), &m) in p.positions.iter().zip(&p.rest_positions).zip(&p.masses) {
-        c += x.cast::<f64>() * f64::from(m);
-        xc += r.cast::<f64>() * f64::from(m);
+    for (i, (x, r)) in p.positions.iter().zip(&p.rest_positions).enumerate() {
+        c += x.cast::<f64>() * w(i);
+        xc += r.cast::<f64>() * w(i);
     }
     c /= mass;
     xc /= mass;
     let mut a = Matrix3::zeros();
-    for ((x, r), &m) in p.positions.iter().zip(&p.rest_positions).zip(&p.masses) {
-        a += (x.cast::<f64>() - c) * (r.cast::<f64>() - xc).transpose() * f64::from(m);
+    for (i, (x, r)) in p.positions.iter().zip(&p.rest_positions).enumerate() {
+        a += (x.cast::<f64>() - c) * (r.cast::<f64>() - xc).transpose() * w(i);
     }
     let svd = a.svd(true, true);
     let (mut uu, vt) = (svd.u?, svd.v_t?);
