@@ -50,30 +50,23 @@ fn take(world: &World, e: Entity) -> Snapshot {
     }
 }
 
+/// Adds the component a snapshot holds, if it holds one.
+fn add<T: hecs::Component>(b: &mut hecs::EntityBuilder, c: Option<T>) {
+    if let Some(c) = c {
+        b.add(c);
+    }
+}
+
 fn restore(s: Snapshot, world: &mut World) -> Entity {
     let mut b = hecs::EntityBuilder::new();
     b.add(s.particles).add(s.tetrahedra).add(s.surface);
-    if let Some(c) = s.edges {
-        b.add(c);
-    }
-    if let Some(c) = s.vertex_face {
-        b.add(c);
-    }
-    if let Some(c) = s.volume {
-        b.add(c);
-    }
-    if let Some(c) = s.activation {
-        b.add(c);
-    }
-    if let Some(c) = s.untangle {
-        b.add(c);
-    }
-    if let Some(c) = s.tearing {
-        b.add(c);
-    }
-    if let Some(c) = s.relaxation {
-        b.add(c);
-    }
+    add(&mut b, s.edges);
+    add(&mut b, s.vertex_face);
+    add(&mut b, s.volume);
+    add(&mut b, s.activation);
+    add(&mut b, s.untangle);
+    add(&mut b, s.tearing);
+    add(&mut b, s.relaxation);
     world.spawn(b.build())
 }
 

@@ -269,7 +269,7 @@ type Families<'a> = (
 
 /// Which bodies a pass moves: free ones (no hook moves particles), or ones a hook's
 /// contacts may touch, whose loads the core does not see.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug)]
 enum Reach<'a> {
     Free,
     /// With the `(body, particle)` pairs the hook holds.
@@ -372,11 +372,12 @@ fn move_if_tangled(
     calm: Calm,
     reach: Reach<'_>,
 ) -> bool {
-    let held = match reach {
-        Reach::Free => &[][..],
-        // Only inverted tetrahedra tell a touched body tangled (below): none, no fit.
+    // Only inverted tetrahedra tell a touched body tangled: none, no fit. (A free body's
+    // are counted below, only when its stored energy does not already say so.)
+    let (held, free) = match reach {
+        Reach::Free => (&[][..], true),
         Reach::Touched(_) if t.count_inverted(&p.positions) == 0 => return false,
-        Reach::Touched(h) => h,
+        Reach::Touched(h) => (h, false),
     };
     let Some((c, xc, r)) = best_fit(p, held) else {
         return false;
@@ -397,10 +398,11 @@ fn move_if_tangled(
     let energy = families.energy(t, &p.positions);
     // A hook's loads are not known here: only inverted tetrahedra say a touched body is
     // tangled.
-    let unexplained = reach == Reach::Free
+    let unexplained = free
         && u_max > DISTANCE_FLOOR * size
         && energy > 2.0 * mass * f64::from(load.norm()) * f64::from(u_max);
-    if !calm.holds(energy) || (!unexplained && t.count_inverted(&p.positions) == 0) {
+    let inverted = || !free || t.count_inverted(&p.positions) > 0;
+    if !calm.holds(energy) || (!unexplained && !inverted()) {
         return false;
     }
     // Only a tangled body fills the scratch: ordinary frames allocate nothing.
@@ -410,7 +412,7 @@ fn move_if_tangled(
     // the body's lowest now: what holds the body up is below that point. The lift's work
     // against the load is paid from the elastic energy the move releases.
     let mut lift_work = 0.0f64;
-    if reach != Reach::Free && load.norm() > 0.0 {
+    if !free && load.norm() > 0.0 {
         let down = load.normalize();
         let lowest = |xs: &[Vector3<f32>]| xs.iter().map(|x| x.dot(&down)).fold(f32::MIN, f32::max);
         let sink = lowest(&u.goals) - lowest(&p.positions);
@@ -431,7 +433,7 @@ fn move_if_tangled(
                 .map(|(x, g)| x + (g - x) * beta),
         );
         // The goal itself stores no elastic energy: a free body always reaches it.
-        if beta >= 1.0 && reach == Reach::Free {
+        if beta >= 1.0 && free {
             break;
         }
         let cost = families.energy(t, &u.trial) + f64::from(beta) * lift_work;
@@ -468,7 +470,8 @@ fn best_fit(
 ) -> Option<(Vector3<f64>, Vector3<f64>, Matrix3<f64>)> {
     let w = |i: usize| {
         let m = f64::from(p.masses[i]);
-        if held.iter().any(|&(_, k)| k as usize == i) {
+        // `held` is one body's pairs, sorted: by particle.
+        if held.binary_search_by_key(&(i as u32), |&(_, k)| k).is_ok() {
             HELD_WEIGHT * m
         } else {
             m
